@@ -1,0 +1,99 @@
+//! The evaluator interface every model implements.
+
+use crate::{Rgb, sampling};
+use glam::{DVec2, DVec3};
+
+/// What a model claims about itself, for its current parameters. The property
+/// tests hold every model to its claims; `bv check` prints them beside the
+/// measured numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Claims {
+    /// Helmholtz reciprocity `f(wi, wo) = f(wo, wi)`.
+    pub reciprocal: bool,
+    /// Directional albedo ρhd ≤ 1 for every incident direction.
+    pub energy_conserving: bool,
+    /// Invariance under a common rotation of `wi` and `wo` about the normal.
+    pub isotropic: bool,
+}
+
+/// Whether a delta lobe reflects or transmits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DeltaKind {
+    /// Mirror reflection into the upper hemisphere.
+    Reflection,
+    /// Refraction into the lower hemisphere.
+    Transmission,
+}
+
+/// A Dirac lobe: all of its energy leaves in one direction. Views draw it as a
+/// spike of length `weight`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DeltaLobe {
+    /// Outgoing direction (unit, away from the surface).
+    pub direction: DVec3,
+    /// Fraction of the incident flux that leaves along `direction`, per channel
+    /// (F for reflection, 1 − F for transmission).
+    pub weight: Rgb,
+    /// Factor applied to radiance along the lobe: equal to `weight` for
+    /// reflection, `(ηo/ηi)² (1 − F)` for transmission (radiance is compressed
+    /// when entering a denser medium).
+    pub radiance_scale: Rgb,
+    /// Reflection or transmission.
+    pub kind: DeltaKind,
+}
+
+/// A microfacet normal distribution, for the D-normalisation check.
+pub trait Ndf: Send + Sync {
+    /// D(h) for a unit `h` in the upper hemisphere (1/sr).
+    fn d(&self, h: DVec3) -> f64;
+}
+
+/// A bidirectional scattering distribution function (SPEC §1 conventions).
+pub trait Brdf: Send + Sync + std::fmt::Debug {
+    /// Model id from the catalogue.
+    fn id(&self) -> &'static str;
+
+    /// `f(wi, wo)` without the cosine factor, 1/sr, per linear-RGB channel.
+    /// Zero when either direction is below the horizon (reflection models) and
+    /// at every finite pair for delta models.
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb;
+
+    /// What the model claims for its current parameters.
+    fn claims(&self) -> Claims;
+
+    /// The delta lobes for light arriving from `wi` (empty for non-delta models).
+    fn deltas(&self, _wi: DVec3) -> Vec<DeltaLobe> {
+        Vec::new()
+    }
+
+    /// Whether the model scatters into the lower hemisphere (lobe meshes then
+    /// cover the whole sphere).
+    fn transmits(&self) -> bool {
+        false
+    }
+
+    /// Draws an outgoing direction for light from `wi`, given a uniform point
+    /// `u ∈ [0,1)²`. `None` when no direction could be drawn. Default: cosine
+    /// weighted, which suits diffuse-like models.
+    fn sample(&self, _wi: DVec3, u: DVec2) -> Option<DVec3> {
+        Some(sampling::cosine_hemisphere(u))
+    }
+
+    /// Solid-angle density of [`Brdf::sample`] at `wo` (must match it).
+    fn pdf(&self, _wi: DVec3, wo: DVec3) -> f64 {
+        sampling::cosine_hemisphere_pdf(wo)
+    }
+
+    /// The microfacet distribution, for models that have one.
+    fn ndf(&self) -> Option<&dyn Ndf> {
+        None
+    }
+
+    /// Evaluates many pairs at once (`out[i] = f(pairs[i])`). Models may override
+    /// it with a faster loop; the default calls [`Brdf::eval`].
+    fn eval_batch(&self, pairs: &[(DVec3, DVec3)], out: &mut [Rgb]) {
+        for (o, &(wi, wo)) in out.iter_mut().zip(pairs) {
+            *o = self.eval(wi, wo);
+        }
+    }
+}

@@ -1,0 +1,34 @@
+//! # bv-core
+//!
+//! All of bv's evaluation: the analytic BRDF models of the lecture, Fresnel
+//! terms, microfacet distributions, measured data, lobe meshes and the property
+//! analysis (positivity, reciprocity, isotropy, energy). It depends on no GUI
+//! crate; the `bv` application, the shaders' parity tests and the command line
+//! all call into it.
+//!
+//! Conventions (SPEC §1): local frame with normal `+z`, tangent `+x`; `wi`
+//! towards the light and `wo` towards the viewer, both pointing away from the
+//! surface; `f(wi, wo)` is returned without the cosine factor, per linear-RGB
+//! channel.
+
+pub mod brdf;
+pub mod error;
+pub mod frame;
+pub mod models;
+pub mod params;
+pub mod registry;
+pub mod sampling;
+
+pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, Ndf};
+pub use error::{BvError, Result};
+pub use params::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
+pub use registry::{ModelInfo, catalogue, find};
+
+/// A linear-RGB triple (one value per channel).
+pub type Rgb = glam::DVec3;
+
+/// Mean of the three channels: the scalar a lobe's radius and the reports use.
+#[inline]
+pub fn mean_rgb(c: Rgb) -> f64 {
+    (c.x + c.y + c.z) / 3.0
+}

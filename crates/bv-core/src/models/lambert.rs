@@ -1,0 +1,85 @@
+//! Lambert: the ideal diffuse reflector, `f = albedo / π`.
+
+use crate::params::{ColorSpec, ParamDecl, ParamKind, Params};
+use crate::registry::ModelInfo;
+use crate::{Brdf, Claims, Result, Rgb};
+use glam::DVec3;
+use std::f64::consts::FRAC_1_PI;
+
+/// Parameter declaration.
+pub const PARAMS: &[ParamDecl] = &[ParamDecl {
+    id: "albedo",
+    label: "albedo",
+    doc: "Directional-hemispherical reflectance ρ (the BRDF is ρ/π)",
+    kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+}];
+
+/// Catalogue entry.
+pub const INFO: ModelInfo = ModelInfo {
+    id: "lambert",
+    name: "Lambert",
+    summary: "Ideal diffuse reflection: the same radiance in every direction",
+    citation: "Lambert 1760; PBRT 3rd ed. §8.3",
+    params: PARAMS,
+    build,
+};
+
+/// Lambertian reflector.
+#[derive(Debug, Clone)]
+pub struct Lambert {
+    /// ρ / π, precomputed.
+    f: Rgb,
+    albedo: Rgb,
+}
+
+impl Lambert {
+    /// A Lambertian reflector of the given albedo.
+    pub fn new(albedo: Rgb) -> Self {
+        Self {
+            f: albedo * FRAC_1_PI,
+            albedo,
+        }
+    }
+}
+
+fn build(p: &Params) -> Result<Box<dyn Brdf>> {
+    Ok(Box::new(Lambert::new(p.color("albedo")?)))
+}
+
+impl Brdf for Lambert {
+    fn id(&self) -> &'static str {
+        INFO.id
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.f
+    }
+
+    fn claims(&self) -> Claims {
+        Claims {
+            reciprocal: true,
+            energy_conserving: self.albedo.max_element() <= 1.0,
+            isotropic: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ModelSpec;
+
+    #[test]
+    fn value_is_albedo_over_pi() {
+        let b = ModelSpec::from_json("lambert", &serde_json::json!({"albedo": 0.5}))
+            .unwrap()
+            .build()
+            .unwrap();
+        let f = b.eval(DVec3::Z, DVec3::new(0.6, 0.0, 0.8));
+        assert!((f.x - 0.5 / std::f64::consts::PI).abs() < 1e-15);
+        assert_eq!(b.eval(DVec3::Z, DVec3::new(0.6, 0.0, -0.8)), Rgb::ZERO);
+    }
+}
