@@ -1,0 +1,5 @@
+//! The `bv` application: the viewer window (`app`, `views`) and the command line
+//! (`cli`), both thin layers over `bv-core`.
+
+pub mod app;
+pub mod cli;
