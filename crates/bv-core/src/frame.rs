@@ -232,7 +232,11 @@ mod tests {
 
     #[test]
     fn half_diff_round_trip() {
-        for &(a, b) in &[((0.3, 0.1), (0.9, 2.0)), ((1.4, -1.0), (0.2, 0.5)), ((0.5, 0.0), (0.5, 3.0))] {
+        for &(a, b) in &[
+            ((0.3, 0.1), (0.9, 2.0)),
+            ((1.4, -1.0), (0.2, 0.5)),
+            ((0.5, 0.0), (0.5, 3.0)),
+        ] {
             let wi = from_spherical(a.0, a.1);
             let wo = from_spherical(b.0, b.1);
             let hd = to_half_diff(wi, wo).unwrap();

@@ -14,6 +14,7 @@
 pub mod brdf;
 pub mod error;
 pub mod frame;
+pub mod lobe;
 pub mod models;
 pub mod params;
 pub mod registry;

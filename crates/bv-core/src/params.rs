@@ -517,8 +517,9 @@ pub fn cli_text_to_json(decl: &ParamDecl, text: &str) -> Result<Value> {
             "false" | "0" | "no" | "off" => Ok(Value::Bool(false)),
             other => Err(bad(format!("`{other}` is not true or false"))),
         },
-        ParamKind::List { .. } | ParamKind::Components { .. } => serde_json::from_str(text)
-            .map_err(|e| bad(format!("expected a JSON list ({e})"))),
+        ParamKind::List { .. } | ParamKind::Components { .. } => {
+            serde_json::from_str(text).map_err(|e| bad(format!("expected a JSON list ({e})")))
+        }
     }
 }
 
@@ -585,10 +586,7 @@ pub fn parse_value(decl: &ParamDecl, v: &Value, depth: usize) -> Result<ParamVal
             if options.contains(&s) {
                 Ok(ParamValue::Text(s.to_string()))
             } else {
-                Err(bad(format!(
-                    "`{s}` is not one of {}",
-                    options.join(", ")
-                )))
+                Err(bad(format!("`{s}` is not one of {}", options.join(", "))))
             }
         }
         ParamKind::Bool { .. } => v
@@ -627,9 +625,8 @@ pub fn parse_value(decl: &ParamDecl, v: &Value, depth: usize) -> Result<ParamVal
                             fields.iter().map(|f| f.id).collect::<Vec<_>>().join(", ")
                         ))
                     })?;
-                    let val = parse_value(f, x, depth).map_err(|e| {
-                        rename(e, &format!("{id}[{i}].{k}"))
-                    })?;
+                    let val = parse_value(f, x, depth)
+                        .map_err(|e| rename(e, &format!("{id}[{i}].{k}")))?;
                     p.0.insert(k.clone(), val);
                 }
                 out.push(p);

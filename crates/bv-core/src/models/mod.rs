@@ -7,6 +7,4 @@ use crate::registry::ModelInfo;
 pub mod lambert;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[
-    &lambert::INFO,
-];
+pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO];
