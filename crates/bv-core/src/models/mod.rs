@@ -5,8 +5,11 @@
 use crate::registry::ModelInfo;
 
 pub mod lambert;
+pub mod lobes;
+pub mod phong;
 
 /// Every model, in presentation order.
 pub static CATALOGUE: &[&ModelInfo] = &[
     &lambert::INFO,
+    &phong::INFO,
 ];
