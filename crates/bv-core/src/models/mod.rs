@@ -4,6 +4,7 @@
 
 use crate::registry::ModelInfo;
 
+pub mod blinn_phong;
 pub mod lambert;
 pub mod lobes;
 pub mod phong;
@@ -12,4 +13,5 @@ pub mod phong;
 pub static CATALOGUE: &[&ModelInfo] = &[
     &lambert::INFO,
     &phong::INFO,
+    &blinn_phong::INFO,
 ];
