@@ -4,7 +4,16 @@
 
 use crate::registry::ModelInfo;
 
+pub mod blinn_phong;
 pub mod lambert;
+pub mod lobes;
+pub mod modified_phong;
+pub mod phong;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO];
+pub static CATALOGUE: &[&ModelInfo] = &[
+    &lambert::INFO,
+    &phong::INFO,
+    &blinn_phong::INFO,
+    &modified_phong::INFO,
+];
