@@ -4,9 +4,11 @@
 
 use crate::registry::ModelInfo;
 
+pub mod ashikhmin_shirley;
 pub mod lambert;
 
+#[cfg(test)]
+pub(crate) mod testkit;
+
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[
-    &lambert::INFO,
-];
+pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO, &ashikhmin_shirley::INFO];
