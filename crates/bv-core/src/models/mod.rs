@@ -6,9 +6,11 @@ use crate::registry::ModelInfo;
 
 pub mod ashikhmin_shirley;
 pub mod lambert;
+pub mod oren_nayar;
 
 #[cfg(test)]
 pub(crate) mod testkit;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO, &ashikhmin_shirley::INFO];
+pub static CATALOGUE: &[&ModelInfo] =
+    &[&lambert::INFO, &ashikhmin_shirley::INFO, &oren_nayar::INFO];
