@@ -5,6 +5,7 @@
 use crate::registry::ModelInfo;
 
 pub mod ashikhmin_shirley;
+pub mod hapke;
 pub mod lambert;
 pub mod oren_nayar;
 
@@ -12,5 +13,9 @@ pub mod oren_nayar;
 pub(crate) mod testkit;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] =
-    &[&lambert::INFO, &ashikhmin_shirley::INFO, &oren_nayar::INFO];
+pub static CATALOGUE: &[&ModelInfo] = &[
+    &lambert::INFO,
+    &ashikhmin_shirley::INFO,
+    &oren_nayar::INFO,
+    &hapke::INFO,
+];
