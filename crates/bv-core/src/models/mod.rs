@@ -4,11 +4,17 @@
 
 use crate::registry::ModelInfo;
 
+pub mod ashikhmin_shirley;
 pub mod blinn_phong;
+pub mod hapke;
 pub mod lambert;
 pub mod lobes;
 pub mod modified_phong;
+pub mod oren_nayar;
 pub mod phong;
+
+#[cfg(test)]
+pub(crate) mod testkit;
 
 /// Every model, in presentation order.
 pub static CATALOGUE: &[&ModelInfo] = &[
@@ -16,4 +22,7 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &phong::INFO,
     &blinn_phong::INFO,
     &modified_phong::INFO,
+    &ashikhmin_shirley::INFO,
+    &oren_nayar::INFO,
+    &hapke::INFO,
 ];
