@@ -7,6 +7,7 @@ use crate::registry::ModelInfo;
 pub mod ashikhmin_shirley;
 pub mod hapke;
 pub mod lambert;
+pub mod mix;
 pub mod oren_nayar;
 
 #[cfg(test)]
@@ -18,4 +19,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &ashikhmin_shirley::INFO,
     &oren_nayar::INFO,
     &hapke::INFO,
+    &mix::INFO,
 ];
