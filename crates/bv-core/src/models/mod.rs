@@ -10,6 +10,7 @@ pub mod hapke;
 pub mod lambert;
 pub mod lobes;
 pub mod modified_phong;
+pub mod mix;
 pub mod oren_nayar;
 pub mod phong;
 
@@ -25,4 +26,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &ashikhmin_shirley::INFO,
     &oren_nayar::INFO,
     &hapke::INFO,
+    &mix::INFO,
 ];
