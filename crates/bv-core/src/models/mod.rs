@@ -9,6 +9,7 @@ pub mod lambert;
 pub mod lobes;
 pub mod modified_phong;
 pub mod phong;
+pub mod ward;
 
 /// Every model, in presentation order.
 pub static CATALOGUE: &[&ModelInfo] = &[
@@ -16,4 +17,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &phong::INFO,
     &blinn_phong::INFO,
     &modified_phong::INFO,
+    &ward::INFO,
 ];
