@@ -5,6 +5,7 @@
 use crate::registry::ModelInfo;
 
 pub mod blinn_phong;
+pub mod lafortune;
 pub mod lambert;
 pub mod lobes;
 pub mod modified_phong;
@@ -18,4 +19,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &blinn_phong::INFO,
     &modified_phong::INFO,
     &ward::INFO,
+    &lafortune::INFO,
 ];
