@@ -4,6 +4,7 @@
 
 use crate::registry::ModelInfo;
 
+pub mod banks;
 pub mod blinn_phong;
 pub mod lafortune;
 pub mod lambert;
@@ -20,4 +21,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &modified_phong::INFO,
     &ward::INFO,
     &lafortune::INFO,
+    &banks::INFO,
 ];
