@@ -14,6 +14,8 @@
 pub mod brdf;
 pub mod error;
 pub mod frame;
+pub mod fresnel;
+pub mod microfacet;
 pub mod models;
 pub mod params;
 pub mod registry;

@@ -4,9 +4,8 @@
 
 use crate::registry::ModelInfo;
 
+pub mod cook_torrance;
 pub mod lambert;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[
-    &lambert::INFO,
-];
+pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO, &cook_torrance::INFO];
