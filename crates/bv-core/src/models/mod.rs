@@ -5,7 +5,14 @@
 use crate::registry::ModelInfo;
 
 pub mod cook_torrance;
+pub mod glass;
 pub mod lambert;
+pub mod mirror;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO, &cook_torrance::INFO];
+pub static CATALOGUE: &[&ModelInfo] = &[
+    &lambert::INFO,
+    &cook_torrance::INFO,
+    &mirror::INFO,
+    &glass::INFO,
+];
