@@ -5,6 +5,7 @@
 use crate::registry::ModelInfo;
 
 pub mod cook_torrance;
+pub mod disney;
 pub mod glass;
 pub mod lambert;
 pub mod mirror;
@@ -15,4 +16,5 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &cook_torrance::INFO,
     &mirror::INFO,
     &glass::INFO,
+    &disney::INFO,
 ];
