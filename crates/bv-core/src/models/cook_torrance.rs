@@ -426,6 +426,33 @@ mod tests {
         v
     }
 
+    #[test]
+    fn every_d_g_f_combination_is_reciprocal() {
+        // Deterministic sweep over all 36 variants (the proptest samples them).
+        let pairs = [
+            (dir(0.2, 0.1), dir(1.1, 2.9)),
+            (dir(1.5, -0.4), dir(0.6, 1.7)),
+            (dir(1e-6f64.acos(), 0.3), dir(0.9, -2.0)),
+            (dir(1.3, 1.0), dir(1.3, 1.0 + PI)),
+        ];
+        for mut p in all_variants() {
+            p["alpha_x"] = json!(0.25);
+            p["alpha_y"] = json!(0.6);
+            p["alpha2"] = json!(0.05);
+            p["weight2"] = json!(0.3);
+            let b = model(p.clone());
+            for (wi, wo) in pairs {
+                let (f, r) = (b.eval(wi, wo), b.eval(wo, wi));
+                let scale = f.max_element().max(r.max_element());
+                assert!(scale > 0.0 && f.is_finite());
+                assert!(
+                    (f - r).abs().max_element() <= 1e-6 * scale,
+                    "{p}: {f} vs {r}"
+                );
+            }
+        }
+    }
+
     fn dir(theta: f64, phi: f64) -> DVec3 {
         from_spherical(theta, phi)
     }
