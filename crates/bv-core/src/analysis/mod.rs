@@ -319,7 +319,14 @@ fn num(x: f64) -> String {
         let digits = (3 - x.abs().log10().floor() as i32).max(0) as usize;
         format!("{x:.digits$}")
     } else {
-        format!("{x:.3e}")
+        // 3.100e-17 → 3.1e-17, 1.000e-6 → 1e-6.
+        let s = format!("{x:.3e}");
+        match s.split_once('e') {
+            Some((m, e)) if m.contains('.') => {
+                format!("{}e{e}", m.trim_end_matches('0').trim_end_matches('.'))
+            }
+            _ => s,
+        }
     }
 }
 
@@ -348,7 +355,7 @@ impl fmt::Display for PropertyReport {
                 p.non_finite
             ),
             if p.ok { "finite, ≥ 0" } else { "VIOLATED" }.into(),
-            "required".into(),
+            "".into(),
             p.ok,
         ));
         rows.push((
@@ -439,7 +446,7 @@ impl fmt::Display for PropertyReport {
                     "NOT normalised"
                 }
                 .into(),
-                "required".into(),
+                "".into(),
                 n.normalised,
             ));
         }
@@ -457,15 +464,15 @@ impl fmt::Display for PropertyReport {
             pad("verdict", w2)
         )?;
         for (name, measured, verdict, claim, agrees) in &rows {
+            let flag = match (*agrees, claim.is_empty()) {
+                (true, _) => "",
+                (false, true) => "  <-- required of every BRDF",
+                (false, false) => "  <-- contradicts the claim",
+            };
             let claim = if claim.is_empty() {
                 String::new()
             } else {
                 format!("(claimed: {claim})")
-            };
-            let flag = if *agrees {
-                ""
-            } else {
-                "  <-- contradicts the claim"
             };
             let line = format!(
                 "  {}  {}  {}  {claim}{flag}",
@@ -667,6 +674,8 @@ mod tests {
         assert_eq!(num(0.0), "0");
         assert_eq!(num(0.5), "0.5000");
         assert_eq!(num(123.456), "123.5");
-        assert_eq!(num(3.1e-17), "3.100e-17");
+        assert_eq!(num(3.1e-17), "3.1e-17");
+        assert_eq!(num(1e-6), "1e-6");
+        assert_eq!(num(-2.5e7), "-2.5e7");
     }
 }
