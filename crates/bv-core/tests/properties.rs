@@ -303,7 +303,7 @@ fn catalogue_is_not_empty_and_ids_are_unique() {
 
 #[test]
 fn f_is_finite_and_non_negative() {
-    for_every_model(48, (any::<u64>(), pair()), |m, (seed, (wi, wo))| {
+    for_every_model(256, (any::<u64>(), pair()), |m, (seed, (wi, wo))| {
         let (spec, b) = random_model(m, seed);
         let mut pairs = vec![(wi, wo), (wo, wi)];
         pairs.extend(directions::upper_pairs(24, seed));
@@ -327,7 +327,7 @@ fn f_is_finite_and_non_negative() {
 
 #[test]
 fn reciprocal_where_claimed() {
-    for_every_model(48, (any::<u64>(), pair()), |m, (seed, (wi, wo))| {
+    for_every_model(256, (any::<u64>(), pair()), |m, (seed, (wi, wo))| {
         let (spec, b) = random_model(m, seed);
         if !b.claims().reciprocal {
             return Ok(());
@@ -357,15 +357,18 @@ fn sample_and_pdf_are_consistent() {
     let u = prop_oneof![
         4 => (0.0..1.0f64, 0.0..1.0f64),
         1 => prop::sample::select(vec![
-            (0.0, 0.0),
-            (1.0 - 1e-16, 1.0 - 1e-16),
-            (0.5, 1.0 - 1e-16),
-            (1.0 - 1e-16, 0.0),
-            (0.0, 0.5),
+            // Near the square's edges but inside it: on the edges a lobe
+            // warp may land where its density is exactly 0 (u.x = 0 maps a
+            // power-cosine lobe to α = 90°), a null set.
+            (1e-12, 1e-12),
+            (1.0 - 1e-12, 1.0 - 1e-12),
+            (0.5, 1.0 - 1e-12),
+            (1.0 - 1e-12, 1e-12),
+            (1e-12, 0.5),
         ]),
     ];
     for_every_model(
-        32,
+        256,
         (any::<u64>(), upper_dir(), u, upper_dir()),
         |m, (seed, wi, u, w)| {
             let (spec, b) = random_model(m, seed);
@@ -400,20 +403,15 @@ fn sample_and_pdf_are_consistent() {
 #[test]
 fn energy_conserving_where_claimed() {
     for_every_model(
-        6,
+        64,
         (any::<u64>(), 0.0..FRAC_PI_2, 0.0..2.0 * PI),
         |m, (seed, t, phi)| {
             let (spec, b) = random_model(m, seed);
             if !b.claims().energy_conserving {
                 return Ok(());
             }
-            for theta in [
-                0.0,
-                t,
-                60f64.to_radians(),
-                85f64.to_radians(),
-                89f64.to_radians(),
-            ] {
+            let grazing = [60.0, 85.0, 89.0, 89.9, 89.99].map(f64::to_radians);
+            for theta in [0.0, t].into_iter().chain(grazing) {
                 let e = albedo::rho_hd(b.as_ref(), theta, phi, 2048, seed);
                 prop_assert_eq!(
                     e.rejected,
@@ -440,7 +438,7 @@ fn energy_conserving_where_claimed() {
 
 #[test]
 fn microfacet_distributions_are_normalised() {
-    for_every_model(4, any::<u64>(), |m, seed| {
+    for_every_model(16, any::<u64>(), |m, seed| {
         let (spec, b) = random_model(m, seed);
         let Some(d) = b.ndf() else {
             return Ok(());

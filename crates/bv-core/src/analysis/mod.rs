@@ -34,6 +34,11 @@ pub struct CheckOptions {
     /// θi angles of each ρhd curve: 0°, 90°/n, …, 90° − 90°/n (default 90, so
     /// 0°, 1°, …, 89°).
     pub theta_count: usize,
+    /// Extra θi (degrees) examined for the energy verdict, beyond the curve's
+    /// grid: near grazing, where `1/cos θi` factors make ρhd grow without bound
+    /// (seed Phong exceeds 1 only above ~88°). Default 89.5°, 89.9°, 89.99°,
+    /// 89.999°.
+    pub grazing_deg: Vec<f64>,
     /// Samples per ρhd value (default 4096, in 16 replicas for the error).
     pub samples_per_angle: usize,
     /// Incident azimuths for the ρhd curves of an anisotropic model:
@@ -63,6 +68,7 @@ impl Default for CheckOptions {
         Self {
             pairs: 20_000,
             theta_count: 90,
+            grazing_deg: vec![89.5, 89.9, 89.99, 89.999],
             samples_per_angle: 4096,
             anisotropic_azimuths: 4,
             hh_samples: 65_536,
@@ -122,8 +128,11 @@ pub struct ClaimsReport {
 /// The energy section of a report.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Energy {
-    /// ρhd curves, one per incident azimuth examined.
+    /// ρhd curves on the uniform θi grid, one per incident azimuth examined.
     pub curves: Vec<AlbedoCurve>,
+    /// ρhd at the near-grazing θi of [`CheckOptions::grazing_deg`], one per
+    /// azimuth.
+    pub grazing: Vec<AlbedoCurve>,
     /// The largest ρhd over the curves (by its largest channel).
     pub max: Estimate,
     /// θi of the maximum (degrees).
@@ -232,9 +241,13 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
         opts.anisotropic_azimuths.max(1)
     };
     let n_theta = opts.theta_count.max(1);
-    let curves: Vec<AlbedoCurve> = (0..azimuths)
-        .map(|k| {
-            let phi = std::f64::consts::PI * k as f64 / azimuths as f64;
+    let phis: Vec<f64> = (0..azimuths)
+        .map(|k| std::f64::consts::PI * k as f64 / azimuths as f64)
+        .collect();
+    let curves: Vec<AlbedoCurve> = phis
+        .iter()
+        .enumerate()
+        .map(|(k, &phi)| {
             albedo::rho_hd_curve(
                 brdf,
                 phi,
@@ -244,10 +257,28 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
             )
         })
         .collect();
+    let grazing_rad: Vec<f64> = opts
+        .grazing_deg
+        .iter()
+        .map(|d| d.clamp(0.0, 90.0).to_radians())
+        .collect();
+    let grazing: Vec<AlbedoCurve> = phis
+        .iter()
+        .enumerate()
+        .map(|(k, &phi)| {
+            albedo::rho_hd_angles(
+                brdf,
+                phi,
+                &grazing_rad,
+                opts.samples_per_angle,
+                directions::stream_seed(opts.seed, 2000 + k as u64),
+            )
+        })
+        .collect();
     let mut max = None::<(Estimate, f64, f64)>;
     let mut max_excess_sigmas = f64::NEG_INFINITY;
     let mut conserves = true;
-    for curve in &curves {
+    for curve in curves.iter().chain(&grazing) {
         for (e, &t) in curve.rho.iter().zip(&curve.theta_deg) {
             for ch in 0..3 {
                 let (v, s) = (e.value[ch], e.std_error[ch]);
@@ -291,6 +322,7 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
     );
     Energy {
         curves,
+        grazing,
         max,
         argmax_theta_deg,
         argmax_phi_deg,
@@ -328,6 +360,13 @@ fn num(x: f64) -> String {
             _ => s,
         }
     }
+}
+
+/// An angle in degrees: up to 3 decimals, trailing zeros dropped (89.999°
+/// must not print as 90°).
+fn deg(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// An estimate of the largest channel with its error.
@@ -402,11 +441,12 @@ impl fmt::Display for PropertyReport {
         rows.push((
             "energy".into(),
             format!(
-                "max ρhd {} at θi = {}°, φi = {}° ({} θi × {} azimuth(s) × {} samples{extras})",
+                "max ρhd {} at θi = {}°, φi = {}° ({} + {} grazing θi × {} azimuth(s) × {} samples{extras})",
                 est(&e.max),
-                num(e.argmax_theta_deg),
-                num(e.argmax_phi_deg),
+                deg(e.argmax_theta_deg),
+                deg(e.argmax_phi_deg),
                 e.curves.first().map_or(0, |cv| cv.rho.len()),
+                e.grazing.first().map_or(0, |cv| cv.rho.len()),
                 e.curves.len(),
                 per_angle.map_or(0, |x| x.samples),
             ),
@@ -487,10 +527,10 @@ impl fmt::Display for PropertyReport {
             writeln!(
                 f,
                 "  worst reciprocity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f(wi,wo) {} vs f(wo,wi) {}",
-                num(w.wi_deg[0]),
-                num(w.wi_deg[1]),
-                num(w.wo_deg[0]),
-                num(w.wo_deg[1]),
+                deg(w.wi_deg[0]),
+                deg(w.wi_deg[1]),
+                deg(w.wo_deg[0]),
+                deg(w.wo_deg[1]),
                 num(w.f.max_element()),
                 num(w.f_swapped.max_element())
             )?;
@@ -499,10 +539,10 @@ impl fmt::Display for PropertyReport {
             writeln!(
                 f,
                 "  worst positivity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f = [{}, {}, {}]",
-                num(w.wi_deg[0]),
-                num(w.wi_deg[1]),
-                num(w.wo_deg[0]),
-                num(w.wo_deg[1]),
+                deg(w.wi_deg[0]),
+                deg(w.wi_deg[1]),
+                deg(w.wo_deg[0]),
+                deg(w.wo_deg[1]),
                 num(w.f.x),
                 num(w.f.y),
                 num(w.f.z)
@@ -511,6 +551,7 @@ impl fmt::Display for PropertyReport {
         let rejected: usize = e
             .curves
             .iter()
+            .chain(&e.grazing)
             .flat_map(|c| c.rho.iter().map(|x| x.rejected))
             .sum::<usize>()
             + e.rho_hh.rejected;
@@ -677,5 +718,8 @@ mod tests {
         assert_eq!(num(3.1e-17), "3.1e-17");
         assert_eq!(num(1e-6), "1e-6");
         assert_eq!(num(-2.5e7), "-2.5e7");
+        assert_eq!(deg(89.999), "89.999");
+        assert_eq!(deg(3.0), "3");
+        assert_eq!(deg(87.5), "87.5");
     }
 }
