@@ -63,17 +63,33 @@ fn synthetic_table(full: bool) -> String {
             std::process::id()
         ));
         // SPEC §4: three little-endian int32 dims, then 3·n float64 values
-        // (channel-major). Values in [−20, 600] so that some are "not
-        // measured" (negative) and the rest give f up to ~0.66 1/sr.
-        let n = (dims[0] * dims[1] * dims[2]) as usize;
-        let mut bytes = Vec::with_capacity(12 + 24 * n);
+        // (channel-major, index (iθh·nθd + iθd)·nφd + iφd). Random cells give
+        // the largest possible steps, so an index or fold error cannot hide;
+        // about 3 % are negative ("not measured"); the rest give f up to
+        // ~0.66 1/sr. The first θh row does not depend on φd: at θh = 0 the
+        // half vector is the normal, φh is undefined and φd changes under a
+        // rotation about the normal, so only φd-independent data there can be
+        // isotropic (as real measurements are).
+        let [nh, nd, np] = dims.map(|d| d as usize);
+        let mut bytes = Vec::with_capacity(12 + 24 * nh * nd * np);
         for d in dims {
             bytes.extend_from_slice(&d.to_le_bytes());
         }
         let mut rng = sampling::rng(42);
-        for _ in 0..3 * n {
-            let v: f64 = rng.random_range(-20.0..600.0);
-            bytes.extend_from_slice(&v.to_le_bytes());
+        for _channel in 0..3 {
+            for ih in 0..nh {
+                for _id in 0..nd {
+                    let row: f64 = rng.random_range(-20.0..600.0);
+                    for _ip in 0..np {
+                        let v = if ih == 0 {
+                            row
+                        } else {
+                            rng.random_range(-20.0..600.0)
+                        };
+                        bytes.extend_from_slice(&v.to_le_bytes());
+                    }
+                }
+            }
         }
         std::fs::write(&path, bytes).unwrap();
         path
