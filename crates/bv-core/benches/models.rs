@@ -48,8 +48,9 @@ fn synthetic_table() -> String {
 }
 
 fn write_synthetic_table() -> String {
-    let path = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("bv-bench-90x90x180-{}.binary", std::process::id()));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let path = dir.join("bv-bench-90x90x180.binary");
+    let tmp = dir.join(format!("bv-bench-90x90x180.binary.{}", std::process::id()));
     let dims = [90i32, 90, 180];
     let n = (dims[0] * dims[1] * dims[2]) as usize;
     let mut bytes = Vec::with_capacity(12 + 24 * n);
@@ -62,7 +63,8 @@ fn write_synthetic_table() -> String {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    if let Err(e) = std::fs::write(&path, bytes) {
+    // A private name, then a rename: a concurrent run never reads half a file.
+    if let Err(e) = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path)) {
         eprintln!("cannot write {}: {e}", path.display());
     }
     path.to_string_lossy().into_owned()

@@ -55,13 +55,9 @@ fn synthetic_table(full: bool) -> String {
         (&SMALL, [6i32, 6, 12])
     };
     let path = cell.get_or_init(|| {
-        let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
-            "bv-properties-{}x{}x{}-{}.binary",
-            dims[0],
-            dims[1],
-            dims[2],
-            std::process::id()
-        ));
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+        let name = format!("bv-properties-{}x{}x{}.binary", dims[0], dims[1], dims[2]);
+        let path = dir.join(&name);
         // SPEC §4: three little-endian int32 dims, then 3·n float64 values
         // (channel-major, index (iθh·nθd + iθd)·nφd + iφd). Random cells give
         // the largest possible steps, so an index or fold error cannot hide;
@@ -91,7 +87,11 @@ fn synthetic_table(full: bool) -> String {
                 }
             }
         }
-        std::fs::write(&path, bytes).unwrap();
+        // Written under a private name and renamed, so that concurrent test
+        // runs never read a half-written table.
+        let tmp = dir.join(format!("{name}.{}", std::process::id()));
+        std::fs::write(&tmp, bytes).unwrap();
+        std::fs::rename(&tmp, &path).unwrap();
         path
     });
     path.to_string_lossy().into_owned()
