@@ -226,11 +226,22 @@ impl Fresnel {
     pub fn eval(&self, cos: f64) -> Rgb {
         match *self {
             Fresnel::None => Rgb::ONE,
+            // A grey index (the common case: one η for a dielectric) is
+            // evaluated once rather than per channel; this is a third of the
+            // cost of a Cook-Torrance evaluation.
+            Fresnel::Dielectric { eta } if eta.x == eta.y && eta.y == eta.z => {
+                Rgb::splat(dielectric(cos, eta.x))
+            }
             Fresnel::Dielectric { eta } => Rgb::new(
                 dielectric(cos, eta.x),
                 dielectric(cos, eta.y),
                 dielectric(cos, eta.z),
             ),
+            Fresnel::Conductor { eta, k }
+                if eta.x == eta.y && eta.y == eta.z && k.x == k.y && k.y == k.z =>
+            {
+                Rgb::splat(conductor(cos, eta.x, k.x))
+            }
             Fresnel::Conductor { eta, k } => Rgb::new(
                 conductor(cos, eta.x, k.x),
                 conductor(cos, eta.y, k.y),
