@@ -181,13 +181,19 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         });
         format!("{v}\n")
     } else {
+        let s = |n: usize| if n == 1 { "" } else { "s" };
         format!(
-            "{:.2} M evals/s (model {}, {} pairs, {} threads, {} passes in {:.3} s)\n",
+            "{:.*} M evals/s (model {}, {} pair{}, {} thread{}, {} pass{} in {:.3} s)\n",
+            // Slow models (below 1 M evals/s) keep three significant digits.
+            if rate >= 1e6 { 2 } else { 4 },
             rate / 1e6,
             spec.model,
             r.pairs,
+            s(r.pairs),
             r.threads,
+            s(r.threads),
             r.passes,
+            if r.passes == 1 { "" } else { "es" },
             r.seconds
         )
     };
