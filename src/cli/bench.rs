@@ -10,7 +10,7 @@
 
 use super::output::print;
 use super::params::ModelArgs;
-use anyhow::{Context, bail};
+use anyhow::Context;
 use bv_core::{Brdf, Rgb, sampling};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -155,9 +155,6 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Some(t) => usize::from(t),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
-    if args.pairs == 0 {
-        bail!("--pairs must be at least 1");
-    }
     let pairs = random_pairs(args.pairs);
     let r = measure(brdf.as_ref(), &pairs, threads, MIN_TIMED)?;
     if r.non_finite > 0 {

@@ -84,32 +84,32 @@ pub fn eval_stream<R: Read, W: Write>(
     let mut evaluator = Evaluator::default();
     let mut summary = Summary::default();
     let mut line = Vec::new();
-    let mut first = true;
+    let mut lines_read = 0usize;
     loop {
         if input.buffer().is_empty() {
             out.flush()?;
         }
-        let answer = match read_line_limited(&mut input, &mut line)? {
+        let read = read_line_limited(&mut input, &mut line)?;
+        lines_read += 1;
+        let answer = match read {
             Line::End => break,
             Line::TooLong => Err(format!("query line longer than {MAX_LINE} bytes; refused")),
             Line::Complete => match std::str::from_utf8(&line) {
                 Err(e) => Err(format!("query line is not valid UTF-8 ({e})")),
                 Ok(text) => {
                     // A byte-order mark some editors put at the start of a file.
-                    let text = if first {
+                    let text = if lines_read == 1 {
                         text.trim_start_matches('\u{feff}')
                     } else {
                         text
                     };
                     if text.trim().is_empty() {
-                        first = false;
                         continue;
                     }
                     evaluator.answer(text)
                 }
             },
         };
-        first = false;
         summary.answered += 1;
         let json = match answer {
             Ok(f) => serde_json::json!({ "f": [f.x, f.y, f.z] }),
