@@ -11,6 +11,7 @@
 //! surface; `f(wi, wo)` is returned without the cosine factor, per linear-RGB
 //! channel.
 
+pub mod analysis;
 pub mod brdf;
 pub mod error;
 pub mod frame;
