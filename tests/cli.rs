@@ -377,3 +377,76 @@ fn a_reader_that_goes_away_is_not_a_crash() {
     assert_eq!(o.status.code(), Some(0));
     assert_no_panic(&o);
 }
+
+#[test]
+fn check_prints_every_property() {
+    let o = bv(
+        &["check", "--model", "lambert", "--param", "albedo=0.8"],
+        "",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert!(text.contains("properties of `lambert`"), "{text}");
+    for property in ["positivity", "reciprocity", "isotropy", "energy", "ρhh"] {
+        assert!(text.contains(property), "{property}: {text}");
+    }
+    assert!(!text.contains("contradicts the claim"), "{text}");
+    assert_no_panic(&o);
+}
+
+#[test]
+fn check_json_has_the_report_and_the_parameters() {
+    let o = bv(
+        &["check", "-m", "lambert", "-p", "albedo=0.8", "--json"],
+        "",
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["model"], "lambert");
+    assert_eq!(v["params"]["albedo"], serde_json::json!([0.8, 0.8, 0.8]));
+    assert_eq!(v["claims"]["reciprocal"], true);
+    assert_eq!(v["positivity"]["ok"], true);
+    // Lambert: ρhd(θi) = albedo at every θi, and ρhh = albedo (closed forms).
+    for c in v["energy"]["max"]["value"].as_array().unwrap() {
+        assert!((c.as_f64().unwrap() - 0.8).abs() < 1e-9, "{}", v["energy"]);
+    }
+    for c in v["energy"]["rho_hh"]["value"].as_array().unwrap() {
+        assert!((c.as_f64().unwrap() - 0.8).abs() < 1e-9, "{}", v["energy"]);
+    }
+    assert_eq!(v["energy"]["conserves"], true);
+}
+
+#[test]
+fn check_runs_on_every_model_with_its_defaults() {
+    for m in bv_core::catalogue() {
+        let o = bv(&["check", "--model", m.id, "--json"], "");
+        assert_no_panic(&o);
+        // A model whose defaults do not build (e.g. measured data without a
+        // file) must say why; every other one must give a report.
+        match bv_core::ModelSpec::new(m.id).unwrap().build() {
+            Ok(_) => {
+                assert_eq!(o.status.code(), Some(0), "{}: {}", m.id, stderr(&o));
+                let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+                assert_eq!(v["model"], m.id);
+            }
+            Err(e) => {
+                assert_eq!(o.status.code(), Some(1), "{}", m.id);
+                assert!(
+                    stderr(&o).contains(&e.to_string()),
+                    "{}: {}",
+                    m.id,
+                    stderr(&o)
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn check_refuses_bad_parameters() {
+    let o = bv(&["check", "--model", "lambert", "--param", "albedo=7"], "");
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("out of range"), "{}", stderr(&o));
+    assert!(stdout(&o).is_empty());
+    assert_no_panic(&o);
+}

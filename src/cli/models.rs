@@ -171,6 +171,9 @@ fn param_table(s: &mut String, decls: &[ParamDecl], indent: &str) {
     for (d, r) in decls.iter().zip(&rows) {
         let cells: Vec<&str> = r.iter().map(String::as_str).collect();
         line(s, &cells, d.doc);
+        if is_list(d) {
+            let _ = writeln!(s, "{indent}    default: {}", d.default_value().to_json());
+        }
         if let ParamKind::List { fields, .. } = d.kind {
             let _ = writeln!(s, "{indent}    each item of `{}`:", d.id);
             param_table(s, fields, &format!("{indent}      "));
@@ -178,10 +181,24 @@ fn param_table(s: &mut String, decls: &[ParamDecl], indent: &str) {
     }
 }
 
+/// Whether a parameter takes a list (its default is printed below its row,
+/// as it would not fit in the table).
+fn is_list(d: &ParamDecl) -> bool {
+    matches!(
+        d.kind,
+        ParamKind::List { .. } | ParamKind::Components { .. }
+    )
+}
+
 /// A default value as short text: `0.5` for a grey colour, `0.1,0.2,0.3`
-/// otherwise, JSON for lists.
+/// otherwise, the item count for lists.
 fn default_text(d: &ParamDecl) -> String {
-    match d.default_value().to_json() {
+    let json = d.default_value().to_json();
+    if is_list(d) {
+        let n = json.as_array().map_or(0, Vec::len);
+        return format!("{n} item{}", if n == 1 { "" } else { "s" });
+    }
+    match json {
         Value::Array(a) if matches!(d.kind, ParamKind::Color(_)) => {
             if a.windows(2).all(|w| w[0] == w[1]) && !a.is_empty() {
                 a[0].to_string()
