@@ -7,10 +7,14 @@ use crate::registry::ModelInfo;
 pub mod ashikhmin_shirley;
 pub mod banks;
 pub mod blinn_phong;
+pub mod cook_torrance;
+pub mod disney;
+pub mod glass;
 pub mod hapke;
 pub mod lafortune;
 pub mod lambert;
 pub mod lobes;
+pub mod mirror;
 pub mod mix;
 pub mod modified_phong;
 pub mod oren_nayar;
@@ -29,8 +33,12 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &ward::INFO,
     &lafortune::INFO,
     &banks::INFO,
+    &cook_torrance::INFO,
     &ashikhmin_shirley::INFO,
     &oren_nayar::INFO,
     &hapke::INFO,
+    &disney::INFO,
+    &mirror::INFO,
+    &glass::INFO,
     &mix::INFO,
 ];
