@@ -15,9 +15,11 @@ pub mod brdf;
 pub mod error;
 pub mod frame;
 pub mod lobe;
+pub mod measured;
 pub mod models;
 pub mod params;
 pub mod registry;
+pub mod represent;
 pub mod sampling;
 
 pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, Ndf};

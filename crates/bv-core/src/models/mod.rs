@@ -5,6 +5,7 @@
 use crate::registry::ModelInfo;
 
 pub mod lambert;
+pub mod merl;
 
 /// Every model, in presentation order.
-pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO];
+pub static CATALOGUE: &[&ModelInfo] = &[&lambert::INFO, &merl::INFO];
