@@ -324,25 +324,20 @@ impl MerlWarnings {
     pub fn messages(&self) -> Vec<String> {
         let mut out = Vec::new();
         let per = |c: [usize; 3]| {
-            format!(
-                "{} (red {}, green {}, blue {})",
+            (
                 c.iter().sum::<usize>(),
-                c[0],
-                c[1],
-                c[2]
+                format!("red {}, green {}, blue {}", c[0], c[1], c[2]),
             )
         };
         if self.unmeasured != [0; 3] {
+            let (n, detail) = per(self.unmeasured);
             out.push(format!(
-                "{} negative samples (not measured) read as 0",
-                per(self.unmeasured)
+                "{n} negative samples (not measured) read as 0 ({detail})"
             ));
         }
         if self.non_finite != [0; 3] {
-            out.push(format!(
-                "{} NaN or infinite samples set to 0",
-                per(self.non_finite)
-            ));
+            let (n, detail) = per(self.non_finite);
+            out.push(format!("{n} NaN or infinite samples set to 0 ({detail})"));
         }
         out
     }
@@ -810,4 +805,558 @@ pub fn read_cached(path: impl AsRef<Path>) -> Result<Arc<MerlTable>> {
 /// Channel names in file order, for reports.
 pub fn channel_names() -> [&'static str; 3] {
     CHANNEL_NAMES
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::lambert::Lambert;
+    use crate::{Claims, ModelSpec, sampling};
+    use rand::Rng;
+    use proptest::prelude::*;
+
+    const DEG: f64 = PI / 180.0;
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("bv-merl-{}-{tag}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// A smooth, reciprocal, isotropic test BRDF written directly in
+    /// half/difference angles: `k_c (0.5 + 0.3 θh + 0.2 θd + 0.1 cos 2φd)`.
+    /// `cos 2φd` is invariant under φd → φd + π, so it is reciprocal.
+    #[derive(Debug)]
+    struct Smooth;
+    const K: [f64; 3] = [1.0, 0.7, 0.4];
+
+    impl Smooth {
+        fn at(theta_h: f64, theta_d: f64, phi_d: f64) -> Rgb {
+            let v = 0.5 + 0.3 * theta_h + 0.2 * theta_d + 0.1 * (2.0 * phi_d).cos();
+            Rgb::from_array(K) * v
+        }
+    }
+
+    impl Brdf for Smooth {
+        fn id(&self) -> &'static str {
+            "smooth-test"
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+            if wi.z <= 0.0 || wo.z <= 0.0 {
+                return Rgb::ZERO;
+            }
+            let hd = frame::to_half_diff(wi, wo).unwrap();
+            Self::at(hd.theta_h, hd.theta_d, hd.phi_d)
+        }
+        fn claims(&self) -> Claims {
+            Claims {
+                reciprocal: true,
+                energy_conserving: false,
+                isotropic: true,
+            }
+        }
+    }
+
+    fn dims(h: usize, d: usize, p: usize) -> MerlDims {
+        MerlDims::new(h as i64, d as i64, p as i64).unwrap()
+    }
+
+    // --- index mapping -------------------------------------------------------
+
+    #[test]
+    fn theta_h_index_by_hand() {
+        // iθh = ⌊√(θh/90°) · 90⌋ (reference: ⌊√(θh/90° · 90 · 90)⌋).
+        let n = 90;
+        assert_eq!(theta_h_index(0.0, n), 0);
+        assert_eq!(theta_h_index(-0.1, n), 0);
+        assert_eq!(theta_h_index(f64::NAN, n), 0);
+        // √(0.01/90)·90 = √0.9 = 0.949 → 0; √(0.012/90)·90 = √1.08 = 1.039 → 1:
+        // a hundredth of a degree already moves a cell (the sqrt mapping).
+        assert_eq!(theta_h_index(0.01 * DEG, n), 0);
+        assert_eq!(theta_h_index(0.012 * DEG, n), 1);
+        // √(1/90)·90 = √90 = 9.487 → 9; √(5/90)·90 = √450 = 21.21 → 21.
+        assert_eq!(theta_h_index(1.0 * DEG, n), 9);
+        assert_eq!(theta_h_index(5.0 * DEG, n), 21);
+        // √(45/90)·90 = 63.64 → 63; √(89.9/90)·90 = 89.95 → 89.
+        assert_eq!(theta_h_index(45.0 * DEG, n), 63);
+        assert_eq!(theta_h_index(89.9 * DEG, n), 89);
+        // π/2 and beyond clamp to the last cell.
+        assert_eq!(theta_h_index(FRAC_PI_2, n), 89);
+        assert_eq!(theta_h_index(2.0, n), 89);
+        // A linear mapping would put 45° in cell 45: the classic wrong-scale bug.
+        assert_ne!(theta_h_index(45.0 * DEG, n), 45);
+    }
+
+    #[test]
+    fn theta_d_index_by_hand() {
+        let n = 90;
+        assert_eq!(theta_d_index(0.0, n), 0);
+        assert_eq!(theta_d_index(0.99 * DEG, n), 0);
+        assert_eq!(theta_d_index(1.01 * DEG, n), 1);
+        assert_eq!(theta_d_index(45.5 * DEG, n), 45);
+        assert_eq!(theta_d_index(89.5 * DEG, n), 89);
+        assert_eq!(theta_d_index(FRAC_PI_2, n), 89);
+        assert_eq!(theta_d_index(-1.0, n), 0);
+    }
+
+    #[test]
+    fn phi_d_index_folds_across_pi() {
+        let n = 180;
+        assert_eq!(phi_d_index(0.0, n), 0);
+        assert_eq!(phi_d_index(10.5 * DEG, n), 10);
+        assert_eq!(phi_d_index(179.9 * DEG, n), 179);
+        // φd = π lands past the end and is clamped to the last cell (reference).
+        assert_eq!(phi_d_index(PI, n), 179);
+        // Negative φd gets +π: −10.5° ≡ 169.5°, −0.1° ≡ 179.9°, −179.5° ≡ 0.5°.
+        assert_eq!(phi_d_index(-10.5 * DEG, n), 169);
+        assert_eq!(phi_d_index(-0.1 * DEG, n), 179);
+        assert_eq!(phi_d_index(-179.5 * DEG, n), 0);
+        // Same cell for φd and φd − π (reciprocity).
+        for k in 0..360 {
+            let p = (k as f64 + 0.25) * 0.5 * DEG; // 0.125° .. 179.875°
+            assert_eq!(phi_d_index(p, n), phi_d_index(p - PI, n), "{p}");
+        }
+        // Continuous coordinate: periodic with period π.
+        assert!((phi_d_coord(-10.5 * DEG, n) - 169.5).abs() < 1e-9);
+        assert!((phi_d_coord(190.5 * DEG, n) - 10.5).abs() < 1e-9);
+        assert!(phi_d_coord(-1e-300, n) < n as f64);
+    }
+
+    #[test]
+    fn cell_centres_invert_the_mapping() {
+        for n in [1usize, 7, 90, 180] {
+            for i in 0..n {
+                assert_eq!(theta_h_index(theta_h_centre(i, n), n), i);
+                assert_eq!(theta_d_index(theta_d_centre(i, n), n), i);
+                assert_eq!(phi_d_index(phi_d_centre(i, n), n), i);
+                assert!((theta_h_coord(theta_h_centre(i, n), n) - (i as f64 + 0.5)).abs() < 1e-9);
+            }
+        }
+    }
+
+    #[test]
+    fn known_configurations_land_in_known_cells() {
+        let d = STANDARD_DIMS;
+        let cells = |wi: DVec3, wo: DVec3| {
+            let hd = frame::to_half_diff(wi, wo).unwrap();
+            (
+                theta_h_index(hd.theta_h, d.theta_h),
+                theta_d_index(hd.theta_d, d.theta_d),
+                phi_d_index(hd.phi_d, d.phi_d),
+            )
+        };
+        // Normal incidence and exit: h = n, d = n.
+        assert_eq!(cells(DVec3::Z, DVec3::Z), (0, 0, 0));
+        // Mirror pair at 31.4°: θh = 0, θd = 31.4° → cell 31 (whole degrees
+        // are cell boundaries of θd).
+        let wi = frame::from_spherical(31.4 * DEG, 0.3);
+        assert_eq!(cells(wi, frame::reflect(wi)).0, 0);
+        assert_eq!(cells(wi, frame::reflect(wi)).1, 31);
+        // Retro-reflection at 50°: h = wi, θh = 50° → ⌊√(50/90)·90⌋ = 67, θd = 0.
+        let wi = frame::from_spherical(50.0 * DEG, 1.0);
+        assert_eq!((cells(wi, wi).0, cells(wi, wi).1), (67, 0));
+    }
+
+    // A line-by-line port of the reference code's std_coords_to_half_diff_coords
+    // and index functions (MERL BRDFRead.cpp, 90/90/360 constants).
+    fn ref_rotate(v: [f64; 3], axis: [f64; 3], angle: f64) -> [f64; 3] {
+        let (s, c) = angle.sin_cos();
+        let mut out = [v[0] * c, v[1] * c, v[2] * c];
+        let temp = (axis[0] * v[0] + axis[1] * v[1] + axis[2] * v[2]) * (1.0 - c);
+        for k in 0..3 {
+            out[k] += axis[k] * temp;
+        }
+        let cross = [
+            axis[1] * v[2] - axis[2] * v[1],
+            axis[2] * v[0] - axis[0] * v[2],
+            axis[0] * v[1] - axis[1] * v[0],
+        ];
+        for k in 0..3 {
+            out[k] += cross[k] * s;
+        }
+        out
+    }
+
+    fn ref_half_diff(ti: f64, fi: f64, to: f64, fo: f64) -> (f64, f64, f64) {
+        let inv = [ti.sin() * fi.cos(), ti.sin() * fi.sin(), ti.cos()];
+        let outv = [to.sin() * fo.cos(), to.sin() * fo.sin(), to.cos()];
+        let mut half = [
+            (inv[0] + outv[0]) / 2.0,
+            (inv[1] + outv[1]) / 2.0,
+            (inv[2] + outv[2]) / 2.0,
+        ];
+        let l = (half[0] * half[0] + half[1] * half[1] + half[2] * half[2]).sqrt();
+        half = [half[0] / l, half[1] / l, half[2] / l];
+        let theta_half = half[2].acos();
+        let fi_half = half[1].atan2(half[0]);
+        let temp = ref_rotate(inv, [0.0, 0.0, 1.0], -fi_half);
+        let diff = ref_rotate(temp, [0.0, 1.0, 0.0], -theta_half);
+        (theta_half, diff[2].acos(), diff[1].atan2(diff[0]))
+    }
+
+    fn ref_indices(th: f64, td: f64, pd: f64) -> (usize, usize, usize) {
+        let ih = if th <= 0.0 {
+            0
+        } else {
+            let deg = th / (PI / 2.0) * 90.0;
+            ((deg * 90.0).sqrt() as i64).clamp(0, 89) as usize
+        };
+        let id = ((td / (PI * 0.5) * 90.0) as i64).clamp(0, 89) as usize;
+        let p = if pd < 0.0 { pd + PI } else { pd };
+        let ip = ((p / PI * 360.0 / 2.0) as i64).clamp(0, 179) as usize;
+        (ih, id, ip)
+    }
+
+    #[test]
+    fn half_diff_and_indices_match_the_reference_code() {
+        let mut rng = sampling::rng(11);
+        let d = STANDARD_DIMS;
+        let mut same = 0;
+        let n = 20_000;
+        for _ in 0..n {
+            let wi = sampling::cosine_hemisphere(sampling::uniform2(&mut rng));
+            let wo = sampling::cosine_hemisphere(sampling::uniform2(&mut rng));
+            let (ti, fi) = frame::to_spherical(wi);
+            let (to, fo) = frame::to_spherical(wo);
+            let (th, td, pd) = ref_half_diff(ti, fi, to, fo);
+            let hd = frame::to_half_diff(wi, wo).unwrap();
+            assert!((hd.theta_h - th).abs() < 1e-9, "{wi} {wo}");
+            assert!((hd.theta_d - td).abs() < 1e-9, "{wi} {wo}");
+            assert!(frame::wrap_phi(hd.phi_d - pd).abs() < 1e-7, "{wi} {wo}");
+            let ours = (
+                theta_h_index(hd.theta_h, d.theta_h),
+                theta_d_index(hd.theta_d, d.theta_d),
+                phi_d_index(hd.phi_d, d.phi_d),
+            );
+            if ours == ref_indices(th, td, pd) {
+                same += 1;
+            }
+        }
+        // Angles agree to ~1e-15; only a pair within that of a cell boundary
+        // could land differently.
+        assert!(same >= n - 2, "{same} of {n}");
+    }
+
+    // --- round trip ------------------------------------------------------------
+
+    #[test]
+    fn round_trip_is_exact_at_centres_and_bounded_between() {
+        let dm = dims(16, 12, 24);
+        let t1 = tabulate(&Smooth, dm).unwrap();
+        assert!(t1.warnings().is_empty());
+        let mut bytes = Vec::new();
+        t1.write_to(&mut bytes).unwrap();
+        assert_eq!(bytes.len() as u64, dm.file_len());
+        let t2 = MerlTable::read_from(&bytes[..], bytes.len() as u64, "mem").unwrap();
+        // f32 → f64 / scale → × scale → f32 is the identity.
+        assert_eq!(t1.data(), t2.data());
+
+        let mut rng = sampling::rng(3);
+        // At cell centres, through the full (wi, wo) path with a random φh, both
+        // lookups return f up to f32 rounding.
+        for ih in 0..dm.theta_h {
+            for id in 0..dm.theta_d {
+                for ip in 0..dm.phi_d {
+                    let (th, td, pd) = (
+                        theta_h_centre(ih, dm.theta_h),
+                        theta_d_centre(id, dm.theta_d),
+                        phi_d_centre(ip, dm.phi_d),
+                    );
+                    let (wi, wo) = frame::from_half_diff(frame::HalfDiff {
+                        theta_h: th,
+                        phi_h: rng.random_range(0.0..2.0 * PI),
+                        theta_d: td,
+                        phi_d: pd,
+                    });
+                    if wi.z <= 1e-9 || wo.z <= 1e-9 {
+                        continue;
+                    }
+                    let f = Smooth::at(th, td, pd);
+                    for mode in [Interpolation::Nearest, Interpolation::Trilinear] {
+                        let g = t2.lookup(wi, wo, mode);
+                        assert!(
+                            (g - f).abs().max_element() <= 2e-7 * f.max_element(),
+                            "{mode:?} {ih} {id} {ip}: {g} vs {f}"
+                        );
+                        // Reciprocity through the fold.
+                        let r = t2.lookup(wo, wi, mode);
+                        assert!((g - r).abs().max_element() <= 2e-7 * f.max_element());
+                    }
+                }
+            }
+        }
+
+        // Between centres: the function is a sum of one-dimensional terms, so
+        // the trilinear error is the sum of the 1D linear-interpolation errors,
+        // each at most (spacing²/8)·max|∂²f| in index units (spacing 1):
+        //   θh term 0.3 θh, θh = (π/2)(u/n)²  → ∂²/∂u² = 0.3 π / nθh²
+        //   θd term 0.2 θd, linear in u        → 0
+        //   φd term 0.1 cos 2φd, φd = π w/nφd   → |∂²/∂w²| ≤ 0.4 π² / nφd²
+        // times k_c, plus f32 rounding (≤ 1e-7 · f). Points are kept where all
+        // eight neighbouring centres are above the horizon (the table is 0
+        // there, the function is not) and away from the clamped θ ends.
+        let bound = |k: f64| {
+            k * (0.3 * PI / (dm.theta_h * dm.theta_h) as f64
+                + 0.4 * PI * PI / (dm.phi_d * dm.phi_d) as f64)
+                / 8.0
+                + 2e-7
+        };
+        let mut checked = 0;
+        let mut worst = 0.0f64;
+        for _ in 0..20_000 {
+            let uh = rng.random_range(0.5..dm.theta_h as f64 - 0.5);
+            let ud = rng.random_range(0.5..dm.theta_d as f64 - 0.5);
+            let th = (uh / dm.theta_h as f64).powi(2) * FRAC_PI_2;
+            let td = ud / dm.theta_d as f64 * FRAC_PI_2;
+            let th_hi = theta_h_centre((uh - 0.5).ceil() as usize, dm.theta_h);
+            let td_hi = theta_d_centre((ud - 0.5).ceil() as usize, dm.theta_d);
+            if th_hi + td_hi >= FRAC_PI_2 - 1e-6 {
+                continue;
+            }
+            let pd = rng.random_range(-PI..PI);
+            let (wi, wo) = frame::from_half_diff(frame::HalfDiff {
+                theta_h: th,
+                phi_h: rng.random_range(0.0..2.0 * PI),
+                theta_d: td,
+                phi_d: pd,
+            });
+            let f = Smooth::at(th, td, pd);
+            let g = t2.lookup(wi, wo, Interpolation::Trilinear);
+            for c in 0..3 {
+                let err = (g[c] - f[c]).abs();
+                assert!(err <= bound(K[c]), "channel {c}: {err} > {}", bound(K[c]));
+                worst = worst.max(err / bound(K[c]));
+            }
+            checked += 1;
+        }
+        assert!(checked > 5_000, "{checked}");
+        // The bound is not vacuous: the error reaches a good part of it.
+        assert!(worst > 0.2, "{worst}");
+    }
+
+    #[test]
+    fn full_size_file_round_trip() {
+        let dir = temp_dir("full");
+        let path = dir.join("lambert.binary");
+        let albedo = Rgb::new(0.2, 0.5, 0.8);
+        let t = tabulate(&Lambert::new(albedo), STANDARD_DIMS).unwrap();
+        t.write(&path).unwrap();
+        assert_eq!(std::fs::metadata(&path).unwrap().len(), 34_992_012);
+        let back = MerlTable::read(&path).unwrap();
+        assert_eq!(back.dims(), STANDARD_DIMS);
+        assert_eq!(back.data(), t.data());
+        // No temporary file is left beside it.
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+        let f = back.lookup(
+            frame::from_spherical(0.4, 0.0),
+            frame::from_spherical(0.9, 2.0),
+            Interpolation::Trilinear,
+        );
+        let want = albedo / PI;
+        assert!((f - want).abs().max_element() < 1e-7 * want.max_element());
+        // Max over cells is ρ/π (cells below the horizon hold 0).
+        for c in 0..3 {
+            assert!((back.ranges()[c].max - want[c]).abs() < 1e-7);
+            assert_eq!(back.ranges()[c].min, 0.0);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    // --- bad files -----------------------------------------------------------
+
+    fn header(d: [i32; 3]) -> Vec<u8> {
+        d.iter().flat_map(|x| x.to_le_bytes()).collect()
+    }
+
+    fn file_with(d: [i32; 3], values: &[f64]) -> Vec<u8> {
+        let mut b = header(d);
+        for v in values {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b
+    }
+
+    #[test]
+    fn bad_file_corpus_is_refused_with_clear_messages() {
+        let dir = temp_dir("bad");
+        let good = file_with([2, 2, 2], &[100.0; 24]);
+        let mut extra = good.clone();
+        extra.extend_from_slice(&[0u8; 5]);
+        let overflow = header([2048, 2048, 2048]);
+        let mut huge = header([4000, 4000, 1]);
+        huge.extend_from_slice(&[0u8; 64]);
+        let corpus: Vec<(&str, Vec<u8>, &[&str])> = vec![
+            ("empty", vec![], &["empty file", "12-byte header"]),
+            ("short", vec![1, 2, 3], &["too short", "3 bytes"]),
+            ("header-only", header([90, 90, 180]), &["90×90×180", "34992012", "has 12"]),
+            ("truncated", good[..good.len() - 8].to_vec(), &["truncated", "8 fewer"]),
+            ("extra", extra, &["5 extra"]),
+            ("zero", file_with([0, 90, 180], &[]), &["nθh = 0", "positive"]),
+            ("negative", file_with([90, -90, 180], &[]), &["nθd = -90", "positive"]),
+            ("too-big-dim", header([90, 90, 100_000]), &["nφd = 100000", "cap of 4096"]),
+            ("overflow", overflow, &["2048×2048×2048", "8589934592", "cap"]),
+            ("huge-tiny", huge, &["4000×4000×1", "need 384000012 bytes", "has 76"]),
+        ];
+        for (name, bytes, expect) in corpus {
+            let path = dir.join(format!("{name}.binary"));
+            std::fs::write(&path, &bytes).unwrap();
+            let err = MerlTable::read(&path).unwrap_err().to_string();
+            assert!(err.contains(&format!("{name}.binary")), "{name}: {err}");
+            for e in expect {
+                assert!(err.contains(e), "{name}: `{err}` lacks `{e}`");
+            }
+            // The model reports the same error instead of building.
+            let mut spec = ModelSpec::new("merl").unwrap();
+            spec.set_str("path", path.to_str().unwrap()).unwrap();
+            assert!(spec.build().is_err());
+        }
+        // A directory and a missing file.
+        assert!(MerlTable::read(&dir).is_err());
+        assert!(MerlTable::read(dir.join("missing.binary")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn stream_shorter_or_longer_than_declared_is_refused() {
+        let good = file_with([2, 2, 2], &[100.0; 24]);
+        let n = good.len() as u64;
+        let err = MerlTable::read_from(&good[..100], n, "s").unwrap_err();
+        assert!(err.to_string().contains("truncated"), "{err}");
+        let mut longer = good.clone();
+        longer.push(0);
+        let err = MerlTable::read_from(&longer[..], n, "s").unwrap_err();
+        assert!(err.to_string().contains("goes on past"), "{err}");
+        assert!(MerlTable::read_from(&good[..], n, "s").is_ok());
+    }
+
+    #[test]
+    fn unmeasured_and_non_finite_samples_are_zeroed_and_counted() {
+        let mut v = vec![1500.0; 24];
+        v[0] = -1.0; // red unmeasured
+        v[3] = f64::NAN; // red NaN
+        v[9] = f64::INFINITY; // green inf
+        v[17] = -1.0; // blue unmeasured
+        v[18] = 1e300; // blue: finite, but beyond f32 after scaling
+        v[19] = f64::NEG_INFINITY; // blue −inf: non-finite, not "unmeasured"
+        let bytes = file_with([2, 2, 2], &v);
+        let t = MerlTable::read_from(&bytes[..], bytes.len() as u64, "w").unwrap();
+        assert_eq!(t.warnings().unmeasured, [1, 0, 1]);
+        assert_eq!(t.warnings().non_finite, [1, 1, 2]);
+        assert_eq!(t.data()[0], 0.0);
+        assert_eq!(t.data()[3], 0.0);
+        assert_eq!(t.data()[18], 0.0);
+        assert!(t.data().iter().all(|x| x.is_finite() && *x >= 0.0));
+        // 1500 stored is f = scale · 1500 = 1, 1.15, 1.66.
+        assert!((t.data()[1] - 1.0).abs() < 1e-7);
+        assert!((t.data()[8 + 2] - 1.15).abs() < 1e-6);
+        assert!((t.data()[16] - 1.66).abs() < 1e-6);
+        assert_eq!(t.ranges()[0].valid, 6);
+        assert!((t.ranges()[2].max - 1.66).abs() < 1e-6);
+        let m = t.warnings().messages().join("; ");
+        assert!(m.contains("2 negative samples"), "{m}");
+        assert!(m.contains("4 NaN or infinite"), "{m}");
+    }
+
+    #[test]
+    fn dims_parse() {
+        assert_eq!(MerlDims::parse("90,90,180").unwrap(), STANDARD_DIMS);
+        assert_eq!(MerlDims::parse(" 4, 5 ,6").unwrap(), dims(4, 5, 6));
+        assert!(MerlDims::parse("90,90").is_err());
+        assert!(MerlDims::parse("90,x,180").is_err());
+        assert!(MerlDims::parse("90,0,180").is_err());
+        assert!(MerlDims::parse("4096,4096,4096").is_err());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// Arbitrary bytes never panic, and whatever is accepted is consistent.
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400)) {
+            if let Ok(t) = MerlTable::read_from(&bytes[..], bytes.len() as u64, "p") {
+                prop_assert_eq!(t.dims().file_len(), bytes.len() as u64);
+                prop_assert!(t.data().iter().all(|x| x.is_finite() && *x >= 0.0));
+            }
+        }
+
+        /// Small valid headers with random lengths and payloads.
+        #[test]
+        fn random_headers_and_lengths(
+            d in proptest::array::uniform3(-3i32..5),
+            extra in -30i64..30,
+            fill in any::<u64>(),
+        ) {
+            let cells = d.iter().map(|&x| x.max(0) as i64).product::<i64>();
+            let len = (12 + 24 * cells + extra).max(0) as usize;
+            let mut bytes = header(d);
+            while bytes.len() < len {
+                bytes.extend_from_slice(&fill.to_le_bytes());
+            }
+            bytes.truncate(len);
+            let r = MerlTable::read_from(&bytes[..], bytes.len() as u64, "p");
+            let valid = d.iter().all(|&x| x > 0) && extra == 0;
+            prop_assert_eq!(r.is_ok(), valid, "{:?}", r.err());
+        }
+    }
+
+    // --- model and cache -------------------------------------------------------
+
+    #[test]
+    fn merl_model_builds_from_a_file_and_is_cached() {
+        let dir = temp_dir("model");
+        let path = dir.join("smooth.binary");
+        tabulate(&Smooth, dims(8, 8, 16)).unwrap().write(&path).unwrap();
+
+        let mut spec = ModelSpec::new("merl").unwrap();
+        let err = spec.build().unwrap_err().to_string();
+        assert!(err.contains("path") && err.contains("no file given"), "{err}");
+        spec.set_str("path", path.to_str().unwrap()).unwrap();
+        let b = spec.build().unwrap();
+        let (t1, mode) = b.measured().unwrap();
+        assert_eq!(mode, Interpolation::Trilinear);
+        let b2 = spec.build().unwrap();
+        assert!(Arc::ptr_eq(t1, b2.measured().unwrap().0));
+        assert!(spec.set_str("interpolation", "cubic").is_err());
+        spec.set_str("interpolation", "nearest").unwrap();
+        let b3 = spec.build().unwrap();
+        assert_eq!(b3.measured().unwrap().1, Interpolation::Nearest);
+        assert!(Arc::ptr_eq(t1, b3.measured().unwrap().0));
+
+        let wi = frame::from_spherical(0.3, 0.2);
+        let wo = frame::from_spherical(0.5, 2.2);
+        assert_eq!(b.eval(wi, wo), t1.lookup(wi, wo, Interpolation::Trilinear));
+        assert_eq!(b.eval(wi, -wo), Rgb::ZERO);
+        let c = b.claims();
+        assert!(c.reciprocal && c.isotropic && !c.energy_conserving);
+
+        // A rewritten file (different size) is read again.
+        tabulate(&Smooth, dims(4, 4, 8)).unwrap().write(&path).unwrap();
+        let b4 = spec.build().unwrap();
+        assert_eq!(b4.measured().unwrap().0.dims(), dims(4, 4, 8));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn trilinear_wraps_in_phi_d_and_clamps_in_theta() {
+        // One θh, one θd, four φd cells with values 0, 1, 2, 3 (red).
+        let dm = dims(1, 1, 4);
+        let mut v = vec![0f32; 12];
+        v[..4].copy_from_slice(&[0.0, 1.0, 2.0, 3.0]);
+        let t = MerlTable::from_values(dm, v).unwrap();
+        let at = |pd: f64| t.lookup_angles(0.1, 0.1, pd, Interpolation::Trilinear).x;
+        // Centres at φd = (i + ½)π/4.
+        assert!((at(0.5 * PI / 4.0) - 0.0).abs() < 1e-12);
+        assert!((at(1.0 * PI / 4.0) - 0.5).abs() < 1e-12);
+        // Between the last centre (3.5π/4) and the first (0.5π/4 + π): wraps.
+        assert!((at(PI) - 1.5).abs() < 1e-12);
+        assert!((at(0.0) - 1.5).abs() < 1e-12);
+        assert!((at(-0.25 * PI / 4.0) - 2.25).abs() < 1e-12);
+        // Nearest at φd = π follows the reference: the last cell.
+        assert_eq!(t.lookup_angles(0.1, 0.1, PI, Interpolation::Nearest).x, 3.0);
+        // θ axes of one cell: constant.
+        assert_eq!(
+            t.lookup_angles(1.5, 1.5, 1.0 * PI / 4.0, Interpolation::Trilinear).x,
+            at(1.0 * PI / 4.0)
+        );
+    }
 }
