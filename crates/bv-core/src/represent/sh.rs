@@ -336,3 +336,245 @@ pub fn relative_l2(a: &dyn Brdf, b: &dyn Brdf, wi: DVec3, cosine: bool, n_theta:
         .reduce(|| (0.0, 0.0), |x, y| (x.0 + y.0, x.1 + y.1));
     Ok(if n > 0.0 { (e / n).sqrt() } else { 0.0 })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::lambert::Lambert;
+    use crate::{Claims, frame};
+
+    fn basis(order: usize, w: DVec3) -> Vec<f64> {
+        let mut y = vec![0.0; num_coeffs(order)];
+        eval_basis(order, w, &mut y);
+        y
+    }
+
+    #[test]
+    fn low_order_basis_by_hand() {
+        // Closed forms (e.g. Sloan 2008, "Stupid SH tricks", without the
+        // Condon–Shortley sign): Y00 = 1/(2√π), Y1,{−1,0,1} = √(3/4π)(y, z, x),
+        // Y20 = √(5/16π)(3z² − 1), Y2,2 = √(15/16π)(x² − y²), Y2,−2 = √(15/4π) xy,
+        // Y2,1 = √(15/4π) xz, Y2,−1 = √(15/4π) yz.
+        let w = DVec3::new(0.3, -0.4, 0.2).normalize();
+        let (x, y, z) = (w.x, w.y, w.z);
+        let c1 = (3.0 / (4.0 * PI)).sqrt();
+        let c2 = (15.0 / (4.0 * PI)).sqrt();
+        let want = [
+            0.5 / PI.sqrt(),
+            c1 * y,
+            c1 * z,
+            c1 * x,
+            c2 * x * y,
+            c2 * y * z,
+            (5.0 / (16.0 * PI)).sqrt() * (3.0 * z * z - 1.0),
+            c2 * x * z,
+            (15.0 / (16.0 * PI)).sqrt() * (x * x - y * y),
+        ];
+        let got = basis(2, w);
+        for (i, (a, b)) in got.iter().zip(want).enumerate() {
+            assert!((a - b).abs() < 1e-14, "{i}: {a} vs {b}");
+        }
+    }
+
+    #[test]
+    fn gauss_legendre_three_points() {
+        // Nodes 0, ±√(3/5), weights 8/9, 5/9 (hand-derived from P3 = (5x³ − 3x)/2).
+        let mut g = gauss_legendre(3);
+        g.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let r = (0.6f64).sqrt();
+        let want = [(-r, 5.0 / 9.0), (0.0, 8.0 / 9.0), (r, 5.0 / 9.0)];
+        for (a, b) in g.iter().zip(want) {
+            assert!((a.0 - b.0).abs() < 1e-14 && (a.1 - b.1).abs() < 1e-14);
+        }
+        // 64 nodes integrate x^126 exactly: 2/127.
+        let s: f64 = gauss_legendre(64).iter().map(|(x, w)| w * x.powi(126)).sum();
+        assert!((s - 2.0 / 127.0).abs() < 1e-13, "{s}");
+    }
+
+    #[test]
+    fn basis_is_orthonormal_up_to_order_16() {
+        let q = Quadrature::new(Domain::Sphere, MAX_ORDER + 2);
+        let nc = num_coeffs(MAX_ORDER);
+        let mut gram = vec![0.0f64; nc * nc];
+        let mut y = vec![0.0; nc];
+        for &(z, wt) in &q.rings {
+            for j in 0..q.n_phi {
+                eval_basis(MAX_ORDER, q.direction(z, j), &mut y);
+                for a in 0..nc {
+                    for b in 0..nc {
+                        gram[a * nc + b] += wt * y[a] * y[b];
+                    }
+                }
+            }
+        }
+        for a in 0..nc {
+            for b in 0..nc {
+                let want = if a == b { 1.0 } else { 0.0 };
+                assert!((gram[a * nc + b] - want).abs() < 1e-11, "{a} {b}");
+            }
+        }
+    }
+
+    /// A transmitting test BRDF whose lobe is a given function on the sphere.
+    #[derive(Debug)]
+    struct SphereFn(fn(DVec3) -> f64);
+    impl Brdf for SphereFn {
+        fn id(&self) -> &'static str {
+            "sphere-fn-test"
+        }
+        fn eval(&self, _wi: DVec3, wo: DVec3) -> Rgb {
+            Rgb::splat((self.0)(wo))
+        }
+        fn claims(&self) -> Claims {
+            Claims {
+                reciprocal: false,
+                energy_conserving: false,
+                isotropic: false,
+            }
+        }
+        fn transmits(&self) -> bool {
+            true
+        }
+    }
+
+    #[test]
+    fn a_low_order_sh_function_is_reproduced() {
+        // g = 1 + 0.5 z + 0.3 xy = 2√π Y00 + 0.5√(4π/3) Y10 + 0.3√(4π/15) Y2,−2.
+        let b = SphereFn(|w| 1.0 + 0.5 * w.z + 0.3 * w.x * w.y);
+        for order in [2usize, 5, 16] {
+            let lobe = project(&b, DVec3::Z, order, false, 24).unwrap();
+            assert_eq!(lobe.domain, Domain::Sphere);
+            let mut want = vec![0.0; num_coeffs(order)];
+            want[0] = 2.0 * PI.sqrt();
+            want[2] = 0.5 * (4.0 * PI / 3.0).sqrt();
+            want[4] = 0.3 * (4.0 * PI / 15.0).sqrt();
+            for (i, (c, w)) in lobe.coeffs.iter().zip(&want).enumerate() {
+                assert!((c.x - w).abs() < 1e-12, "L={order} i={i}: {} vs {w}", c.x);
+            }
+            assert!(lobe.rel_l2_error < 1e-12, "{}", lobe.rel_l2_error);
+            let w = DVec3::new(0.48, 0.6, 0.64);
+            assert!((lobe.eval(w).x - (1.0 + 0.32 + 0.3 * 0.288)).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn lambert_coefficients_match_legendre_integrals() {
+        // g = ρ/π on the hemisphere (0 below), zonal: c_l0 = (ρ/π) 2π √((2l+1)/4π)
+        // ∫₀¹ P_l dx, with ∫₀¹ P_l = 1, 1/2, 0, −1/8 for l = 0..3. With the
+        // cosine, ∫₀¹ x P_l = 1/2, 1/3, 1/8, 0, −1/48 (Ramamoorthi & Hanrahan
+        // 2001's clamped cosine: A0 = π, A1 = 2π/3, A2 = π/4, A3 = 0).
+        let b = Lambert::new(Rgb::splat(1.0));
+        let wi = frame::from_spherical(0.6, 1.0);
+        let plain = project(&b, wi, 4, false, 64).unwrap();
+        let cos = project(&b, wi, 4, true, 64).unwrap();
+        let k = |l: usize| 2.0 * ((2 * l + 1) as f64 / (4.0 * PI)).sqrt();
+        let ip = [1.0, 0.5, 0.0, -0.125];
+        let ixp = [0.5, 1.0 / 3.0, 0.125, 0.0, -1.0 / 48.0];
+        for l in 0..=4 {
+            for m in -(l as i64)..=l as i64 {
+                let i = (l * (l + 1)) as i64 + m;
+                let (pw, cw) = if m == 0 {
+                    (if l < 4 { k(l) * ip[l] } else { 0.0 }, k(l) * ixp[l])
+                } else {
+                    (0.0, 0.0)
+                };
+                if l < 4 {
+                    // ∫₀¹ P_4 = 0 too (even l > 0), but the step's quadrature in
+                    // z is exact only for the polynomial part; keep to l < 4.
+                    assert!((plain.coeffs[i as usize].x - pw).abs() < 1e-9, "plain {l} {m}");
+                }
+                assert!((cos.coeffs[i as usize].x - cw).abs() < 1e-9, "cos {l} {m}");
+            }
+        }
+    }
+
+    #[test]
+    fn lambert_is_not_band_limited_on_the_hemisphere() {
+        // Extended by 0 below the horizon, f = ρ/π is a step (coefficients decay
+        // like l^(−3/2)), f cos θ a kink (l^(−5/2)): neither reaches 0 error at
+        // L = 16, and the kink converges faster than the step.
+        let b = Lambert::new(Rgb::splat(0.8));
+        let err = |order, cosine| {
+            project(&b, DVec3::Z, order, cosine, 96)
+                .unwrap()
+                .rel_l2_error
+        };
+        let (step16, kink16) = (err(16, false), err(16, true));
+        assert!(step16 > 0.05 && kink16 > 1e-3, "{step16} {kink16}");
+        assert!(kink16 < step16, "{kink16} {step16}");
+        assert!(err(4, false) > step16 && err(4, true) > kink16);
+    }
+
+    #[test]
+    fn smooth_lobe_error_falls_fast_with_order() {
+        // A von Mises–Fisher lobe exp(κ(w·r − 1)), κ = 4, on the sphere: its
+        // coefficients fall faster than exponentially, and the full-sphere L2
+        // error of an orthogonal projection never grows with L.
+        let b = SphereFn(|w| (4.0 * (w.dot(DVec3::new(0.6, 0.0, 0.8)) - 1.0)).exp());
+        let errs: Vec<f64> = [0usize, 1, 2, 4, 8, 16]
+            .iter()
+            .map(|&l| project(&b, DVec3::Z, l, false, 48).unwrap().rel_l2_error)
+            .collect();
+        for w in errs.windows(2) {
+            assert!(w[1] <= w[0] + 1e-12, "{errs:?}");
+        }
+        assert!(errs[5] < 1e-8, "{errs:?}");
+        assert!(errs[1] > 0.1, "{errs:?}");
+    }
+
+    /// Normalised Phong lobe `(e+2)/(2π) max(0, R(wo)·wi)^e` (Lewis 1994).
+    #[derive(Debug)]
+    struct Phong(f64);
+    impl Brdf for Phong {
+        fn id(&self) -> &'static str {
+            "phong-test"
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+            if wi.z <= 0.0 || wo.z <= 0.0 {
+                return Rgb::ZERO;
+            }
+            let c = frame::reflect(wo).dot(wi).max(0.0);
+            Rgb::splat((self.0 + 2.0) / (2.0 * PI) * c.powf(self.0))
+        }
+        fn claims(&self) -> Claims {
+            Claims {
+                reciprocal: true,
+                energy_conserving: true,
+                isotropic: true,
+            }
+        }
+    }
+
+    #[test]
+    fn sharp_lobes_lose_their_high_frequencies() {
+        // cosᵉα ≈ exp(−e α²/2): a Gaussian of width 1/√e whose zonal
+        // coefficients go like exp(−l²/(2e)) (heat kernel). Its energy
+        // Σ (2l+1) c_l² ∝ ∫ 2l exp(−l²/e) dl puts a fraction 1 − exp(−L²/e) in
+        // the bands up to L: for e = 1000, L = 16, 23%, so the relative L2
+        // error is about √0.77 ≈ 0.88. A broad lobe about the normal (e = 4)
+        // is cos⁴θ, which vanishes to fourth order at the horizon, so even its
+        // zero extension is smooth (C³) and L = 16 captures it almost exactly.
+        let sharp = project(&Phong(1000.0), DVec3::Z, 16, false, 256).unwrap();
+        assert!(sharp.rel_l2_error > 0.75, "{}", sharp.rel_l2_error);
+        assert!(sharp.rel_l2_error < 0.95, "{}", sharp.rel_l2_error);
+        // The reconstruction misses the peak (e+2)/(2π) by a wide margin.
+        let peak = 1002.0 / (2.0 * PI);
+        assert!(sharp.eval(DVec3::Z).x < 0.5 * peak);
+        let broad = project(&Phong(4.0), DVec3::Z, 16, false, 128).unwrap();
+        assert!(broad.rel_l2_error < 1e-3, "{}", broad.rel_l2_error);
+        // Band energies of the sharp lobe are still large at l = 16.
+        let e = sharp.band_energy();
+        assert!(e[16] > 0.5 * e[1], "{e:?}");
+    }
+
+    #[test]
+    fn arguments_are_checked() {
+        let b = Lambert::new(Rgb::splat(0.5));
+        assert!(project(&b, DVec3::Z, 17, false, 32).is_err());
+        assert!(project(&b, DVec3::Z, 2, false, MAX_RINGS + 1).is_err());
+        // Too few rings are raised to L + 1.
+        assert_eq!(project(&b, DVec3::Z, 8, false, 1).unwrap().n_theta, 9);
+        // Identical models differ by 0.
+        assert_eq!(relative_l2(&b, &b, DVec3::Z, true, 16).unwrap(), 0.0);
+    }
+}
