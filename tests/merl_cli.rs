@@ -26,11 +26,22 @@ fn tabulate_then_info() {
     let file = dir.join("lambert.binary");
     let f = file.to_str().unwrap();
     let out = bv(&[
-        "tabulate", "--model", "lambert", "--param", "albedo=0.2,0.5,0.8", "--out", f, "--dims",
+        "tabulate",
+        "--model",
+        "lambert",
+        "--param",
+        "albedo=0.2,0.5,0.8",
+        "--out",
+        f,
+        "--dims",
         "8,6,12",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("8×6×12"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("8×6×12"),
+        "{}",
+        text(&out.stdout)
+    );
     // 12-byte header + 3 channels × 576 cells × 8 bytes.
     assert_eq!(std::fs::metadata(&file).unwrap().len(), 12 + 3 * 576 * 8);
 
@@ -55,7 +66,10 @@ fn tabulate_then_info() {
     assert_eq!(rho0["theta_i_deg"], 0.0);
     for (c, want) in [0.2, 0.5, 0.8].iter().enumerate() {
         let got = rho0["value"][c].as_f64().unwrap();
-        assert!(got <= want * (1.0 + 1e-6) && got > 0.95 * want, "channel {c}: {got}");
+        assert!(
+            got <= want * (1.0 + 1e-6) && got > 0.95 * want,
+            "channel {c}: {got}"
+        );
         let max = j["channels"][c]["max"].as_f64().unwrap();
         assert!((max - want / std::f64::consts::PI).abs() < 1e-7);
     }
@@ -90,7 +104,10 @@ fn bad_files_and_arguments_fail_with_one_line() {
             "nθd = -1",
         ),
         (
-            vec!["info".into(), dir.join("missing.binary").display().to_string()],
+            vec![
+                "info".into(),
+                dir.join("missing.binary").display().to_string(),
+            ],
             "missing.binary",
         ),
         (

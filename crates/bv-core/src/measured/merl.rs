@@ -230,11 +230,7 @@ pub fn phi_d_coord(phi_d: f64, n: usize) -> f64 {
 }
 
 fn clamp_index(u: f64, n: usize) -> usize {
-    if u > 0.0 {
-        (u as usize).min(n - 1)
-    } else {
-        0
-    }
+    if u > 0.0 { (u as usize).min(n - 1) } else { 0 }
 }
 
 /// Cell index along θh of the reference code: `⌊√(θh/(π/2)) · n⌋`, clamped.
@@ -623,7 +619,13 @@ impl MerlTable {
     }
 
     /// `f` at half/difference angles (φh is ignored: the table is isotropic).
-    pub fn lookup_angles(&self, theta_h: f64, theta_d: f64, phi_d: f64, mode: Interpolation) -> Rgb {
+    pub fn lookup_angles(
+        &self,
+        theta_h: f64,
+        theta_d: f64,
+        phi_d: f64,
+        mode: Interpolation,
+    ) -> Rgb {
         let d = self.dims;
         match mode {
             Interpolation::Nearest => self.at(
@@ -660,11 +662,37 @@ impl MerlTable {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return Rgb::ZERO;
         }
-        match frame::to_half_diff(wi, wo) {
-            Some(hd) => self.lookup_angles(hd.theta_h, hd.theta_d, hd.phi_d, mode),
+        match half_diff_angles(wi, wo) {
+            Some((th, td, pd)) => self.lookup_angles(th, td, pd, mode),
             None => Rgb::ZERO,
         }
     }
+}
+
+/// `(θh, θd, φd)` of a direction pair: the angles of
+/// [`frame::to_half_diff`] (same rotations, −φh about z then −θh about y), but
+/// with the rotations built from h's components instead of from its angles,
+/// which saves four of the seven transcendental calls of a lookup. θ angles
+/// come from `atan2(sin, cos)`, accurate near 0 where `acos` is not. `None`
+/// when `wi = −wo`.
+#[inline]
+pub fn half_diff_angles(wi: DVec3, wo: DVec3) -> Option<(f64, f64, f64)> {
+    let h = frame::half_vector(wi, wo)?;
+    let s = (h.x * h.x + h.y * h.y).sqrt();
+    let (cp, sp) = if s > 0.0 {
+        (h.x / s, h.y / s)
+    } else {
+        (1.0, 0.0)
+    };
+    // Rotate wi by −φh about z ...
+    let x1 = cp * wi.x + sp * wi.y;
+    let y1 = cp * wi.y - sp * wi.x;
+    // ... then by −θh about y (cos θh = h.z, sin θh = s).
+    let x2 = h.z * x1 - s * wi.z;
+    let z2 = s * x1 + h.z * wi.z;
+    let theta_h = s.atan2(h.z);
+    let theta_d = (x2 * x2 + y1 * y1).sqrt().atan2(z2);
+    Some((theta_h, theta_d, y1.atan2(x2)))
 }
 
 /// Zeroes a non-finite or negative value, counting it, and accumulates the rest.
@@ -690,7 +718,10 @@ fn read_exact(r: &mut impl Read, buf: &mut [u8], name: &str, offset: u64, len: u
         if e.kind() == std::io::ErrorKind::UnexpectedEof {
             file_err(
                 name,
-                format!("truncated: the data ends before byte {offset} + {} of the {len} expected", buf.len()),
+                format!(
+                    "truncated: the data ends before byte {offset} + {} of the {len} expected",
+                    buf.len()
+                ),
             )
         } else {
             file_err(name, e.to_string())
@@ -812,8 +843,8 @@ mod tests {
     use super::*;
     use crate::models::lambert::Lambert;
     use crate::{Claims, ModelSpec, sampling};
-    use rand::Rng;
     use proptest::prelude::*;
+    use rand::Rng;
 
     const DEG: f64 = PI / 180.0;
 
@@ -1023,10 +1054,12 @@ mod tests {
             assert!((hd.theta_h - th).abs() < 1e-9, "{wi} {wo}");
             assert!((hd.theta_d - td).abs() < 1e-9, "{wi} {wo}");
             assert!(frame::wrap_phi(hd.phi_d - pd).abs() < 1e-7, "{wi} {wo}");
+            // Indices as the lookup computes them (the fast path).
+            let (fh, fd, fp) = half_diff_angles(wi, wo).unwrap();
             let ours = (
-                theta_h_index(hd.theta_h, d.theta_h),
-                theta_d_index(hd.theta_d, d.theta_d),
-                phi_d_index(hd.phi_d, d.phi_d),
+                theta_h_index(fh, d.theta_h),
+                theta_d_index(fd, d.theta_d),
+                phi_d_index(fp, d.phi_d),
             );
             if ours == ref_indices(th, td, pd) {
                 same += 1;
@@ -1035,6 +1068,28 @@ mod tests {
         // Angles agree to ~1e-15; only a pair within that of a cell boundary
         // could land differently.
         assert!(same >= n - 2, "{same} of {n}");
+    }
+
+    #[test]
+    fn fast_half_diff_matches_frame() {
+        let mut rng = sampling::rng(12);
+        for k in 0..20_000 {
+            let mut wi = sampling::cosine_hemisphere(sampling::uniform2(&mut rng));
+            let wo = sampling::cosine_hemisphere(sampling::uniform2(&mut rng));
+            if k % 10 == 0 {
+                wi = frame::reflect(wo); // θh = 0 exactly or nearly
+            }
+            let hd = frame::to_half_diff(wi, wo).unwrap();
+            let (th, td, pd) = half_diff_angles(wi, wo).unwrap();
+            // acos in frame::to_half_diff loses ~1e-8 near 0; elsewhere they agree to 1e-12.
+            assert!((hd.theta_h - th).abs() < 1e-7, "{wi} {wo}");
+            assert!((hd.theta_d - td).abs() < 1e-7, "{wi} {wo}");
+            if hd.theta_d > 1e-6 {
+                assert!(frame::wrap_phi(hd.phi_d - pd).abs() < 1e-7, "{wi} {wo}");
+            }
+        }
+        assert_eq!(half_diff_angles(DVec3::Z, DVec3::Z), Some((0.0, 0.0, 0.0)));
+        assert!(half_diff_angles(DVec3::Z, -DVec3::Z).is_none());
     }
 
     // --- round trip ------------------------------------------------------------
@@ -1188,14 +1243,42 @@ mod tests {
         let corpus: Vec<(&str, Vec<u8>, &[&str])> = vec![
             ("empty", vec![], &["empty file", "12-byte header"]),
             ("short", vec![1, 2, 3], &["too short", "3 bytes"]),
-            ("header-only", header([90, 90, 180]), &["90×90×180", "34992012", "has 12"]),
-            ("truncated", good[..good.len() - 8].to_vec(), &["truncated", "8 fewer"]),
+            (
+                "header-only",
+                header([90, 90, 180]),
+                &["90×90×180", "34992012", "has 12"],
+            ),
+            (
+                "truncated",
+                good[..good.len() - 8].to_vec(),
+                &["truncated", "8 fewer"],
+            ),
             ("extra", extra, &["5 extra"]),
-            ("zero", file_with([0, 90, 180], &[]), &["nθh = 0", "positive"]),
-            ("negative", file_with([90, -90, 180], &[]), &["nθd = -90", "positive"]),
-            ("too-big-dim", header([90, 90, 100_000]), &["nφd = 100000", "cap of 4096"]),
-            ("overflow", overflow, &["2048×2048×2048", "8589934592", "cap"]),
-            ("huge-tiny", huge, &["4000×4000×1", "need 384000012 bytes", "has 76"]),
+            (
+                "zero",
+                file_with([0, 90, 180], &[]),
+                &["nθh = 0", "positive"],
+            ),
+            (
+                "negative",
+                file_with([90, -90, 180], &[]),
+                &["nθd = -90", "positive"],
+            ),
+            (
+                "too-big-dim",
+                header([90, 90, 100_000]),
+                &["nφd = 100000", "cap of 4096"],
+            ),
+            (
+                "overflow",
+                overflow,
+                &["2048×2048×2048", "8589934592", "cap"],
+            ),
+            (
+                "huge-tiny",
+                huge,
+                &["4000×4000×1", "need 384000012 bytes", "has 76"],
+            ),
         ];
         for (name, bytes, expect) in corpus {
             let path = dir.join(format!("{name}.binary"));
@@ -1305,11 +1388,17 @@ mod tests {
     fn merl_model_builds_from_a_file_and_is_cached() {
         let dir = temp_dir("model");
         let path = dir.join("smooth.binary");
-        tabulate(&Smooth, dims(8, 8, 16)).unwrap().write(&path).unwrap();
+        tabulate(&Smooth, dims(8, 8, 16))
+            .unwrap()
+            .write(&path)
+            .unwrap();
 
         let mut spec = ModelSpec::new("merl").unwrap();
         let err = spec.build().unwrap_err().to_string();
-        assert!(err.contains("path") && err.contains("no file given"), "{err}");
+        assert!(
+            err.contains("path") && err.contains("no file given"),
+            "{err}"
+        );
         spec.set_str("path", path.to_str().unwrap()).unwrap();
         let b = spec.build().unwrap();
         let (t1, mode) = b.measured().unwrap();
@@ -1330,7 +1419,10 @@ mod tests {
         assert!(c.reciprocal && c.isotropic && !c.energy_conserving);
 
         // A rewritten file (different size) is read again.
-        tabulate(&Smooth, dims(4, 4, 8)).unwrap().write(&path).unwrap();
+        tabulate(&Smooth, dims(4, 4, 8))
+            .unwrap()
+            .write(&path)
+            .unwrap();
         let b4 = spec.build().unwrap();
         assert_eq!(b4.measured().unwrap().0.dims(), dims(4, 4, 8));
         std::fs::remove_dir_all(&dir).unwrap();
@@ -1355,7 +1447,8 @@ mod tests {
         assert_eq!(t.lookup_angles(0.1, 0.1, PI, Interpolation::Nearest).x, 3.0);
         // θ axes of one cell: constant.
         assert_eq!(
-            t.lookup_angles(1.5, 1.5, 1.0 * PI / 4.0, Interpolation::Trilinear).x,
+            t.lookup_angles(1.5, 1.5, 1.0 * PI / 4.0, Interpolation::Trilinear)
+                .x,
             at(1.0 * PI / 4.0)
         );
     }

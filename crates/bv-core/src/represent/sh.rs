@@ -298,7 +298,12 @@ pub fn project(
     } else {
         Domain::Hemisphere
     };
-    project_fn(|wo| lobe_value(brdf, wi, wo, cosine), domain, order, n_theta)
+    project_fn(
+        |wo| lobe_value(brdf, wi, wo, cosine),
+        domain,
+        order,
+        n_theta,
+    )
 }
 
 fn lobe_value(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, cosine: bool) -> Rgb {
@@ -309,7 +314,13 @@ fn lobe_value(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, cosine: bool) -> Rgb {
 /// Relative L2 difference `‖a − b‖ / ‖b‖` of two lobes at `wi` over the
 /// hemisphere (the sphere if `b` transmits), on the channel mean: e.g. a
 /// tabulated model `a` against the analytic model `b` it came from.
-pub fn relative_l2(a: &dyn Brdf, b: &dyn Brdf, wi: DVec3, cosine: bool, n_theta: usize) -> Result<f64> {
+pub fn relative_l2(
+    a: &dyn Brdf,
+    b: &dyn Brdf,
+    wi: DVec3,
+    cosine: bool,
+    n_theta: usize,
+) -> Result<f64> {
     let n_theta = check_args(0, n_theta)?;
     let domain = if b.transmits() || a.transmits() {
         Domain::Sphere
@@ -387,7 +398,10 @@ mod tests {
             assert!((a.0 - b.0).abs() < 1e-14 && (a.1 - b.1).abs() < 1e-14);
         }
         // 64 nodes integrate x^126 exactly: 2/127.
-        let s: f64 = gauss_legendre(64).iter().map(|(x, w)| w * x.powi(126)).sum();
+        let s: f64 = gauss_legendre(64)
+            .iter()
+            .map(|(x, w)| w * x.powi(126))
+            .sum();
         assert!((s - 2.0 / 127.0).abs() < 1e-13, "{s}");
     }
 
@@ -481,7 +495,10 @@ mod tests {
                 if l < 4 {
                     // ∫₀¹ P_4 = 0 too (even l > 0), but the step's quadrature in
                     // z is exact only for the polynomial part; keep to l < 4.
-                    assert!((plain.coeffs[i as usize].x - pw).abs() < 1e-9, "plain {l} {m}");
+                    assert!(
+                        (plain.coeffs[i as usize].x - pw).abs() < 1e-9,
+                        "plain {l} {m}"
+                    );
                 }
                 assert!((cos.coeffs[i as usize].x - cw).abs() < 1e-9, "cos {l} {m}");
             }
