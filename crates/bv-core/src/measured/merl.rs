@@ -25,7 +25,8 @@
 //!   `wo` maps `φd` to `φd + π` (the difference vector is mirrored through h),
 //!   so by Helmholtz reciprocity one half-turn of `φd` holds the whole BRDF.
 //!
-//! Every index is clamped to `0..n`. Angles are those of
+//! Every index is clamped to `0..n`, and a φd on the 0 ≡ π seam (within
+//! 1e-9) goes to cell 0 ([`phi_d_index`] says why). Angles are those of
 //! [`crate::frame::to_half_diff`], which rotates by `−φh` about z and `−θh`
 //! about y exactly as the reference code's `std_coords_to_half_diff_coords`
 //! (a test below ports the reference code and compares).
@@ -245,12 +246,24 @@ pub fn theta_d_index(theta_d: f64, n: usize) -> usize {
     clamp_index(theta_d_coord(theta_d, n), n)
 }
 
-/// Cell index along φd of the reference code: fold `φd < 0` by `+π`, then
-/// `⌊φd/π · n⌋`, clamped (so `φd = π` exactly lands in the last cell, as there).
+/// How close to the φd = 0 ≡ π cell boundary (radians) an angle is taken to
+/// lie on it; see [`phi_d_index`].
+pub const PHI_D_SEAM: f64 = 1e-9;
+
+/// Cell index along φd: fold `φd < 0` by `+π` as the reference code does,
+/// then `⌊φd/π · n⌋`, clamped.
+///
+/// One deliberate difference: a folded φd within [`PHI_D_SEAM`] of 0 or of π
+/// goes to cell 0 (the reference code sends φd = π to the last cell). Pairs
+/// in a plane with the normal (the polar plot's plane, `wi` on the normal)
+/// have φd = 0 or ±π exactly in theory, and in floating point a rounding-noise
+/// sign then picks cell 0 or the last cell, which differ in real data: the
+/// lookup would break reciprocity and isotropy on exactly the configurations
+/// a lecturer shows. Both cells are equally near (half a cell each way).
 #[inline]
 pub fn phi_d_index(phi_d: f64, n: usize) -> usize {
     let p = fold_phi_d(phi_d);
-    if p > 0.0 {
+    if p > PHI_D_SEAM && p < PI - PHI_D_SEAM {
         clamp_index(p / PI * n as f64, n)
     } else {
         0
@@ -936,8 +949,13 @@ mod tests {
         assert_eq!(phi_d_index(0.0, n), 0);
         assert_eq!(phi_d_index(10.5 * DEG, n), 10);
         assert_eq!(phi_d_index(179.9 * DEG, n), 179);
-        // φd = π lands past the end and is clamped to the last cell (reference).
-        assert_eq!(phi_d_index(PI, n), 179);
+        // φd = π would land past the end (the reference clamps it to 179); on
+        // the seam, within 1e-9 of 0 or π either way, bv picks cell 0.
+        assert_eq!(phi_d_index(PI, n), 0);
+        assert_eq!(phi_d_index(PI - 1e-12, n), 0);
+        assert_eq!(phi_d_index(-1e-12, n), 0);
+        assert_eq!(phi_d_index(-PI, n), 0);
+        assert_eq!(phi_d_index(PI - 1e-6, n), 179);
         // Negative φd gets +π: −10.5° ≡ 169.5°, −0.1° ≡ 179.9°, −179.5° ≡ 0.5°.
         assert_eq!(phi_d_index(-10.5 * DEG, n), 169);
         assert_eq!(phi_d_index(-0.1 * DEG, n), 179);
@@ -1061,7 +1079,8 @@ mod tests {
                 theta_d_index(fd, d.theta_d),
                 phi_d_index(fp, d.phi_d),
             );
-            if ours == ref_indices(th, td, pd) {
+            let on_seam = fold_phi_d(pd) < 1e-9 || fold_phi_d(pd) > PI - 1e-9;
+            if ours == ref_indices(th, td, pd) || on_seam {
                 same += 1;
             }
         }
@@ -1443,8 +1462,9 @@ mod tests {
         assert!((at(PI) - 1.5).abs() < 1e-12);
         assert!((at(0.0) - 1.5).abs() < 1e-12);
         assert!((at(-0.25 * PI / 4.0) - 2.25).abs() < 1e-12);
-        // Nearest at φd = π follows the reference: the last cell.
-        assert_eq!(t.lookup_angles(0.1, 0.1, PI, Interpolation::Nearest).x, 3.0);
+        // Nearest on the φd = 0 ≡ π seam: cell 0, whichever side.
+        assert_eq!(t.lookup_angles(0.1, 0.1, PI, Interpolation::Nearest).x, 0.0);
+        assert_eq!(t.lookup_angles(0.1, 0.1, -1e-13, Interpolation::Nearest).x, 0.0);
         // θ axes of one cell: constant.
         assert_eq!(
             t.lookup_angles(1.5, 1.5, 1.0 * PI / 4.0, Interpolation::Trilinear)
