@@ -1464,7 +1464,10 @@ mod tests {
         assert!((at(-0.25 * PI / 4.0) - 2.25).abs() < 1e-12);
         // Nearest on the φd = 0 ≡ π seam: cell 0, whichever side.
         assert_eq!(t.lookup_angles(0.1, 0.1, PI, Interpolation::Nearest).x, 0.0);
-        assert_eq!(t.lookup_angles(0.1, 0.1, -1e-13, Interpolation::Nearest).x, 0.0);
+        assert_eq!(
+            t.lookup_angles(0.1, 0.1, -1e-13, Interpolation::Nearest).x,
+            0.0
+        );
         // θ axes of one cell: constant.
         assert_eq!(
             t.lookup_angles(1.5, 1.5, 1.0 * PI / 4.0, Interpolation::Trilinear)
