@@ -36,7 +36,9 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             ui.menu_button("Add BRDF", |ui| {
                 for m in bv_core::catalogue() {
-                    if ui.button(m.name).on_hover_text(m.summary).clicked() {
+                    let r = ui.button(m.name).on_hover_text(m.summary);
+                    labelled(&r, Role::Button, format!("Add {}", m.name));
+                    if r.clicked() {
                         out.push(Command::AddBrdf(m.id.to_string()));
                         ui.close();
                     }
@@ -77,7 +79,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
                 out.push(Command::Select(e.id));
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                let r = ui.small_button("✖").on_hover_text("Remove");
+                let r = ui.small_button("remove").on_hover_text("Remove from the list");
                 labelled(&r, Role::Button, format!("Remove {name}"));
                 if r.clicked() {
                     out.push(Command::RemoveBrdf(e.id));
@@ -102,19 +104,31 @@ pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         ui.vertical(|ui| {
             ui.spacing_mut().slider_width = 110.0;
-            let r = ui.add(egui::Slider::new(&mut t, 0.0..=Incident::MAX_THETA_DEG).text("θi").suffix("°").max_decimals(1));
+            // Display one decimal without rounding the value itself.
+            let one_decimal = |v: f64, _: std::ops::RangeInclusive<usize>| format!("{v:.1}");
+            let r = ui.add(
+                egui::Slider::new(&mut t, 0.0..=Incident::MAX_THETA_DEG)
+                    .text("θi")
+                    .suffix("°")
+                    .custom_formatter(one_decimal),
+            );
             if r.double_clicked() {
                 t = Incident::default().theta_deg;
             }
             r.on_hover_text("Polar angle of the light from the normal");
-            let r = ui.add(egui::Slider::new(&mut p, -180.0..=180.0).text("φi").suffix("°").max_decimals(1));
+            let r = ui.add(
+                egui::Slider::new(&mut p, -180.0..=180.0)
+                    .text("φi")
+                    .suffix("°")
+                    .custom_formatter(one_decimal),
+            );
             if r.double_clicked() {
                 p = Incident::default().phi_deg;
             }
             r.on_hover_text("Azimuth of the light from the tangent t towards b");
-            ui.weak("drag the disc →");
+            ui.weak("or drag the light on the disc");
         });
-        hemisphere_widget(ui, inc, out);
+        hemisphere_widget(ui, inc, state.camera.yaw_deg, out);
     });
     if t != inc.theta_deg || p != inc.phi_deg {
         out.push(Command::SetIncident(Incident {
@@ -128,29 +142,41 @@ pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
 pub const HEMISPHERE_SIZE: f32 = 116.0;
 
 /// The hemisphere seen from above (azimuthal equidistant: the distance from
-/// the centre is θ), with the light as a dot; drag or click to move it.
-pub fn hemisphere_widget(ui: &mut Ui, inc: Incident, out: &mut Vec<Command>) -> egui::Response {
+/// the centre is θ), with the light as a dot; drag or click to move it. It is
+/// turned like the lobe view's camera (`yaw_deg`), so that left and right on
+/// the disc are left and right in the 3D view.
+pub fn hemisphere_widget(ui: &mut Ui, inc: Incident, yaw_deg: f32, out: &mut Vec<Command>) -> egui::Response {
     let (rect, response) = ui.allocate_exact_size(Vec2::splat(HEMISPHERE_SIZE), Sense::click_and_drag());
     labelled(&response, Role::Slider, "Light direction".to_string());
     let dark = ui.visuals().dark_mode;
     let c = rect.center();
     let radius = rect.width() * 0.5 - 12.0;
+    // Screen right is the camera's right vector on the ground, screen down
+    // points towards the eye (see `views::camera`).
+    let yaw = yaw_deg.to_radians();
+    let right = Vec2::new(-yaw.sin(), yaw.cos());
+    let toward = Vec2::new(yaw.cos(), yaw.sin());
+    let ground_to_screen = |g: Vec2| Vec2::new(g.dot(right), g.dot(toward));
     let to_screen = |theta_deg: f64, phi_deg: f64| {
         let r = (theta_deg / 90.0) as f32 * radius;
         let a = phi_deg.to_radians() as f32;
-        // t (x) to the right, b (y) up.
-        c + Vec2::new(r * a.cos(), -r * a.sin())
+        c + ground_to_screen(Vec2::new(r * a.cos(), r * a.sin()))
     };
     if (response.dragged() || response.clicked())
         && let Some(pos) = response.interact_pointer_pos()
     {
         let d = pos - c;
+        let g = right * d.x + toward * d.y;
         let theta = (d.length() / radius * 90.0) as f64;
-        let phi = (-d.y).atan2(d.x).to_degrees() as f64;
-        out.push(Command::SetIncident(Incident {
+        let phi = g.y.atan2(g.x).to_degrees() as f64;
+        let new = Incident {
             theta_deg: theta,
             phi_deg: phi,
-        }));
+        }
+        .clamped();
+        if new != inc {
+            out.push(Command::SetIncident(new));
+        }
     }
     let painter = ui.painter_at(rect.expand(2.0));
     let visuals = ui.visuals();
@@ -161,11 +187,13 @@ pub fn hemisphere_widget(ui: &mut Ui, inc: Incident, out: &mut Vec<Command>) -> 
         painter.circle_stroke(c, radius * deg / 90.0, Stroke::new(1.0, grid));
     }
     painter.circle_stroke(c, radius, Stroke::new(1.5, visuals.widgets.noninteractive.fg_stroke.color));
-    painter.line_segment([c - Vec2::X * radius, c + Vec2::X * radius], Stroke::new(1.0, grid));
-    painter.line_segment([c - Vec2::Y * radius, c + Vec2::Y * radius], Stroke::new(1.0, grid));
+    let tx = ground_to_screen(Vec2::X);
+    let by = ground_to_screen(Vec2::Y);
+    painter.line_segment([c - tx * radius, c + tx * radius], Stroke::new(1.0, grid));
+    painter.line_segment([c - by * radius, c + by * radius], Stroke::new(1.0, grid));
     let font = FontId::proportional(11.0);
-    painter.text(c + Vec2::new(radius + 3.0, 0.0), Align2::LEFT_CENTER, "t", font.clone(), text);
-    painter.text(c + Vec2::new(0.0, -radius - 2.0), Align2::CENTER_BOTTOM, "b", font, text);
+    painter.text(c + tx * (radius + 7.0), Align2::CENTER_CENTER, "t", font.clone(), text);
+    painter.text(c + by * (radius + 7.0), Align2::CENTER_CENTER, "b", font, text);
     let light = views::light_color(dark);
     let p = to_screen(inc.theta_deg, inc.phi_deg);
     // The mirror direction is opposite in azimuth.
@@ -190,7 +218,8 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
     let name = display_name(state, e);
     ui.horizontal(|ui| {
         let [r, g, b] = e.color;
-        ui.label(RichText::new("■").color(Color32::from_rgb(r, g, b)).size(18.0));
+        let (swatch, _) = ui.allocate_exact_size(Vec2::splat(14.0), Sense::hover());
+        ui.painter().rect_filled(swatch, 2.0, Color32::from_rgb(r, g, b));
         ui.heading(&name);
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             let r = ui.small_button("reset all").on_hover_text("All parameters to their defaults");

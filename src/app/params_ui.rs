@@ -3,7 +3,7 @@
 //! sliders (logarithmic where declared, with units), colours a level slider, a
 //! picker and per-channel fields, choices combo boxes, flags check boxes, lists
 //! (Lafortune lobes) and mix components nested groups. Double-clicking a slider
-//! or pressing its ↺ button resets the value to its declared default.
+//! or pressing its "reset" button resets the value to its declared default.
 //!
 //! Widgets edit a copy of a parameter's value; the caller turns a changed copy
 //! into a command, which the core validates before it is applied.
@@ -51,7 +51,7 @@ struct ValueResponse {
 /// A small reset button, shown enabled only when the value is not the default.
 fn reset_button(ui: &mut Ui, label: &str, is_default: bool) -> bool {
     let r = ui
-        .add_enabled(!is_default, egui::Button::new("↺").small().frame(false))
+        .add_enabled(!is_default, egui::Button::new("reset").small())
         .on_hover_text("Reset to default (or double-click the slider)");
     let name = format!("Reset {label}");
     r.widget_info(|| WidgetInfo::labeled(Role::Button, !is_default, &name));

@@ -152,7 +152,7 @@ impl Default for Camera {
         Self {
             yaw_deg: 90.0,
             pitch_deg: 20.0,
-            distance: 3.6,
+            distance: 4.9,
             fixed_scale: 1.0,
         }
     }
@@ -160,7 +160,7 @@ impl Default for Camera {
 
 impl Camera {
     /// Closest and farthest eye distances.
-    pub const DISTANCE_RANGE: (f32, f32) = (1.2, 20.0);
+    pub const DISTANCE_RANGE: (f32, f32) = (1.5, 30.0);
     /// Elevation limits (a little below the ground to look at transmission).
     pub const PITCH_RANGE: (f32, f32) = (-85.0, 89.0);
 

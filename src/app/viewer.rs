@@ -141,8 +141,14 @@ impl Viewer {
         self.shortcuts(&ctx, &mut out);
         self.help_window(&ctx);
         if !out.is_empty() {
+            // Repaint only for real changes, so a widget that re-sends the same
+            // value cannot keep the app busy.
+            let before = self.state.clone();
+            let help = self.help;
             self.apply(out);
-            ctx.request_repaint();
+            if self.state != before || self.help != help {
+                ctx.request_repaint();
+            }
         }
     }
 
@@ -170,7 +176,7 @@ impl Viewer {
     fn left_panel(&mut self, ui: &mut Ui, out: &mut Vec<Command>) {
         egui::Panel::left("bv brdfs")
             .resizable(true)
-            .default_size(330.0)
+            .default_size(350.0)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
                     panel::brdf_list(ui, &self.state, &self.runtime, out);
@@ -400,25 +406,23 @@ fn view_frame(ui: &mut Ui, entry: &ViewEntry, view: &mut dyn View, is_max: bool,
             if title.double_clicked() {
                 out.push(Command::ToggleMaximise(entry.id.to_string()));
             }
+            let (text, hint) = if is_max {
+                ("restore", "Show all views again (Esc)")
+            } else {
+                ("maximise", "Fill the window with this view (M)")
+            };
+            let r = ui.small_button(text).on_hover_text(hint);
+            let label = if is_max {
+                format!("Restore {}", entry.title)
+            } else {
+                format!("Maximise {}", entry.title)
+            };
+            r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Button, true, &label));
+            if r.clicked() {
+                out.push(Command::ToggleMaximise(entry.id.to_string()));
+            }
             ui.separator();
             view.toolbar(ui, scene, out);
-            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                let (text, hint) = if is_max {
-                    ("restore", "Show all views again (Esc)")
-                } else {
-                    ("maximise", "Fill the window with this view (M)")
-                };
-                let r = ui.button(text).on_hover_text(hint);
-                let label = if is_max {
-                    format!("Restore {}", entry.title)
-                } else {
-                    format!("Maximise {}", entry.title)
-                };
-                r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Button, true, &label));
-                if r.clicked() {
-                    out.push(Command::ToggleMaximise(entry.id.to_string()));
-                }
-            });
         });
         ui.separator();
         view.ui(ui, scene, out);

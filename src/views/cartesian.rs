@@ -19,6 +19,8 @@ const SAMPLES: usize = 720;
 pub struct CartesianView {
     /// The values under the pointer in the last frame.
     pub readout: Option<Readout>,
+    /// Where the plot was drawn in the last frame.
+    pub plot_rect: Option<egui::Rect>,
 }
 
 fn axis_name(a: CartesianAxis) -> &'static str {
@@ -109,6 +111,12 @@ impl View for CartesianView {
             CartesianAxis::ThetaD => format!("θd (°), θh = {:.1}°, φd = 90°", p.fixed_theta_h_deg),
         };
         let y_label = if log { format!("{value_name} (1/sr, log scale)") } else { format!("{value_name} (1/sr)") };
+        // Headroom above the largest value for the legend and markers.
+        let (bottom, top) = if log {
+            (floor.log10(), y_of(vmax.max(1e-30)) + 0.4)
+        } else {
+            (0.0, vmax.max(1e-6) * 1.3)
+        };
         let mut plot = Plot::new(super::view_id("cartesian"))
             .width(size.x.max(50.0))
             .height(size.y.max(50.0))
@@ -116,7 +124,8 @@ impl View for CartesianView {
             .x_axis_label(x_label)
             .y_axis_label(y_label)
             .allow_scroll(false)
-            .include_y(0.0)
+            .include_y(bottom)
+            .include_y(top)
             .label_formatter(move |hover| match hover {
                 egui_plot::HoverPosition::NearDataPoint { plot_name, position, .. } if !plot_name.is_empty() => {
                     let v = if log { 10f64.powf(position.y) } else { position.y };
@@ -130,11 +139,10 @@ impl View for CartesianView {
             });
         if log {
             plot = plot
-                .include_y(0.0)
                 .y_axis_formatter(|mark, _| {
                     let k = mark.value.round();
                     if (mark.value - k).abs() < 1e-9 {
-                        format!("10{}", super::superscript(k as i32))
+                        super::decade_label(k as i32)
                     } else {
                         String::new()
                     }
@@ -155,17 +163,16 @@ impl View for CartesianView {
                         .width(1.5)
                         .allow_hover(false),
                 );
-                let top = if log { y_of(vmax.max(1e-30)) } else { vmax.max(1e-6) };
                 pui.text(
-                    Text::new("", PlotPoint::new(li, top), RichText::new("ωi").size(14.0))
+                    Text::new("", PlotPoint::new(li, bottom), RichText::new(" ωi ").size(14.0))
                         .color(light)
-                        .anchor(egui::Align2::RIGHT_TOP)
+                        .anchor(egui::Align2::RIGHT_BOTTOM)
                         .allow_hover(false),
                 );
                 pui.text(
-                    Text::new("", PlotPoint::new(theta_i.to_degrees(), top), RichText::new("ωr").size(14.0))
+                    Text::new("", PlotPoint::new(theta_i.to_degrees(), bottom), RichText::new(" ωr ").size(14.0))
                         .color(mirror)
-                        .anchor(egui::Align2::LEFT_TOP)
+                        .anchor(egui::Align2::LEFT_BOTTOM)
                         .allow_hover(false),
                 );
                 // Delta lobes: where they point, with their weight.
@@ -181,7 +188,7 @@ impl View for CartesianView {
                                 .width(2.0),
                         );
                         pui.text(
-                            Text::new("", PlotPoint::new(a, top * 0.9), RichText::new(format!("δ {w:.3}")).size(11.0))
+                            Text::new("", PlotPoint::new(a, bottom + (top - bottom) * 0.85), RichText::new(format!("δ {w:.3}")).size(11.0))
                                 .color(b.color)
                                 .anchor(egui::Align2::LEFT_TOP)
                                 .allow_hover(false),
@@ -203,6 +210,7 @@ impl View for CartesianView {
         });
 
         self.readout = None;
+        self.plot_rect = Some(response.response.rect);
         if response.response.hovered()
             && let Some(pc) = response.inner
         {

@@ -163,6 +163,16 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
+/// A compact tick label: at most four significant digits, no trailing zeros
+/// (`0.2`, `0.05`, `150`).
+pub fn fmt_tick(v: f64) -> String {
+    let s = fmt_value(v);
+    if s.contains('e') || !s.contains('.') {
+        return s;
+    }
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -227,6 +237,9 @@ mod tests {
         assert_eq!(fmt_value(12.5), "12.50");
         assert_eq!(fmt_value(0.0), "0");
         assert_eq!(fmt_value(2.5e-5), "2.500e-5");
+        assert_eq!(fmt_tick(0.2), "0.2");
+        assert_eq!(fmt_tick(150.0), "150");
+        assert_eq!(fmt_tick(0.05), "0.05");
     }
 
     #[test]

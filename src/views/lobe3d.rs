@@ -496,8 +496,9 @@ impl Lobe3dView {
             && let Some(c) = self.cache.get(&p.id)
         {
             let vmax = c.mesh.max_value;
-            let h = (rect.height() * 0.45).clamp(60.0, 240.0);
-            let bar = Rect::from_min_size(Pos2::new(rect.max.x - 84.0, rect.min.y + 34.0), Vec2::new(14.0, h));
+            // Bottom right: below the horizon, where reflection lobes never go.
+            let h = (rect.height() * 0.32).clamp(50.0, 200.0);
+            let bar = Rect::from_min_size(Pos2::new(rect.max.x - 84.0, rect.max.y - 44.0 - h), Vec2::new(14.0, h));
             let mut mesh = egui::Mesh::default();
             let steps = 32;
             for k in 0..=steps {

@@ -147,19 +147,17 @@ pub fn toolbar_toggle(ui: &mut Ui, on: bool, label: &str, hint: &str) -> bool {
     ui.selectable_label(on, label).on_hover_text(hint).clicked()
 }
 
-/// Superscript digits for axis labels (10⁻³).
-pub fn superscript(n: i32) -> String {
-    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
-    let mut s = String::new();
-    if n < 0 {
-        s.push('⁻');
+/// The label of the decade 10^k on a log axis: plain decimals near 1 (what
+/// students read fastest), `1e-6` style beyond. (egui's default fonts have no
+/// superscript minus.)
+pub fn decade_label(k: i32) -> String {
+    if (-4..=4).contains(&k) {
+        let v = 10f64.powi(k);
+        let digits = (-k).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("1e{k}")
     }
-    for c in n.unsigned_abs().to_string().chars() {
-        if let Some(d) = c.to_digit(10) {
-            s.push(DIGITS[d as usize]);
-        }
-    }
-    s
 }
 
 /// Shared by plots: the toggles for log and cosine.
@@ -192,8 +190,10 @@ mod tests {
     }
 
     #[test]
-    fn superscripts() {
-        assert_eq!(superscript(-3), "⁻³");
-        assert_eq!(superscript(12), "¹²");
+    fn decade_labels() {
+        assert_eq!(decade_label(-3), "0.001");
+        assert_eq!(decade_label(0), "1");
+        assert_eq!(decade_label(2), "100");
+        assert_eq!(decade_label(-6), "1e-6");
     }
 }

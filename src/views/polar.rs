@@ -20,6 +20,8 @@ const SAMPLES: usize = 720;
 pub struct PolarView {
     /// The values under the pointer in the last frame (for tests and the readout).
     pub readout: Option<Readout>,
+    /// Where the plot was drawn in the last frame.
+    pub plot_rect: Option<egui::Rect>,
 }
 
 /// Exact values at one hovered angle.
@@ -145,11 +147,12 @@ impl View for PolarView {
                     })
                     .collect();
                 pui.line(Line::new("", PlotPoints::from(pts)).color(grid).width(1.0).allow_hover(false));
-                let label = curves::fmt_value(value_at(r, log));
+                // Ring values read along the surface line, like a radial axis.
+                let label = curves::fmt_tick(value_at(r, log));
                 pui.text(
-                    Text::new("", PlotPoint::new(r * 0.03, r), RichText::new(label).size(11.0))
+                    Text::new("", PlotPoint::new(r, -outer * 0.015), RichText::new(label).size(11.0))
                         .color(text_col.gamma_multiply(0.8))
-                        .anchor(egui::Align2::LEFT_BOTTOM)
+                        .anchor(egui::Align2::CENTER_TOP)
                         .allow_hover(false),
                 );
             }
@@ -158,7 +161,9 @@ impl View for PolarView {
                 let pts = vec![[0.0, 0.0], [outer * a.sin(), outer * a.cos()]];
                 pui.line(Line::new("", PlotPoints::from(pts)).color(grid).width(1.0).allow_hover(false));
                 if deg % 30 == 0 {
-                    let p = PlotPoint::new(outer * 1.09 * a.sin(), outer * 1.09 * a.cos());
+                    // ±90° sit just above the surface line, clear of the ring values.
+                    let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
+                    let p = PlotPoint::new(outer * 1.09 * a.sin(), outer * 1.09 * a.cos() + lift);
                     pui.text(
                         Text::new("", p, RichText::new(format!("{}°", deg.abs())).size(11.0))
                             .color(text_col.gamma_multiply(0.8))
@@ -239,6 +244,7 @@ impl View for PolarView {
 
         // Exact values along the hovered direction.
         self.readout = None;
+        self.plot_rect = Some(response.response.rect);
         if response.response.hovered()
             && let Some(p) = response.inner
         {
