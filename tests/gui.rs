@@ -409,3 +409,28 @@ fn headless_lobe_render_draws_the_mesh() {
         "centre pixel {c:?} should be lit yellow"
     );
 }
+
+/// Timing of the offscreen lobe pass alone (not a pass/fail test: run with
+/// `cargo test --release --test gui -- --ignored --nocapture lobe_pass_timing`).
+#[test]
+#[ignore]
+fn lobe_pass_timing() {
+    let rs = egui_kittest::wgpu::create_render_state(egui_kittest::wgpu::default_wgpu_setup(), egui_wgpu_options());
+    let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format);
+    let mut s = LobeOnly::new("lambert", serde_json::json!({}));
+    for (w, h) in [(510u32, 680u32), (255, 340)] {
+        let mut times = Vec::new();
+        for k in 0..30 {
+            s.state.incident.theta_deg = 10.0 + k as f64;
+            let scene = build_scene(&s.state, &s.runtime, true);
+            let frame = s.view.frame(&scene, egui::vec2(w as f32, h as f32), [0.1, 0.1, 0.1, 1.0], true);
+            let mut f = (*frame).clone();
+            f.interacting = false;
+            let t = std::time::Instant::now();
+            renderer.render_to_image(&rs.device, &rs.queue, &f, w, h, 1.0).unwrap();
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        println!("{w}x{h} samples {}: median {:.1} ms", renderer.samples(), times[times.len() / 2]);
+    }
+}

@@ -115,14 +115,15 @@ pub fn no_gpu_message(detail: &str) -> String {
 
 /// Opens the viewer window and returns when it is closed.
 pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
+    // Validate `--model` before a window opens (and before the size, which
+    // the smoke script relies on to probe the catalogue).
+    for m in &args.models {
+        bv_core::find(m)?;
+    }
     let size = match &args.size {
         Some(s) => parse_size(s)?,
         None => [1280.0, 800.0],
     };
-    // Validate `--model` before a window opens.
-    for m in &args.models {
-        bv_core::find(m)?;
-    }
     let scripted = args.bench_frames.is_some() || args.screenshot.is_some();
     let persist = !(args.fresh || scripted);
 
@@ -133,6 +134,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
             .with_inner_size(size)
             .with_min_inner_size([720.0, 480.0]),
         persist_window: persist,
+        // egui's dithering costs a noise function per pixel; on a software
+        // renderer that is a noticeable share of the frame, and the UI has no
+        // gradients that band without it.
+        dithering: false,
         ..Default::default()
     };
     if args.bench_frames.is_some() {
@@ -172,6 +177,9 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
             };
             if app.bench.is_some() {
                 app.viewer.force_interacting = true;
+                if let Ok(v) = std::env::var("BV_BENCH_MAXIMISE") {
+                    app.viewer.push(Command::Maximise(Some(v)));
+                }
             }
             Ok(Box::new(app))
         }),
@@ -224,7 +232,8 @@ impl eframe::App for BvApp {
         if let Some(b) = &mut self.bench {
             b.record(t0, ui_time);
             ctx.request_repaint();
-            if b.done() {
+            if b.done() && !b.reported {
+                b.reported = true;
                 println!("{}", b.report());
                 self.finish(&ctx, Ok(()));
             }
@@ -266,12 +275,14 @@ struct Bench {
     ui_times: Vec<f64>,
     what: String,
     adapter: String,
+    reported: bool,
 }
 
 impl Bench {
     fn new(frames: usize, adapter: String) -> Self {
         Self {
             adapter,
+            reported: false,
             frames: frames.max(1),
             warmup: 10,
             k: 0,

@@ -29,10 +29,16 @@ impl CameraMatrices {
         let eye = eye_position(cam);
         let view = glam::camera::rh::view::look_at_mat4(eye, TARGET, Vec3::Z);
         let aspect = (width / height.max(1.0)).max(1e-3);
-        // In a portrait viewport keep the horizontal field at FOV_Y_DEG, so the
-        // hemisphere fits however the view is shaped.
+        // In a portrait viewport widen the vertical field so that the
+        // horizontal one is a quarter wider than FOV_Y_DEG: the scene (axes and
+        // rays reach 1.6 units to the sides, but only about 1.1 above the
+        // target) then fits however the view is shaped.
         let half = (FOV_Y_DEG.to_radians() * 0.5).tan();
-        let fov_y = if aspect < 1.0 { 2.0 * (half / aspect).atan() } else { FOV_Y_DEG.to_radians() };
+        let fov_y = if aspect < 1.25 {
+            2.0 * (half * 1.25 / aspect).atan()
+        } else {
+            FOV_Y_DEG.to_radians()
+        };
         // wgpu clip space: depth 0..1, y up (the DirectX convention).
         let proj = glam::camera::rh::proj::directx::perspective(fov_y, aspect, 0.05, 200.0);
         Self {

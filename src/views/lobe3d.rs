@@ -199,6 +199,7 @@ impl Lobe3dView {
             background,
             meshes,
             lines,
+            interacting: scene.interacting,
         });
         self.last_frame = Some(frame.clone());
         frame
@@ -478,13 +479,15 @@ impl Lobe3dView {
             }
         }
         let wi = scene.wi().as_vec3();
-        if let Some(s) = at(wi * (INCIDENT_LENGTH + 0.1)) {
+        if let Some(s) = at(wi * (INCIDENT_LENGTH + 0.04)) {
             let label = format!("ωi ({:.0}°, {:.0}°)", scene.incident.theta_deg, scene.incident.phi_deg);
-            outlined_text(&painter, s, Align2::CENTER_CENTER, &label, font.clone(), super::light_color(dark), dark);
+            let align = away_from(at(Vec3::ZERO), s);
+            outlined_text(&painter, s, align, &label, font.clone(), super::light_color(dark), dark);
         }
         let r = bv_core::frame::reflect(scene.wi()).as_vec3();
-        if let Some(s) = at(r * (MIRROR_LENGTH + 0.1)) {
-            outlined_text(&painter, s, Align2::CENTER_CENTER, "ωr", font.clone(), super::mirror_color(dark), dark);
+        if let Some(s) = at(r * (MIRROR_LENGTH + 0.04)) {
+            let align = away_from(at(Vec3::ZERO), s);
+            outlined_text(&painter, s, align, "ωr", font.clone(), super::mirror_color(dark), dark);
         }
 
         let d = scene.state.display;
@@ -557,16 +560,34 @@ impl Lobe3dView {
 }
 
 /// Text with a thin outline in the background colour, readable over the lobe.
+/// The text is moved inside the painter's clip rectangle if it would stick out,
+/// so a label is never cut in a narrow view.
 fn outlined_text(painter: &egui::Painter, pos: Pos2, align: Align2, text: &str, font: FontId, color: Color32, dark: bool) {
     let halo = if dark {
         Color32::from_rgba_unmultiplied(0, 0, 0, 160)
     } else {
         Color32::from_rgba_unmultiplied(255, 255, 255, 200)
     };
+    let galley = painter.layout_no_wrap(text.to_string(), font.clone(), color);
+    let mut r = align.anchor_size(pos, galley.size());
+    let bounds = painter.clip_rect().shrink(3.0);
+    let dx = (bounds.min.x - r.min.x).max(0.0) + (bounds.max.x - r.max.x).min(0.0);
+    let dy = (bounds.min.y - r.min.y).max(0.0) + (bounds.max.y - r.max.y).min(0.0);
+    r = r.translate(Vec2::new(dx, dy));
     for o in [Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, -1.0), Vec2::new(0.0, 1.0)] {
-        painter.text(pos + o, align, text, font.clone(), halo);
+        painter.text(r.min + o, Align2::LEFT_TOP, text, font.clone(), halo);
     }
-    painter.text(pos, align, text, font, color);
+    painter.galley(r.min, galley, color);
+}
+
+/// Anchors a label on the side of `p` away from `origin`, so it does not
+/// cover the line it names.
+fn away_from(origin: Option<Pos2>, p: Pos2) -> Align2 {
+    match origin {
+        Some(o) if p.x < o.x - 4.0 => Align2::RIGHT_CENTER,
+        Some(o) if p.x > o.x + 4.0 => Align2::LEFT_CENTER,
+        _ => Align2::CENTER_BOTTOM,
+    }
 }
 
 #[cfg(test)]

@@ -99,6 +99,35 @@ pub struct LobeFrame {
     pub meshes: Vec<MeshDraw>,
     /// Line segments (drawn after opaque meshes, before blended ones).
     pub lines: Vec<LineSeg>,
+    /// Something is being dragged: on a software renderer the frame is then
+    /// drawn without multisampling, which keeps a slider drag smooth.
+    pub interacting: bool,
+}
+
+impl LobeFrame {
+    /// A fingerprint of everything that affects the image (meshes by key and
+    /// revision), so an unchanged frame is not drawn again.
+    fn fingerprint(&self, size: [u32; 2], ppp: f32) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        let floats = |h: &mut std::collections::hash_map::DefaultHasher, xs: &[f32]| {
+            for x in xs {
+                x.to_bits().hash(h);
+            }
+        };
+        floats(&mut h, &self.camera.view_proj.to_cols_array());
+        floats(&mut h, &self.camera.eye.to_array());
+        floats(&mut h, &self.background);
+        floats(&mut h, &[ppp]);
+        size.hash(&mut h);
+        for m in &self.meshes {
+            (m.key, m.revision).hash(&mut h);
+            let s = StyleUniform::new(&m.style);
+            bytemuck::bytes_of(&s).hash(&mut h);
+        }
+        bytemuck::cast_slice::<LineSeg, u8>(&self.lines).hash(&mut h);
+        h.finish()
+    }
 }
 
 #[repr(C)]
@@ -154,6 +183,9 @@ struct GpuMesh {
 
 struct Target {
     size: [u32; 2],
+    samples: u32,
+    /// Fingerprint of the frame the target holds.
+    drawn: Option<u64>,
     msaa_color: Option<wgpu::TextureView>,
     depth: wgpu::TextureView,
     resolve: wgpu::Texture,
@@ -172,23 +204,34 @@ struct ViewResources {
 
 /// Pipelines and per-view GPU resources of every lobe view.
 pub struct LobeRenderer {
-    samples: u32,
+    /// Pipelines at the full sample count, then (software renderers only) at one
+    /// sample for frames drawn while something is dragged.
+    sets: Vec<Pipelines>,
     globals_layout: wgpu::BindGroupLayout,
     style_layout: wgpu::BindGroupLayout,
     blit_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
-    opaque: wgpu::RenderPipeline,
-    blended: wgpu::RenderPipeline,
-    wire: wgpu::RenderPipeline,
-    lines: wgpu::RenderPipeline,
     blit: wgpu::RenderPipeline,
     views: HashMap<u64, ViewResources>,
 }
 
+/// The drawing pipelines for one sample count.
+struct Pipelines {
+    samples: u32,
+    opaque: wgpu::RenderPipeline,
+    blended: wgpu::RenderPipeline,
+    wire: wgpu::RenderPipeline,
+    lines: wgpu::RenderPipeline,
+}
+
 /// The sample count used offscreen: 4 where the adapter supports it for both
-/// formats, else 1.
+/// formats, else 1. `BV_MSAA=1` turns multisampling off (software renderers
+/// pay for every sample).
 fn pick_samples(adapter: Option<&wgpu::Adapter>) -> u32 {
     let Some(adapter) = adapter else { return 1 };
+    if std::env::var("BV_MSAA").is_ok_and(|v| v.trim() == "1") {
+        return 1;
+    }
     let ok = |f: wgpu::TextureFormat| adapter.get_texture_format_features(f).flags.sample_count_supported(4);
     if ok(OFFSCREEN_FORMAT) && ok(DEPTH_FORMAT) { 4 } else { 1 }
 }
@@ -198,6 +241,9 @@ impl LobeRenderer {
     /// result is copied into (the window's surface, or Rgba8Unorm headless).
     pub fn new(device: &wgpu::Device, adapter: Option<&wgpu::Adapter>, target_format: wgpu::TextureFormat) -> Self {
         let samples = pick_samples(adapter);
+        // A CPU rasteriser pays for every sample: while something is dragged it
+        // draws with one, and multisamples the frame once the drag ends.
+        let software = adapter.is_some_and(|a| a.get_info().device_type == wgpu::DeviceType::Cpu);
         let uniform_entry = |visibility| wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility,
@@ -239,9 +285,10 @@ impl LobeRenderer {
         });
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("bv lobe blit sampler"),
-            // The target has the viewport's pixel size: nearest keeps it exact.
-            mag_filter: wgpu::FilterMode::Nearest,
-            min_filter: wgpu::FilterMode::Nearest,
+            // The target matches the viewport pixel for pixel: linear sampling at
+            // pixel centres copies it exactly.
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
 
@@ -281,11 +328,6 @@ impl LobeRenderer {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32],
         };
-        let multisample = wgpu::MultisampleState {
-            count: samples,
-            mask: !0,
-            alpha_to_coverage_enabled: false,
-        };
         let depth = |write: bool| {
             Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
@@ -295,7 +337,7 @@ impl LobeRenderer {
                 bias: wgpu::DepthBiasState::default(),
             })
         };
-        let mesh_pipeline = |label: &str, topology, write: bool, blend: Option<wgpu::BlendState>| {
+        let mesh_pipeline = |label: &str, topology, write: bool, blend: Option<wgpu::BlendState>, multisample| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&mesh_layout),
@@ -326,28 +368,20 @@ impl LobeRenderer {
                 cache: None,
             })
         };
-        let opaque = mesh_pipeline("bv lobe opaque", wgpu::PrimitiveTopology::TriangleList, true, None);
-        let blended = mesh_pipeline(
-            "bv lobe blended",
-            wgpu::PrimitiveTopology::TriangleList,
-            false,
-            Some(alpha_blend),
-        );
-        let wire = mesh_pipeline("bv lobe wire", wgpu::PrimitiveTopology::LineList, true, Some(alpha_blend));
 
         let seg_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<LineSeg>() as u64,
             step_mode: wgpu::VertexStepMode::Instance,
             attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x4],
         };
-        let lines = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        let lines_pipeline = |multisample| device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("bv lobe lines"),
             layout: Some(&lines_layout),
             vertex: wgpu::VertexState {
                 module: &lines_module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(seg_layout)],
+                buffers: &[Some(seg_layout.clone())],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -369,6 +403,30 @@ impl LobeRenderer {
             multiview_mask: None,
             cache: None,
         });
+        let make_set = |samples: u32| {
+            let ms = wgpu::MultisampleState {
+                count: samples,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            };
+            Pipelines {
+                samples,
+                opaque: mesh_pipeline("bv lobe opaque", wgpu::PrimitiveTopology::TriangleList, true, None, ms),
+                blended: mesh_pipeline(
+                    "bv lobe blended",
+                    wgpu::PrimitiveTopology::TriangleList,
+                    false,
+                    Some(alpha_blend),
+                    ms,
+                ),
+                wire: mesh_pipeline("bv lobe wire", wgpu::PrimitiveTopology::LineList, true, Some(alpha_blend), ms),
+                lines: lines_pipeline(ms),
+            }
+        };
+        let mut sets = vec![make_set(samples)];
+        if software && samples > 1 {
+            sets.push(make_set(1));
+        }
         let blit = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("bv lobe blit"),
             layout: Some(&blit_pl),
@@ -396,23 +454,19 @@ impl LobeRenderer {
         });
 
         Self {
-            samples,
+            sets,
             globals_layout,
             style_layout,
             blit_layout,
             sampler,
-            opaque,
-            blended,
-            wire,
-            lines,
             blit,
             views: HashMap::new(),
         }
     }
 
-    /// The offscreen sample count in use.
+    /// The offscreen sample count of frames drawn at rest.
     pub fn samples(&self) -> u32 {
-        self.samples
+        self.sets[0].samples
     }
 
     /// Uploads what changed in `frame` and records its offscreen pass for view
@@ -428,9 +482,14 @@ impl LobeRenderer {
         ppp: f32,
     ) {
         let size = [size[0].max(1), size[1].max(1)];
-        let samples = self.samples;
+        let set = match self.sets.get(1) {
+            Some(fast) if frame.interacting => fast,
+            _ => &self.sets[0],
+        };
+        let samples = set.samples;
+        let fingerprint = frame.fingerprint(size, ppp) ^ u64::from(samples);
         let (style_layout, blit_layout, sampler) = (&self.style_layout, &self.blit_layout, &self.sampler);
-        let (opaque, blended, wire, lines_pl) = (&self.opaque, &self.blended, &self.wire, &self.lines);
+        let (opaque, blended, wire, lines_pl) = (&set.opaque, &set.blended, &set.wire, &set.lines);
         let vr = {
             let layout = &self.globals_layout;
             self.views.entry(view).or_insert_with(|| {
@@ -460,7 +519,7 @@ impl LobeRenderer {
         };
 
         // Target textures follow the viewport's pixel size.
-        if vr.target.as_ref().is_none_or(|t| t.size != size) {
+        if vr.target.as_ref().is_none_or(|t| t.size != size || t.samples != samples) {
             vr.target = Some(create_target(device, blit_layout, sampler, size, samples));
         }
 
@@ -516,7 +575,13 @@ impl LobeRenderer {
         }
         vr.meshes.retain(|_, m| m.used);
 
-        let Some(target) = &vr.target else { return };
+        let Some(target) = &mut vr.target else { return };
+        if target.drawn == Some(fingerprint) {
+            // Same image as last time: egui repainted for something else.
+            return;
+        }
+        target.drawn = Some(fingerprint);
+        let target = &*target;
         let bg = frame.background;
         let (color_view, resolve) = match &target.msaa_color {
             Some(ms) => (ms, Some(&target.resolve_view)),
@@ -738,6 +803,8 @@ fn create_target(
     });
     Target {
         size,
+        samples,
+        drawn: None,
         msaa_color,
         depth,
         resolve,
