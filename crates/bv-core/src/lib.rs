@@ -11,10 +11,13 @@
 //! surface; `f(wi, wo)` is returned without the cosine factor, per linear-RGB
 //! channel.
 
+pub mod analysis;
 pub mod brdf;
 pub mod error;
 pub mod frame;
+pub mod fresnel;
 pub mod lobe;
+pub mod microfacet;
 pub mod models;
 pub mod params;
 pub mod registry;
