@@ -352,13 +352,26 @@ impl LobeOnly {
 }
 
 fn lobe_snapshot(name: &str, model: &str, params: serde_json::Value) {
+    lobe_snapshot_from(name, model, params, bv::app::state::Camera::default());
+}
+
+fn lobe_snapshot_from(name: &str, model: &str, params: serde_json::Value, camera: bv::app::state::Camera) {
     if bv_core::find(model).is_err() {
         eprintln!("skipping snapshot {name}: model `{model}` is not in this build's catalogue");
         return;
     }
     let mut h = gpu_builder()
         .with_size([480.0, 400.0])
-        .build_ui_state(|ui, s: &mut LobeOnly| s.ui(ui), LobeOnly::new(model, params));
+        .build_ui_state(
+            |ui, s: &mut LobeOnly| s.ui(ui),
+            LobeOnly {
+                state: AppState {
+                    camera,
+                    ..LobeOnly::new(model, params.clone()).state
+                },
+                ..LobeOnly::new(model, params)
+            },
+        );
     h.run();
     let img = h.render().expect("render");
     // The lobe must be there: the centre of the view is not the background.
@@ -383,10 +396,16 @@ fn snapshot_lobe_cook_torrance() {
 
 #[test]
 fn snapshot_lobe_ward_anisotropic() {
-    lobe_snapshot(
+    // Seen from above and aside, so that the lobe's two widths both show.
+    lobe_snapshot_from(
         "lobe_ward_anisotropic",
         "ward",
         serde_json::json!({"kd": 0.1, "ks": 0.3, "alpha_x": 0.08, "alpha_y": 0.3}),
+        bv::app::state::Camera {
+            yaw_deg: 55.0,
+            pitch_deg: 40.0,
+            ..Default::default()
+        },
     );
 }
 

@@ -11,11 +11,18 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// side (azimuth φi + π), negative ones towards the light. |θs| > π/2 goes below
 /// the surface (transmission).
 pub fn plane_direction(theta_s: f64, phi_i: f64) -> DVec3 {
-    if theta_s >= 0.0 {
+    let mut w = if theta_s >= 0.0 {
         frame::from_spherical(theta_s, phi_i + PI)
     } else {
         frame::from_spherical(-theta_s, phi_i)
+    };
+    // cos(π/2) is 6e-17, not 0: at the horizon a model with 1/cos θo would
+    // return an enormous value for a direction that is meant to lie in the
+    // surface (where reflection models are 0 by convention).
+    if (theta_s.abs() - FRAC_PI_2).abs() < 1e-12 {
+        w.z = 0.0;
     }
+    w
 }
 
 /// The signed in-plane angle of the light itself: it sits on the negative side.
@@ -188,6 +195,9 @@ mod tests {
             assert!(wo.dot(plane_normal).abs() < 1e-12);
             assert!((frame::to_spherical(wo).0 - f64::abs(x)).abs() < 1e-12);
         }
+        // The horizon is exactly in the surface.
+        assert_eq!(plane_direction(FRAC_PI_2, phi_i).z, 0.0);
+        assert_eq!(plane_direction(-FRAC_PI_2, phi_i).z, 0.0);
         // The mirror direction is at +θi.
         let r = plane_direction(0.5, phi_i);
         assert!((r - frame::reflect(wi)).length() < 1e-12);
