@@ -453,3 +453,42 @@ fn lobe_pass_timing() {
         println!("{w}x{h} samples {}: median {:.1} ms", renderer.samples(), times[times.len() / 2]);
     }
 }
+
+#[test]
+fn shift_drag_on_the_lobe_moves_the_light() {
+    let mut h = viewer(AppState::first_run());
+    let rect = lobe(&h).view_rect.unwrap();
+    let cam = bv::views::camera::CameraMatrices::new(&h.state().state().camera, rect.width(), rect.height());
+    let at = |theta_deg: f64, phi_deg: f64| {
+        let w = bv_core::frame::from_spherical(theta_deg.to_radians(), phi_deg.to_radians()).as_vec3();
+        let s = cam.project(w).unwrap();
+        rect.min + egui::vec2(s[0], s[1])
+    };
+    let (from, to) = (at(20.0, 90.0), at(60.0, 120.0));
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::SHIFT));
+    h.hover_at(from);
+    h.run();
+    h.event(egui::Event::PointerButton {
+        pos: from,
+        button: egui::PointerButton::Primary,
+        pressed: true,
+        modifiers: egui::Modifiers::SHIFT,
+    });
+    h.run();
+    for k in 1..=4 {
+        h.hover_at(from + (to - from) * (k as f32 / 4.0));
+        h.run();
+    }
+    h.event(egui::Event::PointerButton {
+        pos: to,
+        button: egui::PointerButton::Primary,
+        pressed: false,
+        modifiers: egui::Modifiers::SHIFT,
+    });
+    h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
+    h.run();
+    let inc = h.state().state().incident;
+    assert!((inc.theta_deg - 60.0).abs() < 1.0 && (inc.phi_deg - 120.0).abs() < 1.0, "{inc:?}");
+    // The camera did not orbit: the drag went to the light.
+    assert_eq!(h.state().state().camera, bv::app::state::Camera::default());
+}

@@ -48,11 +48,16 @@ pub struct Sample {
     pub rgb: Rgb,
 }
 
+/// How far short of the horizon a reflection curve stops: the horizon itself
+/// is 0 by convention, and a curve that drops to it draws a misleading wall.
+pub const HORIZON_GAP: f64 = 1e-3;
+
 /// `f` in the plane of incidence at `n + 1` signed angles spanning the upper
-/// half (−90°..90°) or, for transmitting models, the whole circle.
+/// half (−90°..90°, stopping [`HORIZON_GAP`] short of the horizon) or, for
+/// transmitting models, the whole circle.
 pub fn plane_of_incidence(brdf: &dyn Brdf, theta_i: f64, phi_i: f64, n: usize, cosine: bool) -> Vec<Sample> {
     let wi = frame::from_spherical(theta_i, phi_i);
-    let span = if brdf.transmits() { PI } else { FRAC_PI_2 };
+    let span = if brdf.transmits() { PI } else { FRAC_PI_2 - HORIZON_GAP };
     let n = n.max(2);
     (0..=n)
         .map(|k| {
@@ -144,18 +149,21 @@ pub fn log_floor(max: f64) -> f64 {
     if max > 0.0 && max.is_finite() { max * 1e-5 } else { 1e-5 }
 }
 
-/// "Nice" round number ≥ `x` (1, 2, 5 × 10^k), for plot rings and scales.
+/// "Nice" round number ≥ `x` (1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k), for
+/// plot rings: fine enough that a curve fills most of the plot.
 pub fn nice_ceil(x: f64) -> f64 {
     if !(x > 0.0) || !x.is_finite() {
         return 1.0;
     }
-    let p = 10f64.powf(x.log10().floor());
-    for m in [1.0, 2.0, 5.0, 10.0] {
-        if m * p >= x * (1.0 - 1e-9) {
-            return m * p;
+    let e = x.log10().floor() as i32;
+    // Divide for negative exponents, so that 0.3 is the double nearest 0.3.
+    let scaled = |m: f64| if e >= 0 { m * 10f64.powi(e) } else { m / 10f64.powi(-e) };
+    for m in [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0] {
+        if scaled(m) >= x * (1.0 - 1e-9) {
+            return scaled(m);
         }
     }
-    10.0 * p
+    scaled(10.0)
 }
 
 /// Formats a value with about four significant digits (plots, readouts).
@@ -211,12 +219,13 @@ mod tests {
         let f = 0.5 / PI;
         let s = plane_of_incidence(b.as_ref(), 0.3, 0.0, 32, false);
         assert_eq!(s.len(), 33);
-        // The end points are at the horizon, where a reflection model is 0.
-        for p in &s[1..32] {
+        // The curve stops just short of the horizon, where the model is 0.
+        assert!((s[0].x + FRAC_PI_2 - HORIZON_GAP).abs() < 1e-12);
+        for p in &s {
             assert!((p.value - f).abs() < 1e-12);
         }
         let c = plane_of_incidence(b.as_ref(), 0.3, 0.0, 32, true);
-        for p in &c[1..32] {
+        for p in &c {
             assert!((p.value - f * p.x.cos()).abs() < 1e-12);
         }
         let h = half_diff_slice(b.as_ref(), HalfDiffAxis::ThetaH, 0.2, 16, false);
@@ -239,9 +248,11 @@ mod tests {
     #[test]
     fn nice_numbers() {
         assert_eq!(nice_ceil(0.159), 0.2);
-        assert_eq!(nice_ceil(3.0), 5.0);
+        assert_eq!(nice_ceil(0.2513), 0.3);
+        assert_eq!(nice_ceil(3.0), 3.0);
         assert_eq!(nice_ceil(5.0), 5.0);
-        assert_eq!(nice_ceil(51.0), 100.0);
+        assert_eq!(nice_ceil(51.0), 60.0);
+        assert_eq!(nice_ceil(81.0), 100.0);
         assert_eq!(nice_ceil(0.0), 1.0);
         assert_eq!(fmt_value(0.159154), "0.1592");
         assert_eq!(fmt_value(12.5), "12.50");

@@ -53,6 +53,8 @@ pub struct Lobe3dView {
     last_scale: f32,
     rebuilds: u64,
     last_frame: Option<Arc<LobeFrame>>,
+    /// Where the view was drawn in the last frame.
+    pub view_rect: Option<Rect>,
 }
 
 impl Default for Lobe3dView {
@@ -74,6 +76,7 @@ impl Lobe3dView {
             last_scale: 1.0,
             rebuilds: 0,
             last_frame: None,
+            view_rect: None,
         }
     }
 
@@ -437,6 +440,7 @@ impl View for Lobe3dView {
             return;
         }
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        self.view_rect = Some(rect);
         let dark = ui.visuals().dark_mode;
         let bg = background(dark);
         let frame = self.frame(scene, rect.size(), bg, dark);
