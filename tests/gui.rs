@@ -12,8 +12,8 @@ use bv::app::state::AppState;
 use bv::app::viewer::build_scene;
 use bv::app::{Command, Viewer};
 use bv::views::cartesian::CartesianView;
-use bv::views::lobe3d::Lobe3dView;
 use bv::views::lobe_gpu::LobeRenderer;
+use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;
 use bv::views::{Scene, View};
 use eframe::egui::{self, Role};
@@ -33,7 +33,9 @@ fn viewer(state: AppState) -> Harness<'static, Viewer> {
 }
 
 fn lobe<'a>(h: &'a Harness<'_, Viewer>) -> &'a Lobe3dView {
-    h.state().view::<Lobe3dView>().expect("lobe view registered")
+    h.state()
+        .view::<Lobe3dView>()
+        .expect("lobe view registered")
 }
 
 fn first_id(h: &Harness<'_, Viewer>) -> u64 {
@@ -67,7 +69,10 @@ fn add_a_brdf_by_its_label_and_remove_it() {
     let s = h.state().state();
     assert_eq!(s.brdfs.len(), 2);
     assert_eq!(s.brdfs[1].spec.model, first.id);
-    assert_ne!(s.brdfs[0].color, s.brdfs[1].color, "overlaid BRDFs get distinct colours");
+    assert_ne!(
+        s.brdfs[0].color, s.brdfs[1].color,
+        "overlaid BRDFs get distinct colours"
+    );
     assert_eq!(s.selected, Some(s.brdfs[1].id), "the new BRDF is selected");
     // Both are drawn in the lobe view, each from its own mesh.
     let ids: Vec<u64> = s.brdfs.iter().map(|b| b.id).collect();
@@ -93,13 +98,27 @@ fn dragging_a_parameter_slider_changes_the_lobe() {
 
     let slider = h.get_by_role_and_label(Role::Slider, "albedo");
     let r = slider.rect();
-    drag(&mut h, r.center(), r.center() - egui::vec2(r.width() * 0.3, 0.0));
+    drag(
+        &mut h,
+        r.center(),
+        r.center() - egui::vec2(r.width() * 0.3, 0.0),
+    );
 
-    let albedo = h.state().state().brdfs[0].spec.params.color("albedo").unwrap();
-    assert!(albedo.x < 0.45, "the slider moved the albedo down: {albedo}");
+    let albedo = h.state().state().brdfs[0]
+        .spec
+        .params
+        .color("albedo")
+        .unwrap();
+    assert!(
+        albedo.x < 0.45,
+        "the slider moved the albedo down: {albedo}"
+    );
     assert_eq!(albedo.x, albedo.y, "a grey stays grey");
     let after = lobe(&h).mesh(id).unwrap().max_value;
-    assert!((after - albedo.x / PI).abs() < 1e-6, "lobe radius {after} follows albedo {albedo}");
+    assert!(
+        (after - albedo.x / PI).abs() < 1e-6,
+        "lobe radius {after} follows albedo {albedo}"
+    );
 }
 
 #[test]
@@ -145,8 +164,14 @@ fn the_light_follows_its_slider_and_the_hemisphere() {
     let r = slider.rect();
     drag(&mut h, r.center(), r.left_center() + egui::vec2(2.0, 0.0));
     let after = h.state().state().incident;
-    assert!(after.theta_deg < before.theta_deg - 10.0, "{before:?} → {after:?}");
-    assert!(lobe(&h).rebuild_count() > builds, "the lobe is rebuilt for the new light");
+    assert!(
+        after.theta_deg < before.theta_deg - 10.0,
+        "{before:?} → {after:?}"
+    );
+    assert!(
+        lobe(&h).rebuild_count() > builds,
+        "the lobe is rebuilt for the new light"
+    );
 
     // Clicking the hemisphere's centre puts the light on the normal.
     let disc = h.get_by_label("Light direction").rect();
@@ -159,7 +184,11 @@ fn the_light_follows_its_slider_and_the_hemisphere() {
     assert!(h.state().state().incident.theta_deg < 1.0);
 
     // Dragging towards its rim lowers the light.
-    drag(&mut h, disc.center(), disc.center() + egui::vec2(0.0, disc.height() * 0.3));
+    drag(
+        &mut h,
+        disc.center(),
+        disc.center() + egui::vec2(0.0, disc.height() * 0.3),
+    );
     let low = h.state().state().incident;
     assert!(low.theta_deg > 30.0, "{low:?}");
 }
@@ -167,10 +196,14 @@ fn the_light_follows_its_slider_and_the_hemisphere() {
 #[test]
 fn views_maximise_and_restore() {
     let mut h = viewer(AppState::first_run());
-    h.get_by_label("Maximise Plane of incidence (polar)").click();
+    h.get_by_label("Maximise Plane of incidence (polar)")
+        .click();
     h.run();
     assert_eq!(h.state().state().maximised.as_deref(), Some("polar"));
-    assert!(h.query_by_label("Maximise 3D lobe").is_none(), "other views are hidden");
+    assert!(
+        h.query_by_label("Maximise 3D lobe").is_none(),
+        "other views are hidden"
+    );
     h.get_by_label("Restore Plane of incidence (polar)").click();
     h.run();
     assert_eq!(h.state().state().maximised, None);
@@ -199,16 +232,24 @@ fn help_overlay_lists_the_shortcuts() {
 #[test]
 fn keyboard_shortcuts_drive_the_views() {
     let mut h = viewer(AppState::first_run());
-    h.state_mut().push(Command::SetCamera(bv::app::state::Camera {
-        yaw_deg: 10.0,
-        ..Default::default()
-    }));
+    h.state_mut()
+        .push(Command::SetCamera(bv::app::state::Camera {
+            yaw_deg: 10.0,
+            ..Default::default()
+        }));
     h.run();
     for (key, check) in [
-        (egui::Key::C, (|s: &AppState| s.display.cosine) as fn(&AppState) -> bool),
+        (
+            egui::Key::C,
+            (|s: &AppState| s.display.cosine) as fn(&AppState) -> bool,
+        ),
         (egui::Key::W, |s: &AppState| s.display.wireframe),
-        (egui::Key::R, |s: &AppState| s.camera == bv::app::state::Camera::default()),
-        (egui::Key::T, |s: &AppState| s.theme == bv::app::state::Theme::Light),
+        (egui::Key::R, |s: &AppState| {
+            s.camera == bv::app::state::Camera::default()
+        }),
+        (egui::Key::T, |s: &AppState| {
+            s.theme == bv::app::state::Theme::Light
+        }),
     ] {
         h.key_press(key);
         h.run();
@@ -224,7 +265,12 @@ fn every_model_gets_widgets_from_its_declaration() {
         let h = viewer(state);
         for decl in info.params {
             let found = h.query_all(by().label(decl.label).include_labels()).count();
-            assert!(found > 0, "model {}: no widget labelled `{}`", info.id, decl.label);
+            assert!(
+                found > 0,
+                "model {}: no widget labelled `{}`",
+                info.id,
+                decl.label
+            );
         }
     }
 }
@@ -250,7 +296,12 @@ fn two_brdfs_overlay_in_all_three_views() {
 
     // Lobe: one opaque mesh coloured by value, one translucent in its colour.
     let frame = lobe(&h).last_frame().unwrap().clone();
-    let styles: Vec<_> = frame.meshes.iter().filter(|m| ids.contains(&m.key)).map(|m| m.style).collect();
+    let styles: Vec<_> = frame
+        .meshes
+        .iter()
+        .filter(|m| ids.contains(&m.key))
+        .map(|m| m.style)
+        .collect();
     assert_eq!(styles.len(), 2);
     assert_eq!(styles.iter().filter(|s| s.alpha >= 1.0).count(), 1);
     assert_ne!(styles[0].color, styles[1].color);
@@ -259,7 +310,12 @@ fn two_brdfs_overlay_in_all_three_views() {
     for which in ["polar", "cartesian"] {
         let rect = match which {
             "polar" => h.state().view::<PolarView>().unwrap().plot_rect.unwrap(),
-            _ => h.state().view::<CartesianView>().unwrap().plot_rect.unwrap(),
+            _ => h
+                .state()
+                .view::<CartesianView>()
+                .unwrap()
+                .plot_rect
+                .unwrap(),
         };
         // Right of centre and above the surface: θo > 0 in both plots.
         let p = rect.center() + egui::vec2(rect.width() * 0.1, -rect.height() * 0.2);
@@ -271,19 +327,23 @@ fn two_brdfs_overlay_in_all_three_views() {
         }
         .unwrap_or_else(|| panic!("{which}: no readout"));
         assert_eq!(readout.values.len(), 2, "{which}");
-        assert_ne!(readout.values[0].1, readout.values[1].1, "{which}: distinct colours");
+        assert_ne!(
+            readout.values[0].1, readout.values[1].1,
+            "{which}: distinct colours"
+        );
         let inc = h.state().state().incident;
         let wi = inc.direction();
         for (k, id) in ids.iter().enumerate() {
             let b = h.state().runtime().get(*id).unwrap().brdf.clone().unwrap();
             let s = &readout.values[k].2;
-            let wo = if which == "polar" {
-                bv::views::curves::plane_direction(s.x, inc.phi_deg.to_radians())
-            } else {
-                bv::views::curves::plane_direction(s.x, inc.phi_deg.to_radians())
-            };
+            // Both plots default to θo in the plane of incidence.
+            let wo = bv::views::curves::plane_direction(s.x, inc.phi_deg.to_radians());
             let exact = bv_core::mean_rgb(b.eval(wi, wo));
-            assert!((s.value - exact).abs() <= 1e-12 * exact.max(1.0), "{which}: {} vs {exact}", s.value);
+            assert!(
+                (s.value - exact).abs() <= 1e-12 * exact.max(1.0),
+                "{which}: {} vs {exact}",
+                s.value
+            );
         }
     }
     h.remove_cursor();
@@ -292,15 +352,17 @@ fn two_brdfs_overlay_in_all_three_views() {
 #[test]
 fn state_survives_a_restart() {
     let mut h = viewer(AppState::first_run());
-    h.state_mut().push(Command::SetIncident(bv::app::state::Incident {
-        theta_deg: 12.0,
-        phi_deg: 34.0,
-    }));
+    h.state_mut()
+        .push(Command::SetIncident(bv::app::state::Incident {
+            theta_deg: 12.0,
+            phi_deg: 34.0,
+        }));
     h.state_mut().push(Command::ToggleLog);
-    h.state_mut().push(Command::SetCamera(bv::app::state::Camera {
-        yaw_deg: 45.0,
-        ..Default::default()
-    }));
+    h.state_mut()
+        .push(Command::SetCamera(bv::app::state::Camera {
+            yaw_deg: 45.0,
+            ..Default::default()
+        }));
     h.run();
     let saved = h.state().state().to_json_string();
     let restored = viewer(AppState::from_json_str(&saved).unwrap());
@@ -355,38 +417,57 @@ fn lobe_snapshot(name: &str, model: &str, params: serde_json::Value) {
     lobe_snapshot_from(name, model, params, bv::app::state::Camera::default());
 }
 
-fn lobe_snapshot_from(name: &str, model: &str, params: serde_json::Value, camera: bv::app::state::Camera) {
+fn lobe_snapshot_from(
+    name: &str,
+    model: &str,
+    params: serde_json::Value,
+    camera: bv::app::state::Camera,
+) {
     if bv_core::find(model).is_err() {
         eprintln!("skipping snapshot {name}: model `{model}` is not in this build's catalogue");
         return;
     }
-    let mut h = gpu_builder()
-        .with_size([480.0, 400.0])
-        .build_ui_state(
-            |ui, s: &mut LobeOnly| s.ui(ui),
-            LobeOnly {
-                state: AppState {
-                    camera,
-                    ..LobeOnly::new(model, params.clone()).state
-                },
-                ..LobeOnly::new(model, params)
+    let mut h = gpu_builder().with_size([480.0, 400.0]).build_ui_state(
+        |ui, s: &mut LobeOnly| s.ui(ui),
+        LobeOnly {
+            state: AppState {
+                camera,
+                ..LobeOnly::new(model, params.clone()).state
             },
-        );
+            ..LobeOnly::new(model, params)
+        },
+    );
     h.run();
     let img = h.render().expect("render");
     // The lobe must be there: the centre of the view is not the background.
     let bg = bv::views::lobe3d::background(true);
     let px = img.get_pixel(240, 200).0;
-    let bg8 = [(bg[0] * 255.0).round() as u8, (bg[1] * 255.0).round() as u8, (bg[2] * 255.0).round() as u8];
+    let bg8 = [
+        (bg[0] * 255.0).round() as u8,
+        (bg[1] * 255.0).round() as u8,
+        (bg[2] * 255.0).round() as u8,
+    ];
     let diff: i32 = (0..3).map(|k| (px[k] as i32 - bg8[k] as i32).abs()).sum();
-    assert!(diff > 30, "{name}: centre pixel {px:?} is the background {bg8:?}");
+    assert!(
+        diff > 30,
+        "{name}: centre pixel {px:?} is the background {bg8:?}"
+    );
     // lavapipe is deterministic on one machine; a little slack for other Mesa versions.
-    h.snapshot_options(name, &egui_kittest::SnapshotOptions::new().threshold(2.0).max_failed_pixels(400));
+    h.snapshot_options(
+        name,
+        &egui_kittest::SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(400),
+    );
 }
 
 #[test]
 fn snapshot_lobe_lambert() {
-    lobe_snapshot("lobe_lambert", "lambert", serde_json::json!({"albedo": [0.8, 0.8, 0.8]}));
+    lobe_snapshot(
+        "lobe_lambert",
+        "lambert",
+        serde_json::json!({"albedo": [0.8, 0.8, 0.8]}),
+    );
 }
 
 #[test]
@@ -411,13 +492,18 @@ fn snapshot_lobe_ward_anisotropic() {
 
 #[test]
 fn headless_lobe_render_draws_the_mesh() {
-    let rs = egui_kittest::wgpu::create_render_state(egui_kittest::wgpu::default_wgpu_setup(), egui_wgpu_options());
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu_options(),
+    );
     let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format);
     let mut s = LobeOnly::new("lambert", serde_json::json!({"albedo": 1.0}));
     let scene = build_scene(&s.state, &s.runtime, false);
     let bg = bv::views::lobe3d::background(true);
     let frame = s.view.frame(&scene, egui::vec2(200.0, 160.0), bg, true);
-    let img = renderer.render_to_image(&rs.device, &rs.queue, &frame, 200, 160, 1.0).unwrap();
+    let img = renderer
+        .render_to_image(&rs.device, &rs.queue, &frame, 200, 160, 1.0)
+        .unwrap();
     assert_eq!(img.dimensions(), (200, 160));
     // Corner: background; centre: the (yellow, top of the colour map) lobe.
     let corner = img.get_pixel(2, 2).0;
@@ -434,7 +520,10 @@ fn headless_lobe_render_draws_the_mesh() {
 #[test]
 #[ignore]
 fn lobe_pass_timing() {
-    let rs = egui_kittest::wgpu::create_render_state(egui_kittest::wgpu::default_wgpu_setup(), egui_wgpu_options());
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu_options(),
+    );
     let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format);
     let mut s = LobeOnly::new("lambert", serde_json::json!({}));
     for (w, h) in [(510u32, 680u32), (255, 340)] {
@@ -442,15 +531,26 @@ fn lobe_pass_timing() {
         for k in 0..30 {
             s.state.incident.theta_deg = 10.0 + k as f64;
             let scene = build_scene(&s.state, &s.runtime, true);
-            let frame = s.view.frame(&scene, egui::vec2(w as f32, h as f32), [0.1, 0.1, 0.1, 1.0], true);
+            let frame = s.view.frame(
+                &scene,
+                egui::vec2(w as f32, h as f32),
+                [0.1, 0.1, 0.1, 1.0],
+                true,
+            );
             let mut f = (*frame).clone();
             f.interacting = false;
             let t = std::time::Instant::now();
-            renderer.render_to_image(&rs.device, &rs.queue, &f, w, h, 1.0).unwrap();
+            renderer
+                .render_to_image(&rs.device, &rs.queue, &f, w, h, 1.0)
+                .unwrap();
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
         times.sort_by(f64::total_cmp);
-        println!("{w}x{h} samples {}: median {:.1} ms", renderer.samples(), times[times.len() / 2]);
+        println!(
+            "{w}x{h} samples {}: median {:.1} ms",
+            renderer.samples(),
+            times[times.len() / 2]
+        );
     }
 }
 
@@ -458,9 +558,14 @@ fn lobe_pass_timing() {
 fn shift_drag_on_the_lobe_moves_the_light() {
     let mut h = viewer(AppState::first_run());
     let rect = lobe(&h).view_rect.unwrap();
-    let cam = bv::views::camera::CameraMatrices::new(&h.state().state().camera, rect.width(), rect.height());
+    let cam = bv::views::camera::CameraMatrices::new(
+        &h.state().state().camera,
+        rect.width(),
+        rect.height(),
+    );
     let at = |theta_deg: f64, phi_deg: f64| {
-        let w = bv_core::frame::from_spherical(theta_deg.to_radians(), phi_deg.to_radians()).as_vec3();
+        let w =
+            bv_core::frame::from_spherical(theta_deg.to_radians(), phi_deg.to_radians()).as_vec3();
         let s = cam.project(w).unwrap();
         rect.min + egui::vec2(s[0], s[1])
     };
@@ -488,7 +593,10 @@ fn shift_drag_on_the_lobe_moves_the_light() {
     h.event(egui::Event::ModifiersChanged(egui::Modifiers::NONE));
     h.run();
     let inc = h.state().state().incident;
-    assert!((inc.theta_deg - 60.0).abs() < 1.0 && (inc.phi_deg - 120.0).abs() < 1.0, "{inc:?}");
+    assert!(
+        (inc.theta_deg - 60.0).abs() < 1.0 && (inc.phi_deg - 120.0).abs() < 1.0,
+        "{inc:?}"
+    );
     // The camera did not orbit: the drag went to the light.
     assert_eq!(h.state().state().camera, bv::app::state::Camera::default());
 }

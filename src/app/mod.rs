@@ -65,8 +65,14 @@ pub fn parse_size(text: &str) -> anyhow::Result<[f32; 2]> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .with_context(|| format!("window size `{text}` is not WIDTHxHEIGHT (e.g. 1280x800)"))?;
-    let w: f32 = w.trim().parse().with_context(|| format!("bad width in `{text}`"))?;
-    let h: f32 = h.trim().parse().with_context(|| format!("bad height in `{text}`"))?;
+    let w: f32 = w
+        .trim()
+        .parse()
+        .with_context(|| format!("bad width in `{text}`"))?;
+    let h: f32 = h
+        .trim()
+        .parse()
+        .with_context(|| format!("bad height in `{text}`"))?;
     if !(200.0..=16384.0).contains(&w) || !(150.0..=16384.0).contains(&h) {
         bail!("window size `{text}` is out of range (200x150 to 16384x16384)");
     }
@@ -78,7 +84,9 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
     let mut state = if args.fresh {
         AppState::first_run()
     } else {
-        saved.and_then(AppState::from_json_str).unwrap_or_else(AppState::first_run)
+        saved
+            .and_then(AppState::from_json_str)
+            .unwrap_or_else(AppState::first_run)
     };
     if !args.models.is_empty() {
         // Check all ids first, so a typo is an error rather than a half list.
@@ -160,7 +168,8 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
             } else {
                 None
             };
-            let state = initial_state(&args2, saved.as_deref()).map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            let state = initial_state(&args2, saved.as_deref())
+                .map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
             let adapter = cc.wgpu_render_state.as_ref().map_or_else(
                 || "no wgpu adapter".to_string(),
                 |rs| {
@@ -317,7 +326,13 @@ impl Bench {
                 } else {
                     lo + (hi - lo) * u
                 };
-                self.what = format!("{}.{param}", state.entry(id).map(|e| e.spec.model.as_str()).unwrap_or("?"));
+                self.what = format!(
+                    "{}.{param}",
+                    state
+                        .entry(id)
+                        .map(|e| e.spec.model.as_str())
+                        .unwrap_or("?")
+                );
                 Command::SetParam {
                     brdf: id,
                     param: param.to_string(),
@@ -438,8 +453,10 @@ impl Shot {
 pub fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyhow::Result<()> {
     let [w, h] = img.size;
     let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
-    let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes).context("screenshot has the wrong size")?;
-    rgba.save(path).with_context(|| format!("cannot write {}", path.display()))?;
+    let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
+        .context("screenshot has the wrong size")?;
+    rgba.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
     eprintln!("bv: saved screenshot {} ({w}x{h})", path.display());
     Ok(())
 }

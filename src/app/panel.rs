@@ -7,7 +7,9 @@ use super::params_ui::{self, Edit};
 use super::runtime::Runtime;
 use super::state::{AppState, BrdfEntry, Incident};
 use crate::views;
-use eframe::egui::{self, Align2, Color32, FontId, RichText, Sense, Stroke, Ui, Vec2, WidgetInfo, Role};
+use eframe::egui::{
+    self, Align2, Color32, FontId, RichText, Role, Sense, Stroke, Ui, Vec2, WidgetInfo,
+};
 
 /// The name shown for an entry: the model's name, numbered when the same
 /// model is loaded more than once ("Lambert", "Lambert 2").
@@ -75,17 +77,25 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             if runtime.get(e.id).is_some_and(|b| b.error.is_some()) {
                 text = text.color(ui.visuals().error_fg_color);
             }
-            if ui.selectable_label(selected, text).on_hover_text("Show its parameters").clicked() {
+            if ui
+                .selectable_label(selected, text)
+                .on_hover_text("Show its parameters")
+                .clicked()
+            {
                 out.push(Command::Select(e.id));
             }
             ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                let r = ui.small_button("remove").on_hover_text("Remove from the list");
+                let r = ui
+                    .small_button("remove")
+                    .on_hover_text("Remove from the list");
                 labelled(&r, Role::Button, format!("Remove {name}"));
                 if r.clicked() {
                     out.push(Command::RemoveBrdf(e.id));
                 }
                 let solo = state.solo == Some(e.id);
-                let r = ui.selectable_label(solo, "solo").on_hover_text("Show only this one");
+                let r = ui
+                    .selectable_label(solo, "solo")
+                    .on_hover_text("Show only this one");
                 labelled(&r, Role::Button, format!("Solo {name}"));
                 if r.clicked() {
                     out.push(Command::ToggleSolo(e.id));
@@ -145,8 +155,14 @@ pub const HEMISPHERE_SIZE: f32 = 116.0;
 /// the centre is θ), with the light as a dot; drag or click to move it. It is
 /// turned like the lobe view's camera (`yaw_deg`), so that left and right on
 /// the disc are left and right in the 3D view.
-pub fn hemisphere_widget(ui: &mut Ui, inc: Incident, yaw_deg: f32, out: &mut Vec<Command>) -> egui::Response {
-    let (rect, response) = ui.allocate_exact_size(Vec2::splat(HEMISPHERE_SIZE), Sense::click_and_drag());
+pub fn hemisphere_widget(
+    ui: &mut Ui,
+    inc: Incident,
+    yaw_deg: f32,
+    out: &mut Vec<Command>,
+) -> egui::Response {
+    let (rect, response) =
+        ui.allocate_exact_size(Vec2::splat(HEMISPHERE_SIZE), Sense::click_and_drag());
     labelled(&response, Role::Slider, "Light direction".to_string());
     let dark = ui.visuals().dark_mode;
     let c = rect.center();
@@ -186,21 +202,45 @@ pub fn hemisphere_widget(ui: &mut Ui, inc: Incident, yaw_deg: f32, out: &mut Vec
     for deg in [30.0f32, 60.0] {
         painter.circle_stroke(c, radius * deg / 90.0, Stroke::new(1.0, grid));
     }
-    painter.circle_stroke(c, radius, Stroke::new(1.5, visuals.widgets.noninteractive.fg_stroke.color));
+    painter.circle_stroke(
+        c,
+        radius,
+        Stroke::new(1.5, visuals.widgets.noninteractive.fg_stroke.color),
+    );
     let tx = ground_to_screen(Vec2::X);
     let by = ground_to_screen(Vec2::Y);
     painter.line_segment([c - tx * radius, c + tx * radius], Stroke::new(1.0, grid));
     painter.line_segment([c - by * radius, c + by * radius], Stroke::new(1.0, grid));
     let font = FontId::proportional(11.0);
-    painter.text(c + tx * (radius + 7.0), Align2::CENTER_CENTER, "t", font.clone(), text);
-    painter.text(c + by * (radius + 7.0), Align2::CENTER_CENTER, "b", font, text);
+    painter.text(
+        c + tx * (radius + 7.0),
+        Align2::CENTER_CENTER,
+        "t",
+        font.clone(),
+        text,
+    );
+    painter.text(
+        c + by * (radius + 7.0),
+        Align2::CENTER_CENTER,
+        "b",
+        font,
+        text,
+    );
     let light = views::light_color(dark);
     let p = to_screen(inc.theta_deg, inc.phi_deg);
     // The mirror direction is opposite in azimuth.
     let m = to_screen(inc.theta_deg, inc.phi_deg + 180.0);
     painter.circle_stroke(m, 4.0, Stroke::new(1.5, views::mirror_color(dark)));
     painter.line_segment([c, p], Stroke::new(1.5, light));
-    painter.circle_filled(p, if response.hovered() || response.dragged() { 7.0 } else { 6.0 }, light);
+    painter.circle_filled(
+        p,
+        if response.hovered() || response.dragged() {
+            7.0
+        } else {
+            6.0
+        },
+        light,
+    );
     painter.circle_stroke(p, 6.0, Stroke::new(1.0, Color32::BLACK.gamma_multiply(0.6)));
     response.on_hover_text("Drag to move the light: the centre is the normal, the rim the horizon")
 }
@@ -212,17 +252,23 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         return;
     };
     let Ok(info) = bv_core::find(&e.spec.model) else {
-        ui.colored_label(ui.visuals().error_fg_color, format!("unknown model `{}`", e.spec.model));
+        ui.colored_label(
+            ui.visuals().error_fg_color,
+            format!("unknown model `{}`", e.spec.model),
+        );
         return;
     };
     let name = display_name(state, e);
     ui.horizontal(|ui| {
         let [r, g, b] = e.color;
         let (swatch, _) = ui.allocate_exact_size(Vec2::splat(14.0), Sense::hover());
-        ui.painter().rect_filled(swatch, 2.0, Color32::from_rgb(r, g, b));
+        ui.painter()
+            .rect_filled(swatch, 2.0, Color32::from_rgb(r, g, b));
         ui.heading(&name);
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-            let r = ui.small_button("reset all").on_hover_text("All parameters to their defaults");
+            let r = ui
+                .small_button("reset all")
+                .on_hover_text("All parameters to their defaults");
             labelled(&r, Role::Button, "Reset all parameters".to_string());
             if r.clicked() {
                 out.push(Command::ResetAllParams(e.id));
@@ -235,7 +281,12 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui.colored_label(ui.visuals().error_fg_color, err);
     }
     ui.add_space(4.0);
-    let edits = params_ui::params_ui(ui, egui::Id::unique(("bv params", e.id)), info.params, &e.spec.params);
+    let edits = params_ui::params_ui(
+        ui,
+        egui::Id::unique(("bv params", e.id)),
+        info.params,
+        &e.spec.params,
+    );
     for edit in edits {
         out.push(match edit {
             Edit::Set(param, value) => Command::SetParam {

@@ -10,7 +10,7 @@
 
 use bv_core::params::{Component, FloatSpec};
 use bv_core::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
-use eframe::egui::{self, Id, Response, RichText, Slider, SliderClamping, Ui, WidgetInfo, Role};
+use eframe::egui::{self, Id, Response, RichText, Role, Slider, SliderClamping, Ui, WidgetInfo};
 
 /// What the user did to one top-level parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,7 +61,11 @@ fn reset_button(ui: &mut Ui, label: &str, is_default: bool) -> bool {
 fn with_doc(r: Response, decl: &ParamDecl) -> Response {
     let range = decl.range_text();
     let unit = decl.unit();
-    let unit = if unit.is_empty() { String::new() } else { format!(" ({unit})") };
+    let unit = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" ({unit})")
+    };
     r.on_hover_text(format!("{}\n`{}`: {}{}", decl.doc, decl.id, range, unit))
 }
 
@@ -86,7 +90,13 @@ fn float_slider(ui: &mut Ui, s: &FloatSpec, x: &mut f64, label: &str) -> Respons
     r
 }
 
-fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth: usize) -> ValueResponse {
+fn value_ui(
+    ui: &mut Ui,
+    id: Id,
+    decl: &ParamDecl,
+    value: &mut ParamValue,
+    depth: usize,
+) -> ValueResponse {
     let mut out = ValueResponse::default();
     let is_default = *value == decl.default_value();
     match (decl.kind, value) {
@@ -134,7 +144,11 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
                 if s.is_reflectance() {
                     let mut rgba = egui::Rgba::from_rgb(c[0] as f32, c[1] as f32, c[2] as f32);
                     let before = rgba;
-                    let r = egui::color_picker::color_edit_button_rgba(ui, &mut rgba, egui::color_picker::Alpha::Opaque);
+                    let r = egui::color_picker::color_edit_button_rgba(
+                        ui,
+                        &mut rgba,
+                        egui::color_picker::Alpha::Opaque,
+                    );
                     let name = format!("{} colour", decl.label);
                     r.widget_info(|| WidgetInfo::labeled(Role::ColorWell, true, &name));
                     if rgba != before {
@@ -165,11 +179,13 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
         }
         (ParamKind::Choice { options, .. }, ParamValue::Text(t)) => {
             ui.horizontal(|ui| {
-                let r = egui::ComboBox::new(id, decl.label).selected_text(t.as_str()).show_ui(ui, |ui| {
-                    for o in options {
-                        ui.selectable_value(t, o.to_string(), *o);
-                    }
-                });
+                let r = egui::ComboBox::new(id, decl.label)
+                    .selected_text(t.as_str())
+                    .show_ui(ui, |ui| {
+                        for o in options {
+                            ui.selectable_value(t, o.to_string(), *o);
+                        }
+                    });
                 with_doc(r.response, decl);
                 out.reset |= reset_button(ui, decl.label, is_default);
             });
@@ -184,7 +200,9 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
             // Edit a draft; apply on Enter or when the field loses focus, so a
             // half-typed path is not loaded at every keystroke.
             let draft_id = id.with("draft");
-            let mut draft: String = ui.data(|d| d.get_temp(draft_id)).unwrap_or_else(|| t.clone());
+            let mut draft: String = ui
+                .data(|d| d.get_temp(draft_id))
+                .unwrap_or_else(|| t.clone());
             ui.horizontal(|ui| {
                 ui.label(decl.label);
                 let r = ui.add(egui::TextEdit::singleline(&mut draft).desired_width(SLIDER_WIDTH));
@@ -231,7 +249,10 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
                             }
                         }
                         if ui
-                            .add_enabled(can_remove, egui::Button::new(format!("Remove {header}")).small())
+                            .add_enabled(
+                                can_remove,
+                                egui::Button::new(format!("Remove {header}")).small(),
+                            )
                             .clicked()
                         {
                             remove = Some(i);
@@ -243,7 +264,11 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
             {
                 items.remove(i);
             }
-            if items.len() < max_items && ui.small_button(format!("Add {}", singular(decl.label))).clicked() {
+            if items.len() < max_items
+                && ui
+                    .small_button(format!("Add {}", singular(decl.label)))
+                    .clicked()
+            {
                 items.push(Params::defaults(fields));
             }
         }
@@ -260,7 +285,9 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
             let mut remove = None;
             let can_remove = comps.len() > 1;
             for (i, comp) in comps.iter_mut().enumerate() {
-                let name = bv_core::find(&comp.spec.model).map(|m| m.name).unwrap_or("?");
+                let name = bv_core::find(&comp.spec.model)
+                    .map(|m| m.name)
+                    .unwrap_or("?");
                 let header = format!("{} {}: {name}", singular(decl.label), i + 1);
                 egui::CollapsingHeader::new(&header)
                     .id_salt(id.with(i))
@@ -275,7 +302,8 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
                             if let Ok(info) = bv_core::find(&comp.spec.model) {
                                 for f in info.params {
                                     if let Some(v) = comp.spec.params.0.get_mut(f.id) {
-                                        let r = value_ui(ui, id.with(i).with(f.id), f, v, depth + 1);
+                                        let r =
+                                            value_ui(ui, id.with(i).with(f.id), f, v, depth + 1);
                                         if r.reset {
                                             *v = f.default_value();
                                         }
@@ -286,7 +314,10 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
                             ui.weak("(nested too deeply to edit here)");
                         }
                         if ui
-                            .add_enabled(can_remove, egui::Button::new(format!("Remove {header}")).small())
+                            .add_enabled(
+                                can_remove,
+                                egui::Button::new(format!("Remove {header}")).small(),
+                            )
                             .clicked()
                         {
                             remove = Some(i);
@@ -299,7 +330,9 @@ fn value_ui(ui: &mut Ui, id: Id, decl: &ParamDecl, value: &mut ParamValue, depth
                 comps.remove(i);
             }
             if comps.len() < max_items
-                && ui.small_button(format!("Add {}", singular(decl.label))).clicked()
+                && ui
+                    .small_button(format!("Add {}", singular(decl.label)))
+                    .clicked()
                 && let Some(first) = bv_core::catalogue().first()
                 && let Ok(spec) = ModelSpec::new(first.id)
             {
@@ -323,11 +356,13 @@ fn component_model_ui(ui: &mut Ui, id: Id, comp: &mut Component, _depth: usize) 
     let current = comp.spec.model.clone();
     let name = bv_core::find(&current).map(|m| m.name).unwrap_or("?");
     let mut chosen = current.clone();
-    egui::ComboBox::new(id.with("model"), "model").selected_text(name).show_ui(ui, |ui| {
-        for m in bv_core::catalogue() {
-            ui.selectable_value(&mut chosen, m.id.to_string(), m.name);
-        }
-    });
+    egui::ComboBox::new(id.with("model"), "model")
+        .selected_text(name)
+        .show_ui(ui, |ui| {
+            for m in bv_core::catalogue() {
+                ui.selectable_value(&mut chosen, m.id.to_string(), m.name);
+            }
+        });
     if chosen != current
         && let Ok(spec) = ModelSpec::new(&chosen)
     {

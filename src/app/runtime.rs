@@ -81,7 +81,11 @@ mod tests {
         let rev_a = rt.get(a).unwrap().revision;
         rt.sync(&s);
         assert_eq!(rt.build_count(), 2);
-        s.entry_mut(b).unwrap().spec.set("albedo", ParamValue::Color([0.2; 3])).unwrap();
+        s.entry_mut(b)
+            .unwrap()
+            .spec
+            .set("albedo", ParamValue::Color([0.2; 3]))
+            .unwrap();
         rt.sync(&s);
         assert_eq!(rt.build_count(), 3);
         assert_eq!(rt.get(a).unwrap().revision, rev_a);

@@ -169,8 +169,10 @@ impl Camera {
         let ok = |x: f32, d: f32| if x.is_finite() { x } else { d };
         let d = Self::default();
         self.yaw_deg = ok(self.yaw_deg, d.yaw_deg).rem_euclid(360.0);
-        self.pitch_deg = ok(self.pitch_deg, d.pitch_deg).clamp(Self::PITCH_RANGE.0, Self::PITCH_RANGE.1);
-        self.distance = ok(self.distance, d.distance).clamp(Self::DISTANCE_RANGE.0, Self::DISTANCE_RANGE.1);
+        self.pitch_deg =
+            ok(self.pitch_deg, d.pitch_deg).clamp(Self::PITCH_RANGE.0, Self::PITCH_RANGE.1);
+        self.distance =
+            ok(self.distance, d.distance).clamp(Self::DISTANCE_RANGE.0, Self::DISTANCE_RANGE.1);
         self.fixed_scale = if self.fixed_scale.is_finite() && self.fixed_scale > 0.0 {
             self.fixed_scale
         } else {

@@ -21,7 +21,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("W", "wireframe lobe"),
     ("N / P", "next / previous model for the selected BRDF"),
     ("PageDown / PageUp", "select the next / previous BRDF"),
-    ("M", "maximise the view under the pointer (again to restore)"),
+    (
+        "M",
+        "maximise the view under the pointer (again to restore)",
+    ),
     ("1, 2, 3", "maximise view 1, 2, 3 (again to restore)"),
     ("Esc", "restore the layout"),
     ("T", "switch between dark and light themes"),
@@ -84,7 +87,9 @@ impl Viewer {
 
     /// The view of concrete type `T`, if registered.
     pub fn view<T: View>(&self) -> Option<&T> {
-        self.views.iter().find_map(|(_, v)| v.as_any().downcast_ref::<T>())
+        self.views
+            .iter()
+            .find_map(|(_, v)| v.as_any().downcast_ref::<T>())
     }
 
     /// Whether the help overlay is open.
@@ -158,7 +163,11 @@ impl Viewer {
                 ui.label(RichText::new("bv").strong().size(16.0));
                 ui.weak("BRDF viewer");
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
-                    if ui.button("? help").on_hover_text("Keyboard shortcuts (F1)").clicked() {
+                    if ui
+                        .button("? help")
+                        .on_hover_text("Keyboard shortcuts (F1)")
+                        .clicked()
+                    {
                         out.push(Command::ToggleHelp);
                     }
                     let (label, next) = match self.state.theme {
@@ -178,28 +187,33 @@ impl Viewer {
             .resizable(true)
             .default_size(350.0)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-                    panel::brdf_list(ui, &self.state, &self.runtime, out);
-                    ui.separator();
-                    panel::light_ui(ui, &self.state, out);
-                    ui.separator();
-                    panel::params_section(ui, &self.state, &self.runtime, out);
-                    if let Some(msg) = &self.status {
+                egui::ScrollArea::vertical()
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| {
+                        panel::brdf_list(ui, &self.state, &self.runtime, out);
                         ui.separator();
-                        ui.horizontal_wrapped(|ui| {
-                            ui.colored_label(ui.visuals().warn_fg_color, msg);
-                        });
-                        if ui.small_button("dismiss").clicked() {
-                            self.status = None;
+                        panel::light_ui(ui, &self.state, out);
+                        ui.separator();
+                        panel::params_section(ui, &self.state, &self.runtime, out);
+                        if let Some(msg) = &self.status {
+                            ui.separator();
+                            ui.horizontal_wrapped(|ui| {
+                                ui.colored_label(ui.visuals().warn_fg_color, msg);
+                            });
+                            if ui.small_button("dismiss").clicked() {
+                                self.status = None;
+                            }
                         }
-                    }
-                });
+                    });
             });
     }
 
     fn hovered_view(&self, ctx: &egui::Context) -> Option<&'static str> {
         let pos = ctx.pointer_hover_pos()?;
-        let area = ctx.memory(|m| m.data.get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects")))?;
+        let area = ctx.memory(|m| {
+            m.data
+                .get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"))
+        })?;
         area.iter()
             .find(|(_, r)| r.contains(pos))
             .and_then(|(id, _)| REGISTRY.iter().find(|e| e.id == id).map(|e| e.id))
@@ -232,7 +246,9 @@ impl Viewer {
                 .filter(|k| i.key_pressed(*k) && i.modifiers.is_none())
                 .collect();
             let question = i.key_pressed(Key::Questionmark)
-                || i.events.iter().any(|e| matches!(e, egui::Event::Text(t) if t == "?"));
+                || i.events
+                    .iter()
+                    .any(|e| matches!(e, egui::Event::Text(t) if t == "?"));
             (pressed, question)
         });
         if question {
@@ -250,7 +266,9 @@ impl Viewer {
                 Key::PageDown => out.push(Command::SelectStep(1)),
                 Key::PageUp => out.push(Command::SelectStep(-1)),
                 Key::M => {
-                    let id = self.hovered_view(ctx).or_else(|| REGISTRY.first().map(|e| e.id));
+                    let id = self
+                        .hovered_view(ctx)
+                        .or_else(|| REGISTRY.first().map(|e| e.id));
                     if let Some(id) = id {
                         out.push(Command::ToggleMaximise(id.to_string()));
                     }
@@ -292,21 +310,27 @@ impl Viewer {
             .resizable(false)
             .anchor(egui::Align2::CENTER_CENTER, Vec2::ZERO)
             .show(ctx, |ui| {
-                egui::Grid::new("bv help keys").num_columns(2).spacing([24.0, 4.0]).show(ui, |ui| {
-                    for (k, what) in SHORTCUTS {
-                        ui.label(RichText::new(*k).monospace().strong());
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
+                egui::Grid::new("bv help keys")
+                    .num_columns(2)
+                    .spacing([24.0, 4.0])
+                    .show(ui, |ui| {
+                        for (k, what) in SHORTCUTS {
+                            ui.label(RichText::new(*k).monospace().strong());
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
                 ui.separator();
-                egui::Grid::new("bv help mouse").num_columns(2).spacing([24.0, 4.0]).show(ui, |ui| {
-                    for (k, what) in GESTURES {
-                        ui.label(RichText::new(*k).strong());
-                        ui.label(*what);
-                        ui.end_row();
-                    }
-                });
+                egui::Grid::new("bv help mouse")
+                    .num_columns(2)
+                    .spacing([24.0, 4.0])
+                    .show(ui, |ui| {
+                        for (k, what) in GESTURES {
+                            ui.label(RichText::new(*k).strong());
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
             });
         if !open {
             self.help = false;
@@ -315,7 +339,12 @@ impl Viewer {
 }
 
 /// Lays out the views in the central area.
-fn central(ui: &mut Ui, views: &mut [(&'static ViewEntry, Box<dyn View>)], scene: &Scene<'_>, out: &mut Vec<Command>) {
+fn central(
+    ui: &mut Ui,
+    views: &mut [(&'static ViewEntry, Box<dyn View>)],
+    scene: &Scene<'_>,
+    out: &mut Vec<Command>,
+) {
     let area = ui.available_rect_before_wrap();
     let maximised = scene
         .state
@@ -391,42 +420,52 @@ pub fn layout(area: Rect, n: usize, maximised: Option<usize>) -> Vec<(usize, Rec
 
 /// A view's frame: a header with its title, toolbar and maximise button, and
 /// the view below.
-fn view_frame(ui: &mut Ui, entry: &ViewEntry, view: &mut dyn View, is_max: bool, scene: &Scene<'_>, out: &mut Vec<Command>) {
+fn view_frame(
+    ui: &mut Ui,
+    entry: &ViewEntry,
+    view: &mut dyn View,
+    is_max: bool,
+    scene: &Scene<'_>,
+    out: &mut Vec<Command>,
+) {
     let rect = ui.max_rect();
     // Remember where views are, for the M shortcut.
     ui.ctx().data_mut(|d| {
-        let list = d.get_temp_mut_or_default::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"));
+        let list =
+            d.get_temp_mut_or_default::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"));
         list.retain(|(id, _)| id != entry.id);
         list.push((entry.id.to_string(), rect));
     });
-    egui::Frame::group(ui.style()).inner_margin(4.0).show(ui, |ui| {
-        ui.set_min_size(rect.size() - Vec2::splat(10.0));
-        ui.horizontal_wrapped(|ui| {
-            let title = ui.label(RichText::new(entry.title).strong());
-            if title.double_clicked() {
-                out.push(Command::ToggleMaximise(entry.id.to_string()));
-            }
-            let (text, hint) = if is_max {
-                ("restore", "Show all views again (Esc)")
-            } else {
-                ("maximise", "Fill the window with this view (M)")
-            };
-            let r = ui.small_button(text).on_hover_text(hint);
-            let label = if is_max {
-                format!("Restore {}", entry.title)
-            } else {
-                format!("Maximise {}", entry.title)
-            };
-            r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Button, true, &label));
-            if r.clicked() {
-                out.push(Command::ToggleMaximise(entry.id.to_string()));
-            }
+    egui::Frame::group(ui.style())
+        .inner_margin(4.0)
+        .show(ui, |ui| {
+            ui.set_min_size(rect.size() - Vec2::splat(10.0));
+            ui.horizontal_wrapped(|ui| {
+                let title = ui.label(RichText::new(entry.title).strong());
+                if title.double_clicked() {
+                    out.push(Command::ToggleMaximise(entry.id.to_string()));
+                }
+                let (text, hint) = if is_max {
+                    ("restore", "Show all views again (Esc)")
+                } else {
+                    ("maximise", "Fill the window with this view (M)")
+                };
+                let r = ui.small_button(text).on_hover_text(hint);
+                let label = if is_max {
+                    format!("Restore {}", entry.title)
+                } else {
+                    format!("Maximise {}", entry.title)
+                };
+                r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Button, true, &label));
+                if r.clicked() {
+                    out.push(Command::ToggleMaximise(entry.id.to_string()));
+                }
+                ui.separator();
+                view.toolbar(ui, scene, out);
+            });
             ui.separator();
-            view.toolbar(ui, scene, out);
+            view.ui(ui, scene, out);
         });
-        ui.separator();
-        view.ui(ui, scene, out);
-    });
 }
 
 #[cfg(test)]

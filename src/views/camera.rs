@@ -78,7 +78,13 @@ impl CameraMatrices {
 /// Eye position of an orbit camera.
 pub fn eye_position(cam: &Camera) -> Vec3 {
     let (yaw, pitch) = (cam.yaw_deg.to_radians(), cam.pitch_deg.to_radians());
-    TARGET + cam.distance * Vec3::new(pitch.cos() * yaw.cos(), pitch.cos() * yaw.sin(), pitch.sin())
+    TARGET
+        + cam.distance
+            * Vec3::new(
+                pitch.cos() * yaw.cos(),
+                pitch.cos() * yaw.sin(),
+                pitch.sin(),
+            )
 }
 
 /// The point of the upper unit hemisphere a ray points at: its hit on the unit

@@ -50,10 +50,18 @@ impl View for CartesianView {
         match axis {
             CartesianAxis::ThetaO => {}
             CartesianAxis::ThetaH => {
-                ui.add(egui::Slider::new(&mut p2.fixed_theta_d_deg, 0.0..=89.5).text("θd").suffix("°"));
+                ui.add(
+                    egui::Slider::new(&mut p2.fixed_theta_d_deg, 0.0..=89.5)
+                        .text("θd")
+                        .suffix("°"),
+                );
             }
             CartesianAxis::ThetaD => {
-                ui.add(egui::Slider::new(&mut p2.fixed_theta_h_deg, 0.0..=89.5).text("θh").suffix("°"));
+                ui.add(
+                    egui::Slider::new(&mut p2.fixed_theta_h_deg, 0.0..=89.5)
+                        .text("θh")
+                        .suffix("°"),
+                );
             }
         }
         if p2 != p {
@@ -67,11 +75,18 @@ impl View for CartesianView {
         let dark = ui.visuals().dark_mode;
         let d = scene.state.display;
         let p = scene.state.plots;
-        let (theta_i, phi_i) = (scene.incident.theta_deg.to_radians(), scene.incident.phi_deg.to_radians());
+        let (theta_i, phi_i) = (
+            scene.incident.theta_deg.to_radians(),
+            scene.incident.phi_deg.to_radians(),
+        );
         let eval = |b: &super::SceneBrdf| -> Vec<curves::Sample> {
             match p.axis {
                 CartesianAxis::ThetaO => {
-                    let n = if b.brdf.transmits() { 2 * SAMPLES } else { SAMPLES };
+                    let n = if b.brdf.transmits() {
+                        2 * SAMPLES
+                    } else {
+                        SAMPLES
+                    };
                     curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
                 }
                 CartesianAxis::ThetaH => curves::half_diff_slice(
@@ -90,7 +105,8 @@ impl View for CartesianView {
                 ),
             }
         };
-        let data: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> = scene.brdfs.iter().map(|b| (b, eval(b))).collect();
+        let data: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
+            scene.brdfs.iter().map(|b| (b, eval(b))).collect();
         let vmax = data
             .iter()
             .flat_map(|(_, s)| s.iter())
@@ -98,7 +114,13 @@ impl View for CartesianView {
             .fold(0.0, f64::max);
         let floor = curves::log_floor(vmax);
         let log = d.log;
-        let y_of = move |v: f64| if log { curves::log_ordinate(v, floor) } else { v };
+        let y_of = move |v: f64| {
+            if log {
+                curves::log_ordinate(v, floor)
+            } else {
+                v
+            }
+        };
         let value_name = super::value_label(d.cosine);
         let axis = p.axis;
         let x_name = axis_name(axis);
@@ -110,7 +132,11 @@ impl View for CartesianView {
             CartesianAxis::ThetaH => format!("θh (°), θd = {:.1}°, φd = 90°", p.fixed_theta_d_deg),
             CartesianAxis::ThetaD => format!("θd (°), θh = {:.1}°, φd = 90°", p.fixed_theta_h_deg),
         };
-        let y_label = if log { format!("{value_name} (1/sr, log scale)") } else { format!("{value_name} (1/sr)") };
+        let y_label = if log {
+            format!("{value_name} (1/sr, log scale)")
+        } else {
+            format!("{value_name} (1/sr)")
+        };
         // Headroom above the largest value for the legend and markers.
         let (bottom, top) = if log {
             (floor.log10(), y_of(vmax.max(1e-30)) + 0.4)
@@ -127,8 +153,16 @@ impl View for CartesianView {
             .include_y(bottom)
             .include_y(top)
             .label_formatter(move |hover| match hover {
-                egui_plot::HoverPosition::NearDataPoint { plot_name, position, .. } if !plot_name.is_empty() => {
-                    let v = if log { 10f64.powf(position.y) } else { position.y };
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
+                    let v = if log {
+                        10f64.powf(position.y)
+                    } else {
+                        position.y
+                    };
                     Some(format!(
                         "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
                         position.x,
@@ -155,7 +189,12 @@ impl View for CartesianView {
         let response = plot.show(ui, |pui| {
             if axis == CartesianAxis::ThetaO {
                 let li = curves::incident_signed_angle(theta_i).to_degrees();
-                pui.vline(VLine::new("", li).color(light).width(2.0).allow_hover(false));
+                pui.vline(
+                    VLine::new("", li)
+                        .color(light)
+                        .width(2.0)
+                        .allow_hover(false),
+                );
                 pui.vline(
                     VLine::new("", theta_i.to_degrees())
                         .color(mirror)
@@ -164,16 +203,24 @@ impl View for CartesianView {
                         .allow_hover(false),
                 );
                 pui.text(
-                    Text::new("", PlotPoint::new(li, bottom), RichText::new(" ωi ").size(14.0))
-                        .color(light)
-                        .anchor(egui::Align2::RIGHT_BOTTOM)
-                        .allow_hover(false),
+                    Text::new(
+                        "",
+                        PlotPoint::new(li, bottom),
+                        RichText::new(" ωi ").size(14.0),
+                    )
+                    .color(light)
+                    .anchor(egui::Align2::RIGHT_BOTTOM)
+                    .allow_hover(false),
                 );
                 pui.text(
-                    Text::new("", PlotPoint::new(theta_i.to_degrees(), bottom), RichText::new(" ωr ").size(14.0))
-                        .color(mirror)
-                        .anchor(egui::Align2::LEFT_BOTTOM)
-                        .allow_hover(false),
+                    Text::new(
+                        "",
+                        PlotPoint::new(theta_i.to_degrees(), bottom),
+                        RichText::new(" ωr ").size(14.0),
+                    )
+                    .color(mirror)
+                    .anchor(egui::Align2::LEFT_BOTTOM)
+                    .allow_hover(false),
                 );
                 // Delta lobes: where they point, with their weight.
                 for (b, _) in &data {
@@ -188,10 +235,14 @@ impl View for CartesianView {
                                 .width(2.0),
                         );
                         pui.text(
-                            Text::new("", PlotPoint::new(a, bottom + (top - bottom) * 0.85), RichText::new(format!("δ {w:.3}")).size(11.0))
-                                .color(b.color)
-                                .anchor(egui::Align2::LEFT_TOP)
-                                .allow_hover(false),
+                            Text::new(
+                                "",
+                                PlotPoint::new(a, bottom + (top - bottom) * 0.85),
+                                RichText::new(format!("δ {w:.3}")).size(11.0),
+                            )
+                            .color(b.color)
+                            .anchor(egui::Align2::LEFT_TOP)
+                            .allow_hover(false),
                         );
                     }
                 }
@@ -199,7 +250,10 @@ impl View for CartesianView {
             let mut order: Vec<&(&super::SceneBrdf, Vec<curves::Sample>)> = data.iter().collect();
             order.sort_by_key(|(b, _)| b.selected);
             for (b, samples) in order {
-                let pts: Vec<[f64; 2]> = samples.iter().map(|s| [s.x.to_degrees(), y_of(s.value)]).collect();
+                let pts: Vec<[f64; 2]> = samples
+                    .iter()
+                    .map(|s| [s.x.to_degrees(), y_of(s.value)])
+                    .collect();
                 pui.line(
                     Line::new(b.label.clone(), PlotPoints::from(pts))
                         .color(b.color)
@@ -220,7 +274,9 @@ impl View for CartesianView {
                 .iter()
                 .map(|b| {
                     let s = match axis {
-                        CartesianAxis::ThetaO => curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, x, d.cosine),
+                        CartesianAxis::ThetaO => {
+                            curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, x, d.cosine)
+                        }
                         CartesianAxis::ThetaH => curves::half_diff_value(
                             b.brdf.as_ref(),
                             HalfDiffAxis::ThetaH,

@@ -55,9 +55,19 @@ pub const HORIZON_GAP: f64 = 1e-3;
 /// `f` in the plane of incidence at `n + 1` signed angles spanning the upper
 /// half (−90°..90°, stopping [`HORIZON_GAP`] short of the horizon) or, for
 /// transmitting models, the whole circle.
-pub fn plane_of_incidence(brdf: &dyn Brdf, theta_i: f64, phi_i: f64, n: usize, cosine: bool) -> Vec<Sample> {
+pub fn plane_of_incidence(
+    brdf: &dyn Brdf,
+    theta_i: f64,
+    phi_i: f64,
+    n: usize,
+    cosine: bool,
+) -> Vec<Sample> {
     let wi = frame::from_spherical(theta_i, phi_i);
-    let span = if brdf.transmits() { PI } else { FRAC_PI_2 - HORIZON_GAP };
+    let span = if brdf.transmits() {
+        PI
+    } else {
+        FRAC_PI_2 - HORIZON_GAP
+    };
     let n = n.max(2);
     (0..=n)
         .map(|k| {
@@ -112,7 +122,13 @@ pub fn half_diff_pair(theta_h: f64, theta_d: f64) -> (DVec3, DVec3) {
 /// `f` along θh ∈ [0°, 90°) at fixed θd, or along θd at fixed θh. Pairs where
 /// either direction is below the horizon give the model's value there (0 for
 /// reflection models).
-pub fn half_diff_slice(brdf: &dyn Brdf, axis: HalfDiffAxis, fixed: f64, n: usize, cosine: bool) -> Vec<Sample> {
+pub fn half_diff_slice(
+    brdf: &dyn Brdf,
+    axis: HalfDiffAxis,
+    fixed: f64,
+    n: usize,
+    cosine: bool,
+) -> Vec<Sample> {
     let n = n.max(2);
     (0..=n)
         .map(|k| {
@@ -124,7 +140,13 @@ pub fn half_diff_slice(brdf: &dyn Brdf, axis: HalfDiffAxis, fixed: f64, n: usize
 }
 
 /// The exact value at one point of a half/difference slice.
-pub fn half_diff_value(brdf: &dyn Brdf, axis: HalfDiffAxis, fixed: f64, x: f64, cosine: bool) -> Sample {
+pub fn half_diff_value(
+    brdf: &dyn Brdf,
+    axis: HalfDiffAxis,
+    fixed: f64,
+    x: f64,
+    cosine: bool,
+) -> Sample {
     let (th, td) = match axis {
         HalfDiffAxis::ThetaH => (x, fixed),
         HalfDiffAxis::ThetaD => (fixed, x),
@@ -146,18 +168,28 @@ pub fn log_ordinate(v: f64, floor: f64) -> f64 {
 
 /// The smallest value a log plot shows: five decades below the largest value.
 pub fn log_floor(max: f64) -> f64 {
-    if max > 0.0 && max.is_finite() { max * 1e-5 } else { 1e-5 }
+    if max > 0.0 && max.is_finite() {
+        max * 1e-5
+    } else {
+        1e-5
+    }
 }
 
 /// "Nice" round number ≥ `x` (1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k), for
 /// plot rings: fine enough that a curve fills most of the plot.
 pub fn nice_ceil(x: f64) -> f64 {
-    if !(x > 0.0) || !x.is_finite() {
+    if x.is_nan() || x <= 0.0 || x.is_infinite() {
         return 1.0;
     }
     let e = x.log10().floor() as i32;
     // Divide for negative exponents, so that 0.3 is the double nearest 0.3.
-    let scaled = |m: f64| if e >= 0 { m * 10f64.powi(e) } else { m / 10f64.powi(-e) };
+    let scaled = |m: f64| {
+        if e >= 0 {
+            m * 10f64.powi(e)
+        } else {
+            m / 10f64.powi(-e)
+        }
+    };
     for m in [1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0] {
         if scaled(m) >= x * (1.0 - 1e-9) {
             return scaled(m);

@@ -104,7 +104,11 @@ impl Lobe3dView {
     /// BRDF) and drops meshes of BRDFs no longer drawn.
     pub fn update_meshes(&mut self, scene: &Scene<'_>) {
         let d = scene.state.display;
-        let resolution = if scene.interacting { DRAG_RESOLUTION } else { IDLE_RESOLUTION };
+        let resolution = if scene.interacting {
+            DRAG_RESOLUTION
+        } else {
+            IDLE_RESOLUTION
+        };
         let wi = scene.wi();
         for b in &scene.brdfs {
             let key = MeshKey {
@@ -121,7 +125,11 @@ impl Lobe3dView {
                 n_theta: resolution.0,
                 n_phi: resolution.1,
                 cosine: d.cosine,
-                scale: if d.log { RadiusScale::Log } else { RadiusScale::Linear },
+                scale: if d.log {
+                    RadiusScale::Log
+                } else {
+                    RadiusScale::Linear
+                },
             };
             let mut mesh = lobe::build(b.brdf.as_ref(), wi, &opts);
             zero_horizon(&mut mesh);
@@ -129,9 +137,17 @@ impl Lobe3dView {
             let revision = self.next_revision;
             self.next_revision += 1;
             self.rebuilds += 1;
-            self.cache.insert(b.id, CachedLobe { key, mesh, revision });
+            self.cache.insert(
+                b.id,
+                CachedLobe {
+                    key,
+                    mesh,
+                    revision,
+                },
+            );
         }
-        self.cache.retain(|id, _| scene.brdfs.iter().any(|b| b.id == *id));
+        self.cache
+            .retain(|id, _| scene.brdfs.iter().any(|b| b.id == *id));
     }
 
     /// The scale that maps the scene's radii to world units.
@@ -145,12 +161,22 @@ impl Lobe3dView {
             .filter_map(|b| self.cache.get(&b.id))
             .map(|c| c.mesh.max_radius)
             .fold(0.0, f64::max);
-        if r > 1e-12 && r.is_finite() { (1.0 / r) as f32 } else { 1.0 }
+        if r > 1e-12 && r.is_finite() {
+            (1.0 / r) as f32
+        } else {
+            1.0
+        }
     }
 
     /// Builds the frame for a viewport of `size` points (updates the mesh cache
     /// first). This is all the GPU needs; `background` is sRGB 0..1.
-    pub fn frame(&mut self, scene: &Scene<'_>, size: Vec2, background: [f32; 4], dark: bool) -> Arc<LobeFrame> {
+    pub fn frame(
+        &mut self,
+        scene: &Scene<'_>,
+        size: Vec2,
+        background: [f32; 4],
+        dark: bool,
+    ) -> Arc<LobeFrame> {
         self.update_meshes(scene);
         let scale = self.scale_for(scene);
         self.last_scale = scale;
@@ -159,7 +185,9 @@ impl Lobe3dView {
         let primary = scene.primary().map(|b| b.id);
         let mut meshes = Vec::new();
         for b in &scene.brdfs {
-            let Some(c) = self.cache.get(&b.id) else { continue };
+            let Some(c) = self.cache.get(&b.id) else {
+                continue;
+            };
             let is_primary = Some(b.id) == primary;
             meshes.push(MeshDraw {
                 key: b.id,
@@ -168,7 +196,11 @@ impl Lobe3dView {
                 style: MeshStyle {
                     by_value: is_primary && d.color_by_value,
                     color: super::srgb_f32(b.color),
-                    alpha: if is_primary || d.wireframe { 1.0 } else { OVERLAY_ALPHA },
+                    alpha: if is_primary || d.wireframe {
+                        1.0
+                    } else {
+                        OVERLAY_ALPHA
+                    },
                     wireframe: d.wireframe,
                     value_max: c.mesh.max_value as f32,
                     log: d.log,
@@ -177,7 +209,11 @@ impl Lobe3dView {
                 },
             });
         }
-        let ground = if dark { [0.55, 0.58, 0.62] } else { [0.45, 0.47, 0.5] };
+        let ground = if dark {
+            [0.55, 0.58, 0.62]
+        } else {
+            [0.45, 0.47, 0.5]
+        };
         meshes.push(MeshDraw {
             key: u64::MAX - 1,
             revision: 0,
@@ -220,7 +256,9 @@ fn zero_horizon(mesh: &mut LobeMesh) {
         return;
     }
     let start = mesh.n_theta * mesh.n_phi;
-    let end = (start + mesh.n_phi).min(mesh.positions.len()).min(mesh.values.len());
+    let end = (start + mesh.n_phi)
+        .min(mesh.positions.len())
+        .min(mesh.values.len());
     if start >= end {
         return;
     }
@@ -272,7 +310,13 @@ fn rgba(c: Color32, alpha: f32) -> [f32; 4] {
 }
 
 /// Points along a curve `f(t)`, `t ∈ [0, 1]`, as segments.
-fn polyline(out: &mut Vec<LineSeg>, n: usize, color: [f32; 4], width: f32, f: impl Fn(f32) -> Vec3) {
+fn polyline(
+    out: &mut Vec<LineSeg>,
+    n: usize,
+    color: [f32; 4],
+    width: f32,
+    f: impl Fn(f32) -> Vec3,
+) {
     let mut prev = f(0.0);
     for k in 1..=n {
         let p = f(k as f32 / n as f32);
@@ -282,7 +326,15 @@ fn polyline(out: &mut Vec<LineSeg>, n: usize, color: [f32; 4], width: f32, f: im
 }
 
 /// A dashed segment.
-fn dashed(out: &mut Vec<LineSeg>, a: Vec3, b: Vec3, dash: f32, gap: f32, color: [f32; 4], width: f32) {
+fn dashed(
+    out: &mut Vec<LineSeg>,
+    a: Vec3,
+    b: Vec3,
+    dash: f32,
+    gap: f32,
+    color: [f32; 4],
+    width: f32,
+) {
     let len = (b - a).length();
     if len <= 0.0 {
         return;
@@ -297,7 +349,14 @@ fn dashed(out: &mut Vec<LineSeg>, a: Vec3, b: Vec3, dash: f32, gap: f32, color: 
 }
 
 /// An arrow head at `tip` pointing along `dir` (unit).
-fn arrow_head(out: &mut Vec<LineSeg>, tip: Vec3, dir: Vec3, size: f32, color: [f32; 4], width: f32) {
+fn arrow_head(
+    out: &mut Vec<LineSeg>,
+    tip: Vec3,
+    dir: Vec3,
+    size: f32,
+    color: [f32; 4],
+    width: f32,
+) {
     let u = dir.any_orthonormal_vector();
     let v = dir.cross(u);
     let back = tip - dir * size;
@@ -340,12 +399,48 @@ fn guide_lines(incident: Incident, dark: bool) -> Vec<LineSeg> {
     // Frame axes: n (blue), t (red), b (green).
     let axis = 1.3;
     let (n_col, t_col, b_col) = axis_colors(dark);
-    out.push(LineSeg::new(Vec3::ZERO, Vec3::Z * axis, rgba(n_col, 1.0), 2.0));
-    arrow_head(&mut out, Vec3::Z * axis, Vec3::Z, 0.07, rgba(n_col, 1.0), 2.0);
-    out.push(LineSeg::new(Vec3::ZERO, Vec3::X * axis, rgba(t_col, 1.0), 2.0));
-    arrow_head(&mut out, Vec3::X * axis, Vec3::X, 0.07, rgba(t_col, 1.0), 2.0);
-    out.push(LineSeg::new(Vec3::ZERO, Vec3::Y * axis, rgba(b_col, 1.0), 2.0));
-    arrow_head(&mut out, Vec3::Y * axis, Vec3::Y, 0.07, rgba(b_col, 1.0), 2.0);
+    out.push(LineSeg::new(
+        Vec3::ZERO,
+        Vec3::Z * axis,
+        rgba(n_col, 1.0),
+        2.0,
+    ));
+    arrow_head(
+        &mut out,
+        Vec3::Z * axis,
+        Vec3::Z,
+        0.07,
+        rgba(n_col, 1.0),
+        2.0,
+    );
+    out.push(LineSeg::new(
+        Vec3::ZERO,
+        Vec3::X * axis,
+        rgba(t_col, 1.0),
+        2.0,
+    ));
+    arrow_head(
+        &mut out,
+        Vec3::X * axis,
+        Vec3::X,
+        0.07,
+        rgba(t_col, 1.0),
+        2.0,
+    );
+    out.push(LineSeg::new(
+        Vec3::ZERO,
+        Vec3::Y * axis,
+        rgba(b_col, 1.0),
+        2.0,
+    ));
+    arrow_head(
+        &mut out,
+        Vec3::Y * axis,
+        Vec3::Y,
+        0.07,
+        rgba(b_col, 1.0),
+        2.0,
+    );
 
     // Incident ray: from the light towards the surface point.
     let wi = incident.direction().as_vec3();
@@ -354,7 +449,15 @@ fn guide_lines(incident: Incident, dark: bool) -> Vec<LineSeg> {
     arrow_head(&mut out, wi * 0.02, -wi, 0.1, light, 3.0);
     // Mirror direction, dashed.
     let r = bv_core::frame::reflect(incident.direction()).as_vec3();
-    dashed(&mut out, Vec3::ZERO, r * MIRROR_LENGTH, 0.06, 0.045, rgba(super::mirror_color(dark), 0.95), 2.0);
+    dashed(
+        &mut out,
+        Vec3::ZERO,
+        r * MIRROR_LENGTH,
+        0.06,
+        0.045,
+        rgba(super::mirror_color(dark), 0.95),
+        2.0,
+    );
     out
 }
 
@@ -385,7 +488,7 @@ fn axis_colors(dark: bool) -> (Color32, Color32, Color32) {
 fn delta_spikes(mesh: &LobeMesh, color: Color32, out: &mut Vec<LineSeg>) {
     for d in &mesh.deltas {
         let w = bv_core::mean_rgb(d.weight) as f32;
-        if !(w > 0.0) || !w.is_finite() {
+        if w.is_nan() || w <= 0.0 || w.is_infinite() {
             continue;
         }
         let dir = d.direction.as_vec3();
@@ -412,7 +515,12 @@ impl View for Lobe3dView {
         if super::toolbar_toggle(ui, d.wireframe, "wireframe", "Draw grid lines (W)") {
             out.push(Command::ToggleWireframe);
         }
-        if super::toolbar_toggle(ui, d.color_by_value, "colour by value", "Colour the selected lobe by its value") {
+        if super::toolbar_toggle(
+            ui,
+            d.color_by_value,
+            "colour by value",
+            "Colour the selected lobe by its value",
+        ) {
             set(out, &|n| n.color_by_value = !n.color_by_value);
         }
         if super::toolbar_toggle(
@@ -429,7 +537,11 @@ impl View for Lobe3dView {
                 ..scene.state.camera
             }));
         }
-        if ui.button("reset camera").on_hover_text("Reset the camera (R, or double-click the view)").clicked() {
+        if ui
+            .button("reset camera")
+            .on_hover_text("Reset the camera (R, or double-click the view)")
+            .clicked()
+        {
             out.push(Command::ResetCamera);
         }
     }
@@ -464,10 +576,21 @@ impl View for Lobe3dView {
 
 /// Background of the lobe view (sRGB 0..1).
 pub fn background(dark: bool) -> [f32; 4] {
-    if dark { [0.106, 0.11, 0.122, 1.0] } else { [0.985, 0.985, 0.985, 1.0] }
+    if dark {
+        [0.106, 0.11, 0.122, 1.0]
+    } else {
+        [0.985, 0.985, 0.985, 1.0]
+    }
 }
 
-fn handle_input(ui: &Ui, response: &egui::Response, rect: Rect, scene: &Scene<'_>, cam: &CameraMatrices, out: &mut Vec<Command>) {
+fn handle_input(
+    ui: &Ui,
+    response: &egui::Response,
+    rect: Rect,
+    scene: &Scene<'_>,
+    cam: &CameraMatrices,
+    out: &mut Vec<Command>,
+) {
     let modifiers = ui.input(|i| i.modifiers);
     let light_drag = modifiers.shift || modifiers.ctrl || modifiers.command;
     if response.double_clicked() {
@@ -478,7 +601,9 @@ fn handle_input(ui: &Ui, response: &egui::Response, rect: Rect, scene: &Scene<'_
         if let Some(p) = response.interact_pointer_pos() {
             let (o, d) = cam.ray(p.x - rect.min.x, p.y - rect.min.y);
             if let Some(hit) = camera::pick_hemisphere(o, d) {
-                out.push(Command::SetIncident(Incident::from_direction(hit.as_dvec3())));
+                out.push(Command::SetIncident(Incident::from_direction(
+                    hit.as_dvec3(),
+                )));
             }
         }
     } else if response.dragged() {
@@ -516,19 +641,46 @@ impl Lobe3dView {
             (Vec3::Y * 1.42, "b", b_col),
         ] {
             if let Some(s) = at(p) {
-                outlined_text(&painter, s, Align2::CENTER_CENTER, label, font.clone(), c, dark);
+                outlined_text(
+                    &painter,
+                    s,
+                    Align2::CENTER_CENTER,
+                    label,
+                    font.clone(),
+                    c,
+                    dark,
+                );
             }
         }
         let wi = scene.wi().as_vec3();
         if let Some(s) = at(wi * (INCIDENT_LENGTH + 0.04)) {
-            let label = format!("ωi ({:.0}°, {:.0}°)", scene.incident.theta_deg, scene.incident.phi_deg);
+            let label = format!(
+                "ωi ({:.0}°, {:.0}°)",
+                scene.incident.theta_deg, scene.incident.phi_deg
+            );
             let align = away_from(at(Vec3::ZERO), s);
-            outlined_text(&painter, s, align, &label, font.clone(), super::light_color(dark), dark);
+            outlined_text(
+                &painter,
+                s,
+                align,
+                &label,
+                font.clone(),
+                super::light_color(dark),
+                dark,
+            );
         }
         let r = bv_core::frame::reflect(scene.wi()).as_vec3();
         if let Some(s) = at(r * (MIRROR_LENGTH + 0.04)) {
             let align = away_from(at(Vec3::ZERO), s);
-            outlined_text(&painter, s, align, "ωr", font.clone(), super::mirror_color(dark), dark);
+            outlined_text(
+                &painter,
+                s,
+                align,
+                "ωr",
+                font.clone(),
+                super::mirror_color(dark),
+                dark,
+            );
         }
 
         let d = scene.state.display;
@@ -542,7 +694,10 @@ impl Lobe3dView {
             let vmax = c.mesh.max_value;
             // Bottom right: below the horizon, where reflection lobes never go.
             let h = (rect.height() * 0.32).clamp(50.0, 200.0);
-            let bar = Rect::from_min_size(Pos2::new(rect.max.x - 84.0, rect.max.y - 44.0 - h), Vec2::new(14.0, h));
+            let bar = Rect::from_min_size(
+                Pos2::new(rect.max.x - 84.0, rect.max.y - 44.0 - h),
+                Vec2::new(14.0, h),
+            );
             let mut mesh = egui::Mesh::default();
             let steps = 32;
             for k in 0..=steps {
@@ -558,16 +713,31 @@ impl Lobe3dView {
                 }
             }
             painter.add(egui::Shape::mesh(mesh));
-            painter.rect_stroke(bar, 0.0, Stroke::new(1.0, text.gamma_multiply(0.6)), egui::StrokeKind::Outside);
+            painter.rect_stroke(
+                bar,
+                0.0,
+                Stroke::new(1.0, text.gamma_multiply(0.6)),
+                egui::StrokeKind::Outside,
+            );
             for t in [0.0f64, 0.5, 1.0] {
                 // The value at colour-map position t (log maps ln(1 + v)).
-                let v = if d.log { ((1.0 + vmax).ln() * t).exp() - 1.0 } else { vmax * t };
+                let v = if d.log {
+                    ((1.0 + vmax).ln() * t).exp() - 1.0
+                } else {
+                    vmax * t
+                };
                 let y = bar.max.y - t as f32 * bar.height();
                 painter.line_segment(
                     [Pos2::new(bar.max.x, y), Pos2::new(bar.max.x + 4.0, y)],
                     Stroke::new(1.0, text),
                 );
-                painter.text(Pos2::new(bar.max.x + 6.0, y), Align2::LEFT_CENTER, curves::fmt_value(v), small.clone(), text);
+                painter.text(
+                    Pos2::new(bar.max.x + 6.0, y),
+                    Align2::LEFT_CENTER,
+                    curves::fmt_value(v),
+                    small.clone(),
+                    text,
+                );
             }
             painter.text(
                 Pos2::new(bar.center().x, bar.min.y - 6.0),
@@ -581,12 +751,26 @@ impl Lobe3dView {
         // What the unit hemisphere stands for, and how to drive the view.
         let unit = 1.0 / self.last_scale.max(1e-30) as f64;
         let scale_text = if d.log {
-            format!("grid radius: ln(1 + {}) = {}", super::value_label(d.cosine), curves::fmt_value(unit))
+            format!(
+                "grid radius: ln(1 + {}) = {}",
+                super::value_label(d.cosine),
+                curves::fmt_value(unit)
+            )
         } else {
-            format!("grid radius: {} = {} 1/sr", super::value_label(d.cosine), curves::fmt_value(unit))
+            format!(
+                "grid radius: {} = {} 1/sr",
+                super::value_label(d.cosine),
+                curves::fmt_value(unit)
+            )
         };
         let weak = ui.visuals().weak_text_color();
-        painter.text(rect.left_bottom() + Vec2::new(8.0, -24.0), Align2::LEFT_BOTTOM, scale_text, small.clone(), text);
+        painter.text(
+            rect.left_bottom() + Vec2::new(8.0, -24.0),
+            Align2::LEFT_BOTTOM,
+            scale_text,
+            small.clone(),
+            text,
+        );
         painter.text(
             rect.left_bottom() + Vec2::new(8.0, -6.0),
             Align2::LEFT_BOTTOM,
@@ -595,7 +779,13 @@ impl Lobe3dView {
             weak,
         );
         if scene.brdfs.is_empty() {
-            painter.text(rect.center(), Align2::CENTER_CENTER, "No BRDF shown: add one on the left", font, weak);
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "No BRDF shown: add one on the left",
+                font,
+                weak,
+            );
         }
     }
 }
@@ -603,7 +793,15 @@ impl Lobe3dView {
 /// Text with a thin outline in the background colour, readable over the lobe.
 /// The text is moved inside the painter's clip rectangle if it would stick out,
 /// so a label is never cut in a narrow view.
-fn outlined_text(painter: &egui::Painter, pos: Pos2, align: Align2, text: &str, font: FontId, color: Color32, dark: bool) {
+fn outlined_text(
+    painter: &egui::Painter,
+    pos: Pos2,
+    align: Align2,
+    text: &str,
+    font: FontId,
+    color: Color32,
+    dark: bool,
+) {
     let halo = if dark {
         Color32::from_rgba_unmultiplied(0, 0, 0, 160)
     } else {
@@ -615,7 +813,12 @@ fn outlined_text(painter: &egui::Painter, pos: Pos2, align: Align2, text: &str, 
     let dx = (bounds.min.x - r.min.x).max(0.0) + (bounds.max.x - r.max.x).min(0.0);
     let dy = (bounds.min.y - r.min.y).max(0.0) + (bounds.max.y - r.max.y).min(0.0);
     r = r.translate(Vec2::new(dx, dy));
-    for o in [Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(0.0, -1.0), Vec2::new(0.0, 1.0)] {
+    for o in [
+        Vec2::new(-1.0, 0.0),
+        Vec2::new(1.0, 0.0),
+        Vec2::new(0.0, -1.0),
+        Vec2::new(0.0, 1.0),
+    ] {
         painter.text(r.min + o, Align2::LEFT_TOP, text, font.clone(), halo);
     }
     painter.galley(r.min, galley, color);

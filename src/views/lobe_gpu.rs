@@ -202,6 +202,16 @@ struct ViewResources {
     meshes: HashMap<u64, GpuMesh>,
 }
 
+/// The size of a lobe view's image in pixels, and pixels per point (which
+/// scales line widths).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelSize {
+    /// Width and height in pixels.
+    pub size: [u32; 2],
+    /// Pixels per point.
+    pub ppp: f32,
+}
+
 /// Pipelines and per-view GPU resources of every lobe view.
 pub struct LobeRenderer {
     /// Pipelines at the full sample count, then (software renderers only) at one
@@ -232,14 +242,27 @@ fn pick_samples(adapter: Option<&wgpu::Adapter>) -> u32 {
     if std::env::var("BV_MSAA").is_ok_and(|v| v.trim() == "1") {
         return 1;
     }
-    let ok = |f: wgpu::TextureFormat| adapter.get_texture_format_features(f).flags.sample_count_supported(4);
-    if ok(OFFSCREEN_FORMAT) && ok(DEPTH_FORMAT) { 4 } else { 1 }
+    let ok = |f: wgpu::TextureFormat| {
+        adapter
+            .get_texture_format_features(f)
+            .flags
+            .sample_count_supported(4)
+    };
+    if ok(OFFSCREEN_FORMAT) && ok(DEPTH_FORMAT) {
+        4
+    } else {
+        1
+    }
 }
 
 impl LobeRenderer {
     /// Creates the pipelines; `target_format` is the format of the pass the
     /// result is copied into (the window's surface, or Rgba8Unorm headless).
-    pub fn new(device: &wgpu::Device, adapter: Option<&wgpu::Adapter>, target_format: wgpu::TextureFormat) -> Self {
+    pub fn new(
+        device: &wgpu::Device,
+        adapter: Option<&wgpu::Adapter>,
+        target_format: wgpu::TextureFormat,
+    ) -> Self {
         let samples = pick_samples(adapter);
         // A CPU rasteriser pays for every sample: while something is dragged it
         // draws with one, and multisamples the frame once the drag ends.
@@ -256,11 +279,15 @@ impl LobeRenderer {
         };
         let globals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bv lobe globals"),
-            entries: &[uniform_entry(wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT)],
+            entries: &[uniform_entry(
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+            )],
         });
         let style_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bv lobe style"),
-            entries: &[uniform_entry(wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT)],
+            entries: &[uniform_entry(
+                wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT,
+            )],
         });
         let blit_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("bv lobe blit"),
@@ -292,7 +319,8 @@ impl LobeRenderer {
             ..Default::default()
         });
 
-        let lobe_src = include_str!("../../shaders/lobe.wgsl").replace("COLORMAP_TABLE", &colormap::wgsl_table());
+        let lobe_src = include_str!("../../shaders/lobe.wgsl")
+            .replace("COLORMAP_TABLE", &colormap::wgsl_table());
         let lobe_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bv lobe.wgsl"),
             source: wgpu::ShaderSource::Wgsl(lobe_src.into()),
@@ -337,30 +365,68 @@ impl LobeRenderer {
                 bias: wgpu::DepthBiasState::default(),
             })
         };
-        let mesh_pipeline = |label: &str, topology, write: bool, blend: Option<wgpu::BlendState>, multisample| {
+        let mesh_pipeline =
+            |label: &str, topology, write: bool, blend: Option<wgpu::BlendState>, multisample| {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&mesh_layout),
+                    vertex: wgpu::VertexState {
+                        module: &lobe_module,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[Some(vertex_layout.clone())],
+                    },
+                    primitive: wgpu::PrimitiveState {
+                        topology,
+                        cull_mode: None,
+                        ..Default::default()
+                    },
+                    depth_stencil: depth(write),
+                    multisample,
+                    fragment: Some(wgpu::FragmentState {
+                        module: &lobe_module,
+                        entry_point: Some("fs_main"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(wgpu::ColorTargetState {
+                            format: OFFSCREEN_FORMAT,
+                            blend,
+                            write_mask: wgpu::ColorWrites::ALL,
+                        })],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
+
+        let seg_layout = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<LineSeg>() as u64,
+            step_mode: wgpu::VertexStepMode::Instance,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x4],
+        };
+        let lines_pipeline = |multisample| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&mesh_layout),
+                label: Some("bv lobe lines"),
+                layout: Some(&lines_layout),
                 vertex: wgpu::VertexState {
-                    module: &lobe_module,
+                    module: &lines_module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
-                    buffers: &[Some(vertex_layout.clone())],
+                    buffers: &[Some(seg_layout.clone())],
                 },
                 primitive: wgpu::PrimitiveState {
-                    topology,
+                    topology: wgpu::PrimitiveTopology::TriangleList,
                     cull_mode: None,
                     ..Default::default()
                 },
-                depth_stencil: depth(write),
+                depth_stencil: depth(false),
                 multisample,
                 fragment: Some(wgpu::FragmentState {
-                    module: &lobe_module,
+                    module: &lines_module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState {
                         format: OFFSCREEN_FORMAT,
-                        blend,
+                        blend: Some(alpha_blend),
                         write_mask: wgpu::ColorWrites::ALL,
                     })],
                 }),
@@ -368,41 +434,6 @@ impl LobeRenderer {
                 cache: None,
             })
         };
-
-        let seg_layout = wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<LineSeg>() as u64,
-            step_mode: wgpu::VertexStepMode::Instance,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x4],
-        };
-        let lines_pipeline = |multisample| device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("bv lobe lines"),
-            layout: Some(&lines_layout),
-            vertex: wgpu::VertexState {
-                module: &lines_module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(seg_layout.clone())],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: depth(false),
-            multisample,
-            fragment: Some(wgpu::FragmentState {
-                module: &lines_module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: OFFSCREEN_FORMAT,
-                    blend: Some(alpha_blend),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
         let make_set = |samples: u32| {
             let ms = wgpu::MultisampleState {
                 count: samples,
@@ -411,7 +442,13 @@ impl LobeRenderer {
             };
             Pipelines {
                 samples,
-                opaque: mesh_pipeline("bv lobe opaque", wgpu::PrimitiveTopology::TriangleList, true, None, ms),
+                opaque: mesh_pipeline(
+                    "bv lobe opaque",
+                    wgpu::PrimitiveTopology::TriangleList,
+                    true,
+                    None,
+                    ms,
+                ),
                 blended: mesh_pipeline(
                     "bv lobe blended",
                     wgpu::PrimitiveTopology::TriangleList,
@@ -419,7 +456,13 @@ impl LobeRenderer {
                     Some(alpha_blend),
                     ms,
                 ),
-                wire: mesh_pipeline("bv lobe wire", wgpu::PrimitiveTopology::LineList, true, Some(alpha_blend), ms),
+                wire: mesh_pipeline(
+                    "bv lobe wire",
+                    wgpu::PrimitiveTopology::LineList,
+                    true,
+                    Some(alpha_blend),
+                    ms,
+                ),
                 lines: lines_pipeline(ms),
             }
         };
@@ -470,7 +513,7 @@ impl LobeRenderer {
     }
 
     /// Uploads what changed in `frame` and records its offscreen pass for view
-    /// `view` at `size` pixels (`ppp` pixels per point scales line widths).
+    /// `view` at the given pixel size.
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
@@ -478,9 +521,9 @@ impl LobeRenderer {
         encoder: &mut wgpu::CommandEncoder,
         view: u64,
         frame: &LobeFrame,
-        size: [u32; 2],
-        ppp: f32,
+        pixels: PixelSize,
     ) {
+        let PixelSize { size, ppp } = pixels;
         let size = [size[0].max(1), size[1].max(1)];
         let set = match self.sets.get(1) {
             Some(fast) if frame.interacting => fast,
@@ -488,7 +531,8 @@ impl LobeRenderer {
         };
         let samples = set.samples;
         let fingerprint = frame.fingerprint(size, ppp) ^ u64::from(samples);
-        let (style_layout, blit_layout, sampler) = (&self.style_layout, &self.blit_layout, &self.sampler);
+        let (style_layout, blit_layout, sampler) =
+            (&self.style_layout, &self.blit_layout, &self.sampler);
         let (opaque, blended, wire, lines_pl) = (&set.opaque, &set.blended, &set.wire, &set.lines);
         let vr = {
             let layout = &self.globals_layout;
@@ -519,7 +563,11 @@ impl LobeRenderer {
         };
 
         // Target textures follow the viewport's pixel size.
-        if vr.target.as_ref().is_none_or(|t| t.size != size || t.samples != samples) {
+        if vr
+            .target
+            .as_ref()
+            .is_none_or(|t| t.size != size || t.samples != samples)
+        {
             vr.target = Some(create_target(device, blit_layout, sampler, size, samples));
         }
 
@@ -564,13 +612,21 @@ impl LobeRenderer {
             m.used = false;
         }
         for d in &frame.meshes {
-            let stale = vr.meshes.get(&d.key).is_none_or(|g| g.revision != d.revision);
+            let stale = vr
+                .meshes
+                .get(&d.key)
+                .is_none_or(|g| g.revision != d.revision);
             if stale {
-                vr.meshes.insert(d.key, upload_mesh(device, style_layout, d));
+                vr.meshes
+                    .insert(d.key, upload_mesh(device, style_layout, d));
             }
             if let Some(g) = vr.meshes.get_mut(&d.key) {
                 g.used = true;
-                queue.write_buffer(&g.style, 0, bytemuck::bytes_of(&StyleUniform::new(&d.style)));
+                queue.write_buffer(
+                    &g.style,
+                    0,
+                    bytemuck::bytes_of(&StyleUniform::new(&d.style)),
+                );
             }
         }
         vr.meshes.retain(|_, m| m.used);
@@ -620,7 +676,9 @@ impl LobeRenderer {
         pass.set_bind_group(0, &vr.globals_bg, &[]);
 
         let draw_mesh = |pass: &mut wgpu::RenderPass<'_>, d: &MeshDraw, wire_pass: bool| {
-            let Some(g) = vr.meshes.get(&d.key) else { return };
+            let Some(g) = vr.meshes.get(&d.key) else {
+                return;
+            };
             pass.set_bind_group(1, &g.style_bg, &[]);
             pass.set_vertex_buffer(0, g.vertices.slice(..));
             if wire_pass {
@@ -634,7 +692,11 @@ impl LobeRenderer {
 
         // 1. Opaque surfaces write depth.
         pass.set_pipeline(opaque);
-        for d in frame.meshes.iter().filter(|d| d.style.alpha >= 1.0 && !d.style.wireframe) {
+        for d in frame
+            .meshes
+            .iter()
+            .filter(|d| d.style.alpha >= 1.0 && !d.style.wireframe)
+        {
             draw_mesh(&mut pass, d, false);
         }
         // 2. Wireframes.
@@ -653,7 +715,11 @@ impl LobeRenderer {
         // 4. Translucent surfaces (overlaid BRDFs, ground disc), no depth write.
         pass.set_pipeline(blended);
         pass.set_bind_group(0, &vr.globals_bg, &[]);
-        for d in frame.meshes.iter().filter(|d| d.style.alpha < 1.0 && !d.style.wireframe) {
+        for d in frame
+            .meshes
+            .iter()
+            .filter(|d| d.style.alpha < 1.0 && !d.style.wireframe)
+        {
             draw_mesh(&mut pass, d, false);
         }
     }
@@ -685,7 +751,17 @@ impl LobeRenderer {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("bv lobe headless"),
         });
-        self.prepare(device, queue, &mut encoder, HEADLESS, frame, [width, height], ppp);
+        self.prepare(
+            device,
+            queue,
+            &mut encoder,
+            HEADLESS,
+            frame,
+            PixelSize {
+                size: [width, height],
+                ppp,
+            },
+        );
         let target = self
             .views
             .get(&HEADLESS)
@@ -729,7 +805,9 @@ impl LobeRenderer {
         rx.recv()
             .map_err(|e| e.to_string())?
             .map_err(|e| format!("GPU readback failed: {e}"))?;
-        let data = slice.get_mapped_range().map_err(|e| format!("GPU readback failed: {e}"))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| format!("GPU readback failed: {e}"))?;
         let mut pixels = Vec::with_capacity(unpadded * h as usize);
         for row in data.chunks_exact(padded) {
             pixels.extend_from_slice(&row[..unpadded]);
@@ -768,7 +846,9 @@ fn create_target(
         "bv lobe colour",
         OFFSCREEN_FORMAT,
         1,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
+        wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
     );
     let resolve_view = resolve.create_view(&Default::default());
     let msaa_color = (samples > 1).then(|| {
@@ -837,7 +917,11 @@ pub fn wire_indices(mesh: &LobeMesh) -> Vec<u32> {
     out
 }
 
-fn upload_mesh(device: &wgpu::Device, style_layout: &wgpu::BindGroupLayout, d: &MeshDraw) -> GpuMesh {
+fn upload_mesh(
+    device: &wgpu::Device,
+    style_layout: &wgpu::BindGroupLayout,
+    d: &MeshDraw,
+) -> GpuMesh {
     let m = &d.mesh;
     let vertices: Vec<Vertex> = m
         .positions
@@ -860,7 +944,11 @@ fn upload_mesh(device: &wgpu::Device, style_layout: &wgpu::BindGroupLayout, d: &
     } else {
         vertices
     };
-    let indices = if m.indices.is_empty() { vec![0u32; 3] } else { m.indices.clone() };
+    let indices = if m.indices.is_empty() {
+        vec![0u32; 3]
+    } else {
+        m.indices.clone()
+    };
     let wire = wire_indices(m);
     let wire = if wire.is_empty() { vec![0u32; 2] } else { wire };
     let vb = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -962,12 +1050,27 @@ impl CallbackTrait for LobeCallback {
     ) -> Vec<wgpu::CommandBuffer> {
         if let Some(r) = resources.get_mut::<LobeRenderer>() {
             let ppp = screen.pixels_per_point;
-            r.prepare(device, queue, encoder, self.view, &self.frame, rect_pixels(self.rect, ppp, screen.size_in_pixels), ppp);
+            r.prepare(
+                device,
+                queue,
+                encoder,
+                self.view,
+                &self.frame,
+                PixelSize {
+                    size: rect_pixels(self.rect, ppp, screen.size_in_pixels),
+                    ppp,
+                },
+            );
         }
         Vec::new()
     }
 
-    fn paint(&self, _info: egui::PaintCallbackInfo, pass: &mut wgpu::RenderPass<'static>, resources: &CallbackResources) {
+    fn paint(
+        &self,
+        _info: egui::PaintCallbackInfo,
+        pass: &mut wgpu::RenderPass<'static>,
+        resources: &CallbackResources,
+    ) {
         if let Some(r) = resources.get::<LobeRenderer>() {
             r.paint(self.view, pass);
         }

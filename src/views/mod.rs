@@ -63,7 +63,10 @@ impl Scene<'_> {
     /// The BRDF drawn opaque and coloured by value in the lobe view: the
     /// selected one if drawn, else the first drawn.
     pub fn primary(&self) -> Option<&SceneBrdf> {
-        self.brdfs.iter().find(|b| b.selected).or_else(|| self.brdfs.first())
+        self.brdfs
+            .iter()
+            .find(|b| b.selected)
+            .or_else(|| self.brdfs.first())
     }
 
     /// The unit direction towards the light.
@@ -97,9 +100,21 @@ pub struct ViewEntry {
 /// Every view, in layout order: the first fills the left of the central area,
 /// the others stack on the right. Add a view here.
 pub const REGISTRY: &[ViewEntry] = &[
-    ViewEntry { id: "lobe", title: "3D lobe", make: || Box::new(lobe3d::Lobe3dView::new()) },
-    ViewEntry { id: "polar", title: "Plane of incidence (polar)", make: || Box::new(polar::PolarView::default()) },
-    ViewEntry { id: "cartesian", title: "f versus angle", make: || Box::new(cartesian::CartesianView::default()) },
+    ViewEntry {
+        id: "lobe",
+        title: "3D lobe",
+        make: || Box::new(lobe3d::Lobe3dView::new()),
+    },
+    ViewEntry {
+        id: "polar",
+        title: "Plane of incidence (polar)",
+        make: || Box::new(polar::PolarView::default()),
+    },
+    ViewEntry {
+        id: "cartesian",
+        title: "f versus angle",
+        make: || Box::new(cartesian::CartesianView::default()),
+    },
 ];
 
 /// The registry entry with id `id`.
@@ -114,7 +129,11 @@ pub fn value_label(cosine: bool) -> &'static str {
 
 /// Convert an egui colour to sRGB 0..1 floats.
 pub fn srgb_f32(c: Color32) -> [f32; 3] {
-    [c.r() as f32 / 255.0, c.g() as f32 / 255.0, c.b() as f32 / 255.0]
+    [
+        c.r() as f32 / 255.0,
+        c.g() as f32 / 255.0,
+        c.b() as f32 / 255.0,
+    ]
 }
 
 /// A text colour that reads on the current background.
@@ -124,12 +143,20 @@ pub fn strong_text(ui: &Ui) -> Color32 {
 
 /// Marker colour of the light (ωi) in every view.
 pub fn light_color(dark: bool) -> Color32 {
-    if dark { Color32::from_rgb(255, 200, 60) } else { Color32::from_rgb(210, 130, 0) }
+    if dark {
+        Color32::from_rgb(255, 200, 60)
+    } else {
+        Color32::from_rgb(210, 130, 0)
+    }
 }
 
 /// Marker colour of the mirror direction in every view.
 pub fn mirror_color(dark: bool) -> Color32 {
-    if dark { Color32::from_rgb(200, 200, 200) } else { Color32::from_rgb(90, 90, 90) }
+    if dark {
+        Color32::from_rgb(200, 200, 200)
+    } else {
+        Color32::from_rgb(90, 90, 90)
+    }
 }
 
 /// A faint colour for grids.

@@ -44,15 +44,19 @@ pub fn readout_ui(ui: &mut Ui, readout: Option<&Readout>, cosine: bool) {
                 ui.label(RichText::new(format!("{} = {:.1}°", r.axis, r.x_deg)).monospace());
                 for (label, color, s) in &r.values {
                     let rgb = s.rgb;
-                    ui.label(RichText::new(format!("{label}: {}", curves::fmt_value(s.value))).color(*color).strong())
-                        .on_hover_text(format!(
-                            "{} = {} 1/sr\nf (r, g, b) = ({}, {}, {}) 1/sr",
-                            super::value_label(cosine),
-                            s.value,
-                            rgb.x,
-                            rgb.y,
-                            rgb.z
-                        ));
+                    ui.label(
+                        RichText::new(format!("{label}: {}", curves::fmt_value(s.value)))
+                            .color(*color)
+                            .strong(),
+                    )
+                    .on_hover_text(format!(
+                        "{} = {} 1/sr\nf (r, g, b) = ({}, {}, {}) 1/sr",
+                        super::value_label(cosine),
+                        s.value,
+                        rgb.x,
+                        rgb.y,
+                        rgb.z
+                    ));
                 }
                 ui.weak("1/sr");
             }
@@ -81,7 +85,10 @@ impl View for PolarView {
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
         let d = scene.state.display;
-        let (theta_i, phi_i) = (scene.incident.theta_deg.to_radians(), scene.incident.phi_deg.to_radians());
+        let (theta_i, phi_i) = (
+            scene.incident.theta_deg.to_radians(),
+            scene.incident.phi_deg.to_radians(),
+        );
         let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
 
         // Curves and the largest radius.
@@ -89,7 +96,11 @@ impl View for PolarView {
             .brdfs
             .iter()
             .map(|b| {
-                let n = if b.brdf.transmits() { 2 * SAMPLES } else { SAMPLES };
+                let n = if b.brdf.transmits() {
+                    2 * SAMPLES
+                } else {
+                    SAMPLES
+                };
                 let pts = curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
                     .iter()
                     .map(|s| {
@@ -125,10 +136,18 @@ impl View for PolarView {
             .allow_scroll(false)
             .legend(Legend::default().position(Corner::RightTop))
             .label_formatter(move |hover| match hover {
-                egui_plot::HoverPosition::NearDataPoint { plot_name, position, .. } if !plot_name.is_empty() => {
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
                     let angle = position.x.atan2(position.y).to_degrees();
                     let v = value_at(position.x.hypot(position.y), log);
-                    Some(format!("{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr", angle, curves::fmt_value(v)))
+                    Some(format!(
+                        "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
+                        angle,
+                        curves::fmt_value(v)
+                    ))
                 }
                 _ => None,
             });
@@ -142,24 +161,39 @@ impl View for PolarView {
                 let n = 4 * span as usize;
                 let pts: Vec<[f64; 2]> = (0..=n)
                     .map(|j| {
-                        let a = (-(span as f64) + 2.0 * span as f64 * j as f64 / n as f64).to_radians();
+                        let a =
+                            (-(span as f64) + 2.0 * span as f64 * j as f64 / n as f64).to_radians();
                         [r * a.sin(), r * a.cos()]
                     })
                     .collect();
-                pui.line(Line::new("", PlotPoints::from(pts)).color(grid).width(1.0).allow_hover(false));
+                pui.line(
+                    Line::new("", PlotPoints::from(pts))
+                        .color(grid)
+                        .width(1.0)
+                        .allow_hover(false),
+                );
                 // Ring values read along the surface line, like a radial axis.
                 let label = curves::fmt_tick(value_at(r, log));
                 pui.text(
-                    Text::new("", PlotPoint::new(r, -outer * 0.015), RichText::new(label).size(11.0))
-                        .color(text_col.gamma_multiply(0.8))
-                        .anchor(egui::Align2::CENTER_TOP)
-                        .allow_hover(false),
+                    Text::new(
+                        "",
+                        PlotPoint::new(r, -outer * 0.015),
+                        RichText::new(label).size(11.0),
+                    )
+                    .color(text_col.gamma_multiply(0.8))
+                    .anchor(egui::Align2::CENTER_TOP)
+                    .allow_hover(false),
                 );
             }
             for deg in (-span..=span).step_by(15) {
                 let a = (deg as f64).to_radians();
                 let pts = vec![[0.0, 0.0], [outer * a.sin(), outer * a.cos()]];
-                pui.line(Line::new("", PlotPoints::from(pts)).color(grid).width(1.0).allow_hover(false));
+                pui.line(
+                    Line::new("", PlotPoints::from(pts))
+                        .color(grid)
+                        .width(1.0)
+                        .allow_hover(false),
+                );
                 if deg % 30 == 0 {
                     // ±90° sit just above the surface line, clear of the ring values.
                     let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
@@ -173,10 +207,13 @@ impl View for PolarView {
             }
             // The surface.
             pui.line(
-                Line::new("", PlotPoints::from(vec![[-outer * 1.15, 0.0], [outer * 1.15, 0.0]]))
-                    .color(text_col.gamma_multiply(0.7))
-                    .width(1.5)
-                    .allow_hover(false),
+                Line::new(
+                    "",
+                    PlotPoints::from(vec![[-outer * 1.15, 0.0], [outer * 1.15, 0.0]]),
+                )
+                .color(text_col.gamma_multiply(0.7))
+                .width(1.5)
+                .allow_hover(false),
             );
             // Light (left) and mirror direction (right).
             let li = curves::incident_signed_angle(theta_i);
@@ -188,9 +225,13 @@ impl View for PolarView {
                     .allow_hover(false),
             );
             pui.text(
-                Text::new("", PlotPoint::new(lp[0] * 1.06, lp[1] * 1.06 + outer * 0.04), RichText::new("ωi").size(14.0))
-                    .color(light)
-                    .allow_hover(false),
+                Text::new(
+                    "",
+                    PlotPoint::new(lp[0] * 1.06, lp[1] * 1.06 + outer * 0.04),
+                    RichText::new("ωi").size(14.0),
+                )
+                .color(light)
+                .allow_hover(false),
             );
             let mp = [outer * 1.12 * theta_i.sin(), outer * 1.12 * theta_i.cos()];
             pui.line(
@@ -201,9 +242,13 @@ impl View for PolarView {
                     .allow_hover(false),
             );
             pui.text(
-                Text::new("", PlotPoint::new(mp[0] * 1.08, mp[1] * 1.08), RichText::new("ωr").size(14.0))
-                    .color(mirror)
-                    .allow_hover(false),
+                Text::new(
+                    "",
+                    PlotPoint::new(mp[0] * 1.08, mp[1] * 1.08),
+                    RichText::new("ωr").size(14.0),
+                )
+                .color(mirror)
+                .allow_hover(false),
             );
             // The curves, selected one on top.
             let mut order: Vec<&(String, Color32, bool, Vec<[f64; 2]>)> = curves.iter().collect();
@@ -229,13 +274,21 @@ impl View for PolarView {
                     let w = bv_core::mean_rgb(dl.weight);
                     let tip = [outer * w * a.sin(), outer * w * a.cos()];
                     pui.arrows(
-                        egui_plot::Arrows::new(format!("{} δ", b.label), PlotPoints::from(vec![[0.0, 0.0]]), PlotPoints::from(vec![tip]))
-                            .color(b.color),
+                        egui_plot::Arrows::new(
+                            format!("{} δ", b.label),
+                            PlotPoints::from(vec![[0.0, 0.0]]),
+                            PlotPoints::from(vec![tip]),
+                        )
+                        .color(b.color),
                     );
                     pui.text(
-                        Text::new("", PlotPoint::new(tip[0] * 1.05, tip[1] * 1.05), RichText::new(format!("δ {w:.3}")).size(11.0))
-                            .color(b.color)
-                            .allow_hover(false),
+                        Text::new(
+                            "",
+                            PlotPoint::new(tip[0] * 1.05, tip[1] * 1.05),
+                            RichText::new(format!("δ {w:.3}")).size(11.0),
+                        )
+                        .color(b.color)
+                        .allow_hover(false),
                     );
                 }
             }
@@ -249,7 +302,11 @@ impl View for PolarView {
             && let Some(p) = response.inner
         {
             let a = p.x.atan2(p.y);
-            let limit = if transmits { std::f64::consts::PI } else { FRAC_PI_2 };
+            let limit = if transmits {
+                std::f64::consts::PI
+            } else {
+                FRAC_PI_2
+            };
             if a.abs() <= limit {
                 self.readout = Some(Readout {
                     axis: "θo".into(),
@@ -258,7 +315,11 @@ impl View for PolarView {
                         .brdfs
                         .iter()
                         .map(|b| {
-                            (b.label.clone(), b.color, curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine))
+                            (
+                                b.label.clone(),
+                                b.color,
+                                curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine),
+                            )
                         })
                         .collect(),
                 });
