@@ -372,7 +372,7 @@ fn state_survives_a_restart() {
 // ---- Rendering on the GPU (lavapipe where there is none) ----
 
 /// A harness whose renderer has the lobe pipeline installed, like eframe's window.
-fn gpu_builder() -> egui_kittest::HarnessBuilder<LobeOnly> {
+fn gpu_builder<S>() -> egui_kittest::HarnessBuilder<S> {
     let rs = egui_kittest::wgpu::create_render_state(
         egui_kittest::wgpu::default_wgpu_setup(),
         egui_wgpu_options(),
@@ -599,4 +599,44 @@ fn shift_drag_on_the_lobe_moves_the_light() {
     );
     // The camera did not orbit: the drag went to the light.
     assert_eq!(h.state().state().camera, bv::app::state::Camera::default());
+}
+
+/// Renders the whole window in a few states into `$BV_RENDER_DIR` (default
+/// `out/gui-states`) for a human to look at; not a pass/fail test. Run with
+/// `cargo test --test gui -- --ignored render_window_states`.
+#[test]
+#[ignore]
+fn render_window_states() {
+    let dir = std::env::var("BV_RENDER_DIR").unwrap_or_else(|_| "out/gui-states".into());
+    std::fs::create_dir_all(&dir).unwrap();
+    let models: Vec<&str> = ["cook-torrance", "lambert", "ward"]
+        .into_iter()
+        .filter(|m| bv_core::find(m).is_ok())
+        .collect();
+    let mut state = AppState::default();
+    for m in &models {
+        state.add(bv_core::ModelSpec::new(m).unwrap());
+    }
+    state.selected = state.brdfs.first().map(|b| b.id);
+    let variants: Vec<(&str, Vec<Command>)> = vec![
+        ("default", vec![]),
+        ("log_cos", vec![Command::ToggleLog, Command::ToggleCosine]),
+        ("wireframe", vec![Command::ToggleWireframe]),
+        ("light", vec![Command::SetTheme(bv::app::state::Theme::Light)]),
+        ("help", vec![Command::ToggleHelp]),
+        ("lobe_max", vec![Command::Maximise(Some("lobe".into()))]),
+        ("theta_h", vec![Command::SetCartesianAxis(bv::app::state::CartesianAxis::ThetaH)]),
+    ];
+    for (name, cmds) in variants {
+        let mut h = gpu_builder()
+            .with_size(SIZE)
+            .with_max_steps(12)
+            .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state.clone()));
+        for c in cmds {
+            h.state_mut().push(c);
+        }
+        h.run();
+        let img = h.render().unwrap();
+        img.save(format!("{dir}/{name}.png")).unwrap();
+    }
 }

@@ -302,7 +302,7 @@ impl Bench {
         }
     }
 
-    /// Moves the first float parameter of the selected BRDF one step along a
+    /// Moves a float parameter of the selected BRDF one step along a
     /// triangle wave across its slider span (log-spaced for log parameters), as
     /// a user's slider drag would; with no float parameter, sweeps θi.
     fn drive(&mut self, viewer: &mut Viewer) {
@@ -311,10 +311,15 @@ impl Bench {
         let state = viewer.state();
         let target = state.selected_entry().and_then(|e| {
             let info = bv_core::find(&e.spec.model).ok()?;
-            info.params.iter().find_map(|d| match d.kind {
-                ParamKind::Float(s) => Some((e.id, d.id, s)),
-                _ => None,
-            })
+            // A log-scaled float first (roughness, exponent: what a lecturer
+            // drags), else the first float.
+            let floats = || {
+                info.params.iter().filter_map(|d| match d.kind {
+                    ParamKind::Float(s) => Some((e.id, d.id, s)),
+                    _ => None,
+                })
+            };
+            floats().find(|(_, _, s)| s.log).or_else(|| floats().next())
         });
         let cmd = match target {
             Some((id, param, s)) => {

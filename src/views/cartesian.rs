@@ -149,6 +149,18 @@ impl View for CartesianView {
             .legend(Legend::default().position(Corner::RightTop))
             .x_axis_label(x_label)
             .y_axis_label(y_label)
+            .y_axis_min_width(44.0)
+            // Angles read in steps a lecturer uses: 15°, 45°, 90°.
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+                let span = input.bounds.1 - input.bounds.0;
+                if span > 200.0 {
+                    [10.0, 30.0, 90.0]
+                } else if span > 50.0 {
+                    [5.0, 15.0, 45.0]
+                } else {
+                    [1.0, 5.0, 15.0]
+                }
+            }))
             .allow_scroll(false)
             .include_y(bottom)
             .include_y(top)

@@ -210,6 +210,21 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
+/// `v` rounded to `digits` significant digits.
+pub fn round_significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let e = v.abs().log10().floor() as i32 - (digits - 1);
+    if e >= 0 {
+        let p = 10f64.powi(e);
+        (v / p).round() * p
+    } else {
+        let p = 10f64.powi(-e);
+        (v * p).round() / p
+    }
+}
+
 /// A compact tick label: at most four significant digits, no trailing zeros
 /// (`0.2`, `0.05`, `150`).
 pub fn fmt_tick(v: f64) -> String {
@@ -291,6 +306,8 @@ mod tests {
         assert_eq!(fmt_value(0.0), "0");
         assert_eq!(fmt_value(2.5e-5), "2.500e-5");
         assert_eq!(fmt_tick(0.2), "0.2");
+        assert_eq!(round_significant(0.13314, 2), 0.13);
+        assert_eq!(round_significant(648.7, 2), 650.0);
         assert_eq!(fmt_tick(150.0), "150");
         assert_eq!(fmt_tick(0.05), "0.05");
     }

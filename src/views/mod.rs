@@ -178,7 +178,7 @@ pub fn toolbar_toggle(ui: &mut Ui, on: bool, label: &str, hint: &str) -> bool {
 /// students read fastest), `1e-6` style beyond. (egui's default fonts have no
 /// superscript minus.)
 pub fn decade_label(k: i32) -> String {
-    if (-4..=4).contains(&k) {
+    if (-3..=4).contains(&k) {
         let v = 10f64.powi(k);
         let digits = (-k).max(0) as usize;
         format!("{v:.digits$}")
@@ -222,5 +222,6 @@ mod tests {
         assert_eq!(decade_label(0), "1");
         assert_eq!(decade_label(2), "100");
         assert_eq!(decade_label(-6), "1e-6");
+        assert_eq!(decade_label(-4), "1e-4");
     }
 }

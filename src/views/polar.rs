@@ -157,7 +157,12 @@ impl View for PolarView {
         let response = plot.show(ui, |pui| {
             // Rings with the value they stand for, and spokes every 15°.
             for k in 1..=4 {
-                let r = outer * k as f64 / 4.0;
+                // On the log scale the rings stand at round values of f.
+                let r = if log {
+                    radius(curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2), log)
+                } else {
+                    outer * k as f64 / 4.0
+                };
                 let n = 4 * span as usize;
                 let pts: Vec<[f64; 2]> = (0..=n)
                     .map(|j| {
