@@ -39,6 +39,7 @@ pub struct ViewerArgs {
     pub models: Vec<String>,
 
     /// Start from the defaults: ignore the saved session and do not overwrite it.
+    /// (`--screenshot` and `--bench-frames` never overwrite it either.)
     #[arg(long)]
     pub fresh: bool,
 
@@ -133,7 +134,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         None => [1280.0, 800.0],
     };
     let scripted = args.bench_frames.is_some() || args.screenshot.is_some();
+    // Scripted runs (benchmark, screenshot) start from the saved session unless
+    // `--fresh`, but never overwrite it.
     let persist = !(args.fresh || scripted);
+    let load_saved = !args.fresh;
 
     let mut options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default()
@@ -163,7 +167,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
             if let Some(rs) = &cc.wgpu_render_state {
                 lobe_gpu::install(rs);
             }
-            let saved = if persist {
+            let saved = if load_saved {
                 cc.storage.and_then(|s| s.get_string(STORAGE_KEY))
             } else {
                 None

@@ -28,6 +28,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("1, 2, 3", "maximise view 1, 2, 3 (again to restore)"),
     ("Esc", "restore the layout"),
     ("T", "switch between dark and light themes"),
+    ("Ctrl+Q", "quit (the session is saved)"),
 ];
 
 /// Mouse gestures, as shown in the help overlay.
@@ -220,6 +221,9 @@ impl Viewer {
     }
 
     fn shortcuts(&mut self, ctx: &egui::Context, out: &mut Vec<Command>) {
+        if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
         if ctx.egui_wants_keyboard_input() {
             return;
         }
