@@ -1,10 +1,513 @@
-//! The viewer window (issue 3 builds it).
+//! The viewer window (issue 3): an eframe app on wgpu around [`Viewer`].
+//!
+//! - [`state`]: what is saved between runs; [`command`]: the changes UI code
+//!   asks for, applied after each frame; [`runtime`]: evaluators built from the
+//!   state; [`panel`] and [`params_ui`]: the left panel; [`viewer`]: the whole
+//!   UI; the views live in [`crate::views`].
+//! - [`run`] opens the window. `--bench-frames N` drives a scripted slider
+//!   sweep and prints frame-time percentiles; `--screenshot PATH` saves the
+//!   window once it has drawn and exits.
+
+pub mod command;
+pub mod panel;
+pub mod params_ui;
+pub mod runtime;
+pub mod state;
+pub mod viewer;
+
+pub use command::Command;
+pub use state::AppState;
+pub use viewer::Viewer;
+
+use crate::views::lobe_gpu;
+use anyhow::{Context as _, bail};
+use bv_core::{ParamKind, ParamValue};
+use eframe::egui;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Key of the saved state in eframe's storage.
+pub const STORAGE_KEY: &str = "bv-state";
 
 /// Options of the viewer window, flattened into the top-level command line.
 #[derive(Debug, Clone, Default, clap::Args)]
-pub struct ViewerArgs {}
+pub struct ViewerArgs {
+    /// Open the viewer with these models (catalogue ids; repeat for several)
+    /// instead of the saved list.
+    #[arg(long = "model", value_name = "ID")]
+    pub models: Vec<String>,
 
-/// Opens the viewer window.
-pub fn run(_args: &ViewerArgs) -> anyhow::Result<()> {
-    anyhow::bail!("the viewer window is not part of this build yet")
+    /// Start from the defaults: ignore the saved session and do not overwrite it.
+    /// (`--screenshot` and `--bench-frames` never overwrite it either.)
+    #[arg(long)]
+    pub fresh: bool,
+
+    /// Benchmark: drive a scripted slider sweep of the selected BRDF for N
+    /// frames, print the frame-time p50/p95 and exit.
+    #[arg(long, value_name = "N")]
+    pub bench_frames: Option<usize>,
+
+    /// Save a PNG screenshot of the window to PATH once it has drawn, and exit.
+    #[arg(long, value_name = "PATH")]
+    pub screenshot: Option<PathBuf>,
+
+    /// Window size in points, as WIDTHxHEIGHT (default 1280x800).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+
+    /// Start with the light theme.
+    #[arg(long)]
+    pub light: bool,
+}
+
+/// Parses `WIDTHxHEIGHT`.
+pub fn parse_size(text: &str) -> anyhow::Result<[f32; 2]> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("window size `{text}` is not WIDTHxHEIGHT (e.g. 1280x800)"))?;
+    let w: f32 = w
+        .trim()
+        .parse()
+        .with_context(|| format!("bad width in `{text}`"))?;
+    let h: f32 = h
+        .trim()
+        .parse()
+        .with_context(|| format!("bad height in `{text}`"))?;
+    if !(200.0..=16384.0).contains(&w) || !(150.0..=16384.0).contains(&h) {
+        bail!("window size `{text}` is out of range (200x150 to 16384x16384)");
+    }
+    Ok([w, h])
+}
+
+/// The state the window starts with.
+fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppState> {
+    let mut state = if args.fresh {
+        AppState::first_run()
+    } else {
+        saved
+            .and_then(AppState::from_json_str)
+            .unwrap_or_else(AppState::first_run)
+    };
+    if !args.models.is_empty() {
+        // Check all ids first, so a typo is an error rather than a half list.
+        for m in &args.models {
+            bv_core::find(m)?;
+        }
+        state.brdfs.clear();
+        state.solo = None;
+        for m in &args.models {
+            state.add(bv_core::ModelSpec::new(m)?);
+        }
+        if let Some(first) = state.brdfs.first() {
+            state.selected = Some(first.id);
+        }
+    }
+    if args.light {
+        state.theme = state::Theme::Light;
+    }
+    Ok(state.sanitised())
+}
+
+/// What to tell a user whose machine has no GPU adapter wgpu can use.
+pub fn no_gpu_message(detail: &str) -> String {
+    format!(
+        "no graphics adapter found ({detail}).\n\
+         bv draws with wgpu (Vulkan, Metal, DirectX 12 or OpenGL). On a Linux machine without a GPU driver,\n\
+         install Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, then start bv again:\n\
+         \x20   Debian/Ubuntu: sudo apt install mesa-vulkan-drivers libvulkan1\n\
+         \x20   Fedora:        sudo dnf install mesa-vulkan-drivers vulkan-loader\n\
+         \x20   Arch:          sudo pacman -S vulkan-swrast\n\
+         WGPU_BACKEND=gl tries OpenGL instead. The command-line tools (`bv eval`, `bv check`, …) need no GPU."
+    )
+}
+
+/// Opens the viewer window and returns when it is closed.
+pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
+    // Validate `--model` before a window opens (and before the size, which
+    // the smoke script relies on to probe the catalogue).
+    for m in &args.models {
+        bv_core::find(m)?;
+    }
+    let size = match &args.size {
+        Some(s) => parse_size(s)?,
+        None => [1280.0, 800.0],
+    };
+    let scripted = args.bench_frames.is_some() || args.screenshot.is_some();
+    // Scripted runs (benchmark, screenshot) start from the saved session unless
+    // `--fresh`, but never overwrite it.
+    let persist = !(args.fresh || scripted);
+    let load_saved = !args.fresh;
+
+    let mut options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("bv — BRDF viewer")
+            .with_app_id("bv")
+            .with_inner_size(size)
+            .with_min_inner_size([720.0, 480.0]),
+        persist_window: persist,
+        // egui's dithering costs a noise function per pixel; on a software
+        // renderer that is a noticeable share of the frame, and the UI has no
+        // gradients that band without it.
+        dithering: false,
+        ..Default::default()
+    };
+    if args.bench_frames.is_some() {
+        // Measure what drawing costs, not the display's refresh rate.
+        options.wgpu_options.surface.present_mode = eframe::wgpu::PresentMode::AutoNoVsync;
+    }
+
+    let outcome: Arc<Mutex<Option<anyhow::Result<()>>>> = Arc::new(Mutex::new(None));
+    let args2 = args.clone();
+    let outcome2 = outcome.clone();
+    let result = eframe::run_native(
+        "bv",
+        options,
+        Box::new(move |cc| {
+            if let Some(rs) = &cc.wgpu_render_state {
+                lobe_gpu::install(rs);
+            }
+            let saved = if load_saved {
+                cc.storage.and_then(|s| s.get_string(STORAGE_KEY))
+            } else {
+                None
+            };
+            let state = initial_state(&args2, saved.as_deref())
+                .map_err(|e| -> Box<dyn std::error::Error + Send + Sync> { e.into() })?;
+            let adapter = cc.wgpu_render_state.as_ref().map_or_else(
+                || "no wgpu adapter".to_string(),
+                |rs| {
+                    let i = rs.adapter.get_info();
+                    format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+                },
+            );
+            let mut app = BvApp {
+                viewer: Viewer::new(state),
+                persist,
+                bench: args2.bench_frames.map(|n| Bench::new(n, adapter)),
+                shot: args2.screenshot.clone().map(Shot::new),
+                outcome: outcome2,
+            };
+            if app.bench.is_some() {
+                app.viewer.force_interacting = true;
+                if let Ok(v) = std::env::var("BV_BENCH_MAXIMISE") {
+                    app.viewer.push(Command::Maximise(Some(v)));
+                }
+            }
+            Ok(Box::new(app))
+        }),
+    );
+    match result {
+        Ok(()) => {}
+        Err(eframe::Error::Wgpu(e)) => bail!(no_gpu_message(&e.to_string())),
+        Err(e) => {
+            let text = e.to_string();
+            if text.contains("adapter") {
+                bail!(no_gpu_message(&text));
+            }
+            bail!(
+                "could not open the viewer window: {text}\n\
+                 (no display? set DISPLAY or WAYLAND_DISPLAY, or run under `xvfb-run -a bv …`)"
+            );
+        }
+    }
+    let outcome = outcome.lock().map(|mut o| o.take()).unwrap_or(None);
+    outcome.unwrap_or(Ok(()))
+}
+
+/// The eframe app: the viewer plus the scripted drivers.
+struct BvApp {
+    viewer: Viewer,
+    persist: bool,
+    bench: Option<Bench>,
+    shot: Option<Shot>,
+    outcome: Arc<Mutex<Option<anyhow::Result<()>>>>,
+}
+
+impl BvApp {
+    fn finish(&self, ctx: &egui::Context, r: anyhow::Result<()>) {
+        if let Ok(mut o) = self.outcome.lock() {
+            *o = Some(r);
+        }
+        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+    }
+}
+
+impl eframe::App for BvApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        let t0 = Instant::now();
+        if let Some(b) = &mut self.bench {
+            b.drive(&mut self.viewer);
+        }
+        self.viewer.ui(ui);
+        let ui_time = t0.elapsed();
+        if let Some(b) = &mut self.bench {
+            b.record(t0, ui_time);
+            ctx.request_repaint();
+            if b.done() && !b.reported {
+                b.reported = true;
+                println!("{}", b.report());
+                self.finish(&ctx, Ok(()));
+            }
+        }
+        if let Some(s) = &mut self.shot {
+            ctx.request_repaint();
+            match s.tick(&ctx) {
+                ShotState::Waiting => {}
+                ShotState::Done(r) => {
+                    self.shot = None;
+                    self.finish(&ctx, r);
+                }
+            }
+        }
+    }
+
+    fn save(&mut self, storage: &mut dyn eframe::Storage) {
+        if self.persist {
+            storage.set_string(STORAGE_KEY, self.viewer.state().to_json_string());
+        }
+    }
+
+    fn persist_egui_memory(&self) -> bool {
+        self.persist
+    }
+
+    fn auto_save_interval(&self) -> Duration {
+        Duration::from_secs(10)
+    }
+}
+
+/// The scripted slider sweep of `--bench-frames`.
+struct Bench {
+    frames: usize,
+    warmup: usize,
+    k: usize,
+    last: Option<Instant>,
+    intervals: Vec<f64>,
+    ui_times: Vec<f64>,
+    what: String,
+    adapter: String,
+    reported: bool,
+}
+
+impl Bench {
+    fn new(frames: usize, adapter: String) -> Self {
+        Self {
+            adapter,
+            reported: false,
+            frames: frames.max(1),
+            warmup: 10,
+            k: 0,
+            last: None,
+            intervals: Vec::new(),
+            ui_times: Vec::new(),
+            what: String::new(),
+        }
+    }
+
+    /// Moves a float parameter of the selected BRDF one step along a
+    /// triangle wave across its slider span (log-spaced for log parameters), as
+    /// a user's slider drag would; with no float parameter, sweeps θi.
+    fn drive(&mut self, viewer: &mut Viewer) {
+        let phase = (self.k % 120) as f64 / 60.0;
+        let u = if phase <= 1.0 { phase } else { 2.0 - phase };
+        let state = viewer.state();
+        let target = state.selected_entry().and_then(|e| {
+            let info = bv_core::find(&e.spec.model).ok()?;
+            // A log-scaled float first (roughness, exponent: what a lecturer
+            // drags), else the first float.
+            let floats = || {
+                info.params.iter().filter_map(|d| match d.kind {
+                    ParamKind::Float(s) => Some((e.id, d.id, s)),
+                    _ => None,
+                })
+            };
+            floats().find(|(_, _, s)| s.log).or_else(|| floats().next())
+        });
+        let cmd = match target {
+            Some((id, param, s)) => {
+                let lo = s.slider_min.max(s.min);
+                let hi = s.slider_max.min(s.max);
+                let x = if s.log {
+                    let lo = if lo > 0.0 { lo } else { hi * 1e-3 };
+                    lo * (hi / lo).powf(u)
+                } else {
+                    lo + (hi - lo) * u
+                };
+                self.what = format!(
+                    "{}.{param}",
+                    state
+                        .entry(id)
+                        .map(|e| e.spec.model.as_str())
+                        .unwrap_or("?")
+                );
+                Command::SetParam {
+                    brdf: id,
+                    param: param.to_string(),
+                    value: ParamValue::Float(x),
+                }
+            }
+            None => {
+                self.what = "θi".to_string();
+                Command::SetIncident(state::Incident {
+                    theta_deg: 85.0 * u,
+                    ..state.incident
+                })
+            }
+        };
+        viewer.push(cmd);
+        self.k += 1;
+    }
+
+    fn record(&mut self, start: Instant, ui_time: Duration) {
+        if self.k > self.warmup {
+            if let Some(last) = self.last {
+                self.intervals.push((start - last).as_secs_f64() * 1e3);
+            }
+            self.ui_times.push(ui_time.as_secs_f64() * 1e3);
+        }
+        self.last = Some(start);
+    }
+
+    fn done(&self) -> bool {
+        self.intervals.len() >= self.frames
+    }
+
+    fn report(&self) -> String {
+        format!(
+            "bench: {} frames sweeping {} on {}: frame time p50 {:.2} ms, p95 {:.2} ms ({:.1} fps median); \
+             app ui (incl. mesh rebuild) p50 {:.2} ms, p95 {:.2} ms",
+            self.intervals.len(),
+            self.what,
+            self.adapter,
+            percentile(&self.intervals, 0.5),
+            percentile(&self.intervals, 0.95),
+            1e3 / percentile(&self.intervals, 0.5).max(1e-9),
+            percentile(&self.ui_times, 0.5),
+            percentile(&self.ui_times, 0.95),
+        )
+    }
+}
+
+/// The `q`-quantile (nearest rank) of `xs`; 0 for an empty list.
+pub fn percentile(xs: &[f64], q: f64) -> f64 {
+    if xs.is_empty() {
+        return 0.0;
+    }
+    let mut v: Vec<f64> = xs.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f64::total_cmp);
+    let rank = (q.clamp(0.0, 1.0) * v.len() as f64).ceil() as usize;
+    v[rank.clamp(1, v.len()) - 1]
+}
+
+enum ShotState {
+    Waiting,
+    Done(anyhow::Result<()>),
+}
+
+/// The `--screenshot` driver: waits until the meshes are final, asks eframe
+/// for a screenshot and saves it.
+struct Shot {
+    path: PathBuf,
+    frames: usize,
+    started: Instant,
+    requested: bool,
+    image: Arc<Mutex<Option<Arc<egui::ColorImage>>>>,
+}
+
+impl Shot {
+    /// Frames drawn before the screenshot (layout settles, meshes at full
+    /// resolution).
+    const SETTLE_FRAMES: usize = 6;
+
+    fn new(path: PathBuf) -> Self {
+        Self {
+            path,
+            frames: 0,
+            started: Instant::now(),
+            requested: false,
+            image: Arc::new(Mutex::new(None)),
+        }
+    }
+
+    fn tick(&mut self, ctx: &egui::Context) -> ShotState {
+        self.frames += 1;
+        if !self.requested && self.frames >= Self::SETTLE_FRAMES {
+            let slot = self.image.clone();
+            let ctx2 = ctx.clone();
+            ctx.request_screenshot(move |img| {
+                if let Ok(mut s) = slot.lock() {
+                    *s = Some(img);
+                }
+                ctx2.request_repaint();
+            });
+            self.requested = true;
+        }
+        let img = self.image.lock().ok().and_then(|mut s| s.take());
+        if let Some(img) = img {
+            return ShotState::Done(save_color_image(&img, &self.path));
+        }
+        if self.started.elapsed() > Duration::from_secs(60) {
+            return ShotState::Done(Err(anyhow::anyhow!("no screenshot arrived within 60 s")));
+        }
+        ShotState::Waiting
+    }
+}
+
+/// Saves an egui image as PNG.
+pub fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyhow::Result<()> {
+    let [w, h] = img.size;
+    let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
+    let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
+        .context("screenshot has the wrong size")?;
+    rgba.save(path)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("bv: saved screenshot {} ({w}x{h})", path.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse() {
+        assert_eq!(parse_size("1280x800").unwrap(), [1280.0, 800.0]);
+        assert!(parse_size("12x8").is_err());
+        assert!(parse_size("wide").is_err());
+    }
+
+    #[test]
+    fn percentiles() {
+        let xs: Vec<f64> = (1..=100).map(f64::from).collect();
+        assert_eq!(percentile(&xs, 0.5), 50.0);
+        assert_eq!(percentile(&xs, 0.95), 95.0);
+        assert_eq!(percentile(&[], 0.5), 0.0);
+    }
+
+    #[test]
+    fn models_flag_replaces_the_list() {
+        let args = ViewerArgs {
+            models: vec!["lambert".into(), "lambert".into()],
+            ..Default::default()
+        };
+        let s = initial_state(&args, None).unwrap();
+        assert_eq!(s.brdfs.len(), 2);
+        assert_eq!(s.selected, Some(s.brdfs[0].id));
+        let bad = ViewerArgs {
+            models: vec!["nope".into()],
+            ..Default::default()
+        };
+        assert!(initial_state(&bad, None).is_err());
+    }
+
+    #[test]
+    fn no_gpu_message_says_what_to_install() {
+        let m = no_gpu_message("x");
+        assert!(m.contains("mesa-vulkan-drivers"));
+    }
 }

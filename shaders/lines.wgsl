@@ -1,0 +1,58 @@
+// Screen-space thick lines for the lobe view's axes, rays, spikes and grid
+// (bv, issue 3). Each instance is one segment; six vertices make its quad,
+// widened in pixels after projection so widths do not depend on the zoom.
+
+struct Globals {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    // xy: target size in pixels.
+    viewport: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> g: Globals;
+
+struct Seg {
+    @location(0) a: vec3<f32>,
+    @location(1) b: vec3<f32>,
+    // rgb: sRGB colour, a: opacity.
+    @location(2) color: vec4<f32>,
+    // x: width in pixels.
+    @location(3) width: vec4<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) color: vec4<f32>,
+};
+
+@vertex
+fn vs_main(@builtin(vertex_index) vi: u32, seg: Seg) -> VsOut {
+    let ca = g.view_proj * vec4<f32>(seg.a, 1.0);
+    let cb = g.view_proj * vec4<f32>(seg.b, 1.0);
+    let px = g.viewport.xy;
+    let sa = ca.xy / max(ca.w, 1e-6) * px;
+    let sb = cb.xy / max(cb.w, 1e-6) * px;
+    var d = sb - sa;
+    if (length(d) < 1e-6) {
+        d = vec2<f32>(1.0, 0.0);
+    }
+    d = normalize(d);
+    let nrm = vec2<f32>(-d.y, d.x);
+    // Corner table: (t, side) for two triangles.
+    var t = array<f32, 6>(0.0, 0.0, 1.0, 0.0, 1.0, 1.0);
+    var side = array<f32, 6>(-1.0, 1.0, 1.0, -1.0, 1.0, -1.0);
+    let k = t[vi];
+    var c = mix(ca, cb, k);
+    // Half the width on each side, in NDC units (2 per viewport).
+    let offset = nrm * side[vi] * seg.width.x / px;
+    c = vec4<f32>(c.xy + offset * c.w, c.zw);
+    var o: VsOut;
+    o.clip = c;
+    o.color = seg.color;
+    return o;
+}
+
+@fragment
+fn fs_main(v: VsOut) -> @location(0) vec4<f32> {
+    return v.color;
+}

@@ -1,0 +1,107 @@
+// Lobe surfaces of the 3D view (bv, issue 3).
+//
+// Positions arrive in radius units (1/sr, or ln(1 + f) on the log scale) and
+// are scaled to the view's world units here, so a scale change needs no
+// re-upload. Colours are handled in linear RGB and written gamma-encoded to an
+// Rgba8Unorm target, which egui then copies as it stands (egui-wgpu draws in
+// gamma space to a non-sRGB framebuffer, so this keeps both consistent).
+
+struct Globals {
+    view_proj: mat4x4<f32>,
+    // xyz: eye position.
+    eye: vec4<f32>,
+    // xy: target size in pixels.
+    viewport: vec4<f32>,
+};
+
+struct Style {
+    // rgb: solid colour (sRGB), a: opacity.
+    color: vec4<f32>,
+    // x: 1 = colour by value, y: largest value, z: 1 = log scale, w: world scale.
+    params: vec4<f32>,
+    // x: 1 = unlit (flat colour).
+    extra: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> g: Globals;
+@group(1) @binding(0) var<uniform> s: Style;
+
+const COLORMAP = COLORMAP_TABLE;
+
+struct VsIn {
+    @location(0) pos: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) value: f32,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) value: f32,
+};
+
+@vertex
+fn vs_main(v: VsIn) -> VsOut {
+    var o: VsOut;
+    let world = v.pos * s.params.w;
+    o.clip = g.view_proj * vec4<f32>(world, 1.0);
+    o.world = world;
+    o.normal = v.normal;
+    o.value = v.value;
+    return o;
+}
+
+fn colormap(t_in: f32) -> vec3<f32> {
+    let t = clamp(t_in, 0.0, 1.0) * 10.0;
+    let i = min(u32(floor(t)), 9u);
+    let f = t - f32(i);
+    return mix(COLORMAP[i], COLORMAP[i + 1u], f);
+}
+
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    let lo = c / 12.92;
+    let hi = pow((c + 0.055) / 1.055, vec3<f32>(2.4));
+    return select(hi, lo, c <= vec3<f32>(0.04045));
+}
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    let lo = c * 12.92;
+    let hi = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055;
+    return select(hi, lo, c <= vec3<f32>(0.0031308));
+}
+
+fn base_color(value: f32) -> vec3<f32> {
+    if (s.params.x > 0.5) {
+        let vmax = max(s.params.y, 1e-30);
+        var t = value / vmax;
+        if (s.params.z > 0.5) {
+            t = log(1.0 + max(value, 0.0)) / log(1.0 + vmax);
+        }
+        return colormap(t);
+    }
+    return s.color.rgb;
+}
+
+@fragment
+fn fs_main(v: VsOut) -> @location(0) vec4<f32> {
+    let base = srgb_to_linear(base_color(v.value));
+    if (s.extra.x > 0.5) {
+        return vec4<f32>(linear_to_srgb(base), s.color.a);
+    }
+    let to_eye = normalize(g.eye.xyz - v.world);
+    var n = normalize(v.normal);
+    // Two-sided: the inside of a lobe is seen through its opening.
+    if (dot(n, to_eye) < 0.0) {
+        n = -n;
+    }
+    // A key light above and to the side of the eye, and a softer fill from the
+    // eye itself, so the silhouette and the ridges both read.
+    let key = normalize(to_eye + vec3<f32>(0.0, 0.0, 1.2));
+    let diffuse = max(dot(n, key), 0.0);
+    let fill = max(dot(n, to_eye), 0.0);
+    let h = normalize(key + to_eye);
+    let spec = pow(max(dot(n, h), 0.0), 48.0) * 0.25;
+    let lit = base * (0.28 + 0.55 * diffuse + 0.25 * fill) + vec3<f32>(spec);
+    return vec4<f32>(linear_to_srgb(lit), s.color.a);
+}

@@ -1,0 +1,269 @@
+//! Commands: what UI code asks for. Widgets never change the state while the
+//! frame is being laid out; they push a [`Command`], and the viewer applies the
+//! whole list after the frame (so that one frame sees one consistent state, and
+//! so that tests and scripted drivers can use the same entry point).
+
+use super::state::{AppState, CartesianAxis, Display, Incident, PlotSettings, Theme};
+use bv_core::{ModelSpec, ParamValue};
+
+/// One change to the viewer's state.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// Adds a BRDF of catalogue model `0` with its defaults, and selects it.
+    AddBrdf(String),
+    /// Removes a BRDF.
+    RemoveBrdf(u64),
+    /// Shows a BRDF's parameters in the panel.
+    Select(u64),
+    /// Selects the next (+1) or previous (−1) BRDF of the list.
+    SelectStep(i32),
+    /// Shows or hides a BRDF.
+    SetVisible(u64, bool),
+    /// Shows a BRDF alone, or ends the solo if it is the soloed one.
+    ToggleSolo(u64),
+    /// Sets one parameter (validated against the model's declaration).
+    SetParam {
+        /// BRDF id.
+        brdf: u64,
+        /// Parameter id.
+        param: String,
+        /// New value.
+        value: ParamValue,
+    },
+    /// Resets one parameter to its declared default.
+    ResetParam {
+        /// BRDF id.
+        brdf: u64,
+        /// Parameter id.
+        param: String,
+    },
+    /// Resets every parameter of a BRDF.
+    ResetAllParams(u64),
+    /// Replaces the selected BRDF's model by the next (+1) or previous (−1) model
+    /// of the catalogue, with its defaults (keeps colour and place).
+    StepModel(i32),
+    /// Changes a BRDF's display colour.
+    SetColor(u64, [u8; 3]),
+    /// Moves the light.
+    SetIncident(Incident),
+    /// Sets the shared display options.
+    SetDisplay(Display),
+    /// Toggles the logarithmic scale.
+    ToggleLog,
+    /// Toggles the × cos θo factor.
+    ToggleCosine,
+    /// Toggles the lobe wireframe.
+    ToggleWireframe,
+    /// Sets the lobe camera.
+    SetCamera(super::state::Camera),
+    /// Resets the lobe camera to its default.
+    ResetCamera,
+    /// Sets the plot settings.
+    SetPlots(PlotSettings),
+    /// Sets the Cartesian plot's axis.
+    SetCartesianAxis(CartesianAxis),
+    /// Maximises the view with this registry id, or restores the layout.
+    Maximise(Option<String>),
+    /// Maximises the view, or restores the layout if it is the maximised one.
+    ToggleMaximise(String),
+    /// Switches the colour theme.
+    SetTheme(Theme),
+    /// Opens or closes the keyboard help.
+    ToggleHelp,
+}
+
+/// What applying a command did, beyond changing the state.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Applied {
+    /// A message for the status line (errors and refusals).
+    pub message: Option<String>,
+    /// The help overlay should toggle.
+    pub toggle_help: bool,
+}
+
+impl Command {
+    /// Applies the command to `state`.
+    pub fn apply(self, state: &mut AppState) -> Applied {
+        let mut out = Applied::default();
+        match self {
+            Command::AddBrdf(model) => match ModelSpec::new(&model) {
+                Ok(spec) => {
+                    state.add(spec);
+                }
+                Err(e) => out.message = Some(e.to_string()),
+            },
+            Command::RemoveBrdf(id) => {
+                let pos = state.brdfs.iter().position(|b| b.id == id);
+                if let Some(i) = pos {
+                    state.brdfs.remove(i);
+                    if state.selected == Some(id) {
+                        let j = i.min(state.brdfs.len().saturating_sub(1));
+                        state.selected = state.brdfs.get(j).map(|b| b.id);
+                    }
+                    if state.solo == Some(id) {
+                        state.solo = None;
+                    }
+                }
+            }
+            Command::Select(id) => {
+                if state.entry(id).is_some() {
+                    state.selected = Some(id);
+                }
+            }
+            Command::SelectStep(step) => {
+                let n = state.brdfs.len() as i64;
+                if n > 0 {
+                    let cur = state
+                        .selected
+                        .and_then(|id| state.brdfs.iter().position(|b| b.id == id))
+                        .unwrap_or(0) as i64;
+                    let next = (cur + step as i64).rem_euclid(n) as usize;
+                    state.selected = Some(state.brdfs[next].id);
+                }
+            }
+            Command::SetVisible(id, v) => {
+                if let Some(e) = state.entry_mut(id) {
+                    e.visible = v;
+                }
+            }
+            Command::ToggleSolo(id) => {
+                state.solo = if state.solo == Some(id) {
+                    None
+                } else if state.entry(id).is_some() {
+                    Some(id)
+                } else {
+                    state.solo
+                };
+            }
+            Command::SetParam { brdf, param, value } => {
+                if let Some(e) = state.entry_mut(brdf) {
+                    // Validate on a copy: a refused value leaves the spec untouched.
+                    let mut spec = e.spec.clone();
+                    match spec.set(&param, value) {
+                        Ok(()) => e.spec = spec,
+                        Err(err) => out.message = Some(err.to_string()),
+                    }
+                }
+            }
+            Command::ResetParam { brdf, param } => {
+                if let Some(e) = state.entry_mut(brdf)
+                    && let Ok(info) = bv_core::find(&e.spec.model)
+                    && let Ok(decl) = info.param(&param)
+                {
+                    e.spec.params.0.insert(param, decl.default_value());
+                }
+            }
+            Command::ResetAllParams(id) => {
+                if let Some(e) = state.entry_mut(id)
+                    && let Ok(spec) = ModelSpec::new(&e.spec.model)
+                {
+                    e.spec = spec;
+                }
+            }
+            Command::StepModel(step) => {
+                let cat = bv_core::catalogue();
+                if let Some(id) = state.selected
+                    && let Some(e) = state.entry_mut(id)
+                    && !cat.is_empty()
+                {
+                    let cur = cat.iter().position(|m| m.id == e.spec.model).unwrap_or(0) as i64;
+                    let next = (cur + step as i64).rem_euclid(cat.len() as i64) as usize;
+                    match ModelSpec::new(cat[next].id) {
+                        Ok(spec) => e.spec = spec,
+                        Err(err) => out.message = Some(err.to_string()),
+                    }
+                }
+            }
+            Command::SetColor(id, c) => {
+                if let Some(e) = state.entry_mut(id) {
+                    e.color = c;
+                }
+            }
+            Command::SetIncident(i) => state.incident = i.clamped(),
+            Command::SetDisplay(d) => state.display = d,
+            Command::ToggleLog => state.display.log = !state.display.log,
+            Command::ToggleCosine => state.display.cosine = !state.display.cosine,
+            Command::ToggleWireframe => state.display.wireframe = !state.display.wireframe,
+            Command::SetCamera(c) => state.camera = c.clamped(),
+            Command::ResetCamera => {
+                state.camera = super::state::Camera {
+                    fixed_scale: state.camera.fixed_scale,
+                    ..Default::default()
+                }
+            }
+            Command::SetPlots(p) => state.plots = p,
+            Command::SetCartesianAxis(a) => state.plots.axis = a,
+            Command::Maximise(v) => state.maximised = v,
+            Command::ToggleMaximise(v) => {
+                state.maximised = if state.maximised.as_deref() == Some(v.as_str()) {
+                    None
+                } else {
+                    Some(v)
+                };
+            }
+            Command::SetTheme(t) => state.theme = t,
+            Command::ToggleHelp => out.toggle_help = true,
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn add_select_remove() {
+        let mut s = AppState::default();
+        Command::AddBrdf("lambert".into()).apply(&mut s);
+        Command::AddBrdf("lambert".into()).apply(&mut s);
+        let (a, b) = (s.brdfs[0].id, s.brdfs[1].id);
+        assert_eq!(s.selected, Some(b));
+        Command::RemoveBrdf(b).apply(&mut s);
+        assert_eq!(s.selected, Some(a));
+        let r = Command::AddBrdf("nope".into()).apply(&mut s);
+        assert!(r.message.unwrap().contains("nope"));
+        assert_eq!(s.brdfs.len(), 1);
+    }
+
+    #[test]
+    fn refused_values_leave_the_spec_alone() {
+        let mut s = AppState::default();
+        Command::AddBrdf("lambert".into()).apply(&mut s);
+        let id = s.brdfs[0].id;
+        let before = s.brdfs[0].spec.clone();
+        let r = Command::SetParam {
+            brdf: id,
+            param: "albedo".into(),
+            value: ParamValue::Color([2.0, 0.0, 0.0]),
+        }
+        .apply(&mut s);
+        assert!(r.message.unwrap().contains("albedo"));
+        assert_eq!(s.brdfs[0].spec, before);
+        Command::SetParam {
+            brdf: id,
+            param: "albedo".into(),
+            value: ParamValue::Color([0.1, 0.2, 0.3]),
+        }
+        .apply(&mut s);
+        assert_eq!(
+            s.brdfs[0].spec.params.color("albedo").unwrap(),
+            glam::DVec3::new(0.1, 0.2, 0.3)
+        );
+        Command::ResetParam {
+            brdf: id,
+            param: "albedo".into(),
+        }
+        .apply(&mut s);
+        assert_eq!(s.brdfs[0].spec, before);
+    }
+
+    #[test]
+    fn maximise_toggles() {
+        let mut s = AppState::default();
+        Command::ToggleMaximise("lobe".into()).apply(&mut s);
+        assert_eq!(s.maximised.as_deref(), Some("lobe"));
+        Command::ToggleMaximise("lobe".into()).apply(&mut s);
+        assert_eq!(s.maximised, None);
+    }
+}

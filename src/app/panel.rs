@@ -1,0 +1,315 @@
+//! The left panel: the list of loaded BRDFs (colour, visible, solo, remove,
+//! add), the light direction (sliders and a hemisphere to drag on) and the
+//! selected BRDF's parameters, generated from its model's declaration.
+
+use super::command::Command;
+use super::params_ui::{self, Edit};
+use super::runtime::Runtime;
+use super::state::{AppState, BrdfEntry, Incident};
+use crate::views;
+use eframe::egui::{
+    self, Align2, Color32, FontId, RichText, Role, Sense, Stroke, Ui, Vec2, WidgetInfo,
+};
+
+/// The name shown for an entry: the model's name, numbered when the same
+/// model is loaded more than once ("Lambert", "Lambert 2").
+pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
+    let name = bv_core::find(&e.spec.model).map(|m| m.name).unwrap_or("?");
+    let same: Vec<u64> = state
+        .brdfs
+        .iter()
+        .filter(|b| b.spec.model == e.spec.model)
+        .map(|b| b.id)
+        .collect();
+    match same.iter().position(|&id| id == e.id) {
+        Some(0) | None => name.to_string(),
+        Some(k) => format!("{name} {}", k + 1),
+    }
+}
+
+fn labelled(r: &egui::Response, kind: Role, label: String) {
+    r.widget_info(move || WidgetInfo::labeled(kind, true, &label));
+}
+
+/// The list of loaded BRDFs and the "Add BRDF" menu.
+pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        ui.heading("BRDFs");
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            ui.menu_button("Add BRDF", |ui| {
+                for m in bv_core::catalogue() {
+                    let r = ui.button(m.name).on_hover_text(m.summary);
+                    labelled(&r, Role::Button, format!("Add {}", m.name));
+                    if r.clicked() {
+                        out.push(Command::AddBrdf(m.id.to_string()));
+                        ui.close();
+                    }
+                }
+            })
+            .response
+            .on_hover_text("Add any model of the catalogue");
+        });
+    });
+    if state.brdfs.is_empty() {
+        ui.weak("Nothing loaded: use “Add BRDF”.");
+    }
+    for e in &state.brdfs {
+        let name = display_name(state, e);
+        let selected = state.selected == Some(e.id);
+        ui.horizontal(|ui| {
+            let mut c = e.color;
+            let r = egui::color_picker::color_edit_button_srgb(ui, &mut c);
+            labelled(&r, Role::ColorWell, format!("Colour of {name}"));
+            if c != e.color {
+                out.push(Command::SetColor(e.id, c));
+            }
+            let mut v = e.visible;
+            let r = ui.checkbox(&mut v, "").on_hover_text("Show or hide");
+            let label = format!("Show {name}");
+            r.widget_info(|| WidgetInfo::selected(Role::CheckBox, true, v, &label));
+            if v != e.visible {
+                out.push(Command::SetVisible(e.id, v));
+            }
+            let mut text = RichText::new(&name);
+            if !state.is_drawn(e) {
+                text = text.weak();
+            }
+            if runtime.get(e.id).is_some_and(|b| b.error.is_some()) {
+                text = text.color(ui.visuals().error_fg_color);
+            }
+            if ui
+                .selectable_label(selected, text)
+                .on_hover_text("Show its parameters")
+                .clicked()
+            {
+                out.push(Command::Select(e.id));
+            }
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                let r = ui
+                    .small_button("remove")
+                    .on_hover_text("Remove from the list");
+                labelled(&r, Role::Button, format!("Remove {name}"));
+                if r.clicked() {
+                    out.push(Command::RemoveBrdf(e.id));
+                }
+                let solo = state.solo == Some(e.id);
+                let r = ui
+                    .selectable_label(solo, "solo")
+                    .on_hover_text("Show only this one");
+                labelled(&r, Role::Button, format!("Solo {name}"));
+                if r.clicked() {
+                    out.push(Command::ToggleSolo(e.id));
+                }
+            });
+        });
+    }
+}
+
+/// θi and φi sliders and the hemisphere widget.
+pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
+    ui.heading("Light");
+    let inc = state.incident;
+    let mut t = inc.theta_deg;
+    let mut p = inc.phi_deg;
+    ui.horizontal(|ui| {
+        ui.vertical(|ui| {
+            ui.spacing_mut().slider_width = 110.0;
+            // Display one decimal without rounding the value itself.
+            let one_decimal = |v: f64, _: std::ops::RangeInclusive<usize>| format!("{v:.1}");
+            let r = ui.add(
+                egui::Slider::new(&mut t, 0.0..=Incident::MAX_THETA_DEG)
+                    .text("θi")
+                    .suffix("°")
+                    .custom_formatter(one_decimal),
+            );
+            if r.double_clicked() {
+                t = Incident::default().theta_deg;
+            }
+            r.on_hover_text("Polar angle of the light from the normal");
+            let r = ui.add(
+                egui::Slider::new(&mut p, -180.0..=180.0)
+                    .text("φi")
+                    .suffix("°")
+                    .custom_formatter(one_decimal),
+            );
+            if r.double_clicked() {
+                p = Incident::default().phi_deg;
+            }
+            r.on_hover_text("Azimuth of the light from the tangent t towards b");
+            ui.weak("or drag the light on the disc");
+        });
+        hemisphere_widget(ui, inc, state.camera.yaw_deg, out);
+    });
+    if t != inc.theta_deg || p != inc.phi_deg {
+        out.push(Command::SetIncident(Incident {
+            theta_deg: t,
+            phi_deg: p,
+        }));
+    }
+}
+
+/// Size of the hemisphere widget.
+pub const HEMISPHERE_SIZE: f32 = 116.0;
+
+/// The hemisphere seen from above (azimuthal equidistant: the distance from
+/// the centre is θ), with the light as a dot; drag or click to move it. It is
+/// turned like the lobe view's camera (`yaw_deg`), so that left and right on
+/// the disc are left and right in the 3D view.
+pub fn hemisphere_widget(
+    ui: &mut Ui,
+    inc: Incident,
+    yaw_deg: f32,
+    out: &mut Vec<Command>,
+) -> egui::Response {
+    let (rect, response) =
+        ui.allocate_exact_size(Vec2::splat(HEMISPHERE_SIZE), Sense::click_and_drag());
+    labelled(&response, Role::Slider, "Light direction".to_string());
+    let dark = ui.visuals().dark_mode;
+    let c = rect.center();
+    let radius = rect.width() * 0.5 - 12.0;
+    // Screen right is the camera's right vector on the ground, screen down
+    // points towards the eye (see `views::camera`).
+    let yaw = yaw_deg.to_radians();
+    let right = Vec2::new(-yaw.sin(), yaw.cos());
+    let toward = Vec2::new(yaw.cos(), yaw.sin());
+    let ground_to_screen = |g: Vec2| Vec2::new(g.dot(right), g.dot(toward));
+    let to_screen = |theta_deg: f64, phi_deg: f64| {
+        let r = (theta_deg / 90.0) as f32 * radius;
+        let a = phi_deg.to_radians() as f32;
+        c + ground_to_screen(Vec2::new(r * a.cos(), r * a.sin()))
+    };
+    if (response.dragged() || response.clicked())
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        let d = pos - c;
+        let g = right * d.x + toward * d.y;
+        let theta = (d.length() / radius * 90.0) as f64;
+        let phi = g.y.atan2(g.x).to_degrees() as f64;
+        let new = Incident {
+            theta_deg: theta,
+            phi_deg: phi,
+        }
+        .clamped();
+        if new != inc {
+            out.push(Command::SetIncident(new));
+        }
+    }
+    let painter = ui.painter_at(rect.expand(2.0));
+    let visuals = ui.visuals();
+    let grid = views::grid_color(dark);
+    let text = visuals.text_color();
+    painter.circle_filled(c, radius, visuals.extreme_bg_color);
+    for deg in [30.0f32, 60.0] {
+        painter.circle_stroke(c, radius * deg / 90.0, Stroke::new(1.0, grid));
+    }
+    painter.circle_stroke(
+        c,
+        radius,
+        Stroke::new(1.5, visuals.widgets.noninteractive.fg_stroke.color),
+    );
+    let tx = ground_to_screen(Vec2::X);
+    let by = ground_to_screen(Vec2::Y);
+    painter.line_segment([c - tx * radius, c + tx * radius], Stroke::new(1.0, grid));
+    painter.line_segment([c - by * radius, c + by * radius], Stroke::new(1.0, grid));
+    let font = FontId::proportional(11.0);
+    painter.text(
+        c + tx * (radius + 7.0),
+        Align2::CENTER_CENTER,
+        "t",
+        font.clone(),
+        text,
+    );
+    painter.text(
+        c + by * (radius + 7.0),
+        Align2::CENTER_CENTER,
+        "b",
+        font,
+        text,
+    );
+    let light = views::light_color(dark);
+    let p = to_screen(inc.theta_deg, inc.phi_deg);
+    // The mirror direction is opposite in azimuth.
+    let m = to_screen(inc.theta_deg, inc.phi_deg + 180.0);
+    painter.circle_stroke(m, 4.0, Stroke::new(1.5, views::mirror_color(dark)));
+    painter.line_segment([c, p], Stroke::new(1.5, light));
+    painter.circle_filled(
+        p,
+        if response.hovered() || response.dragged() {
+            7.0
+        } else {
+            6.0
+        },
+        light,
+    );
+    painter.circle_stroke(p, 6.0, Stroke::new(1.0, Color32::BLACK.gamma_multiply(0.6)));
+    response.on_hover_text("Drag to move the light: the centre is the normal, the rim the horizon")
+}
+
+/// The selected BRDF's description and parameter widgets.
+pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec<Command>) {
+    let Some(e) = state.selected_entry() else {
+        ui.weak("Select a BRDF to edit its parameters.");
+        return;
+    };
+    let Ok(info) = bv_core::find(&e.spec.model) else {
+        ui.colored_label(
+            ui.visuals().error_fg_color,
+            format!("unknown model `{}`", e.spec.model),
+        );
+        return;
+    };
+    let name = display_name(state, e);
+    ui.horizontal(|ui| {
+        let [r, g, b] = e.color;
+        let (swatch, _) = ui.allocate_exact_size(Vec2::splat(14.0), Sense::hover());
+        ui.painter()
+            .rect_filled(swatch, 2.0, Color32::from_rgb(r, g, b));
+        ui.heading(&name);
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+            let r = ui
+                .small_button("reset all")
+                .on_hover_text("All parameters to their defaults");
+            labelled(&r, Role::Button, "Reset all parameters".to_string());
+            if r.clicked() {
+                out.push(Command::ResetAllParams(e.id));
+            }
+        });
+    });
+    ui.label(RichText::new(info.summary).small());
+    ui.label(RichText::new(info.citation).small().weak());
+    if let Some(err) = runtime.get(e.id).and_then(|b| b.error.as_ref()) {
+        ui.colored_label(ui.visuals().error_fg_color, err);
+    }
+    ui.add_space(4.0);
+    let edits = params_ui::params_ui(
+        ui,
+        egui::Id::unique(("bv params", e.id)),
+        info.params,
+        &e.spec.params,
+    );
+    for edit in edits {
+        out.push(match edit {
+            Edit::Set(param, value) => Command::SetParam {
+                brdf: e.id,
+                param,
+                value,
+            },
+            Edit::Reset(param) => Command::ResetParam { brdf: e.id, param },
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bv_core::ModelSpec;
+
+    #[test]
+    fn duplicate_models_are_numbered() {
+        let mut s = AppState::default();
+        let a = s.add(ModelSpec::new("lambert").unwrap());
+        let b = s.add(ModelSpec::new("lambert").unwrap());
+        assert_eq!(display_name(&s, s.entry(a).unwrap()), "Lambert");
+        assert_eq!(display_name(&s, s.entry(b).unwrap()), "Lambert 2");
+    }
+}

@@ -1,0 +1,474 @@
+//! The viewer's state: everything that is saved between runs (loaded BRDFs and
+//! their parameters, incident direction, camera, display options, layout, theme),
+//! kept apart from GPU resources and caches.
+//!
+//! It is serialised to JSON (not eframe's RON) because a BRDF's parameters are
+//! stored in their `ModelSpec::to_json` form, the same form scene files and
+//! `bv eval` use; a saved BRDF whose model is gone or whose values no longer
+//! validate is dropped with a note instead of failing the whole session.
+
+use bv_core::ModelSpec;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde_json::Value;
+
+/// Current layout of the saved state; bump when a field changes meaning.
+pub const STATE_VERSION: u32 = 1;
+
+/// Distinct colours for overlaid BRDFs (Tableau 10, reordered so that the first
+/// few differ most and read on both dark and light backgrounds).
+pub const PALETTE: [[u8; 3]; 10] = [
+    [78, 151, 234],  // blue
+    [242, 142, 43],  // orange
+    [89, 185, 90],   // green
+    [225, 87, 89],   // red
+    [176, 122, 211], // purple
+    [237, 201, 72],  // yellow
+    [118, 183, 178], // teal
+    [255, 157, 167], // pink
+    [176, 135, 104], // brown
+    [186, 176, 172], // grey
+];
+
+/// One loaded BRDF.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BrdfEntry {
+    /// Stable id within this session's list (never reused while the app runs).
+    pub id: u64,
+    /// Model and parameters.
+    #[serde(with = "spec_json")]
+    pub spec: ModelSpec,
+    /// Display colour (sRGB).
+    pub color: [u8; 3],
+    /// Whether it is drawn.
+    pub visible: bool,
+}
+
+/// The incident (light) direction, in degrees because that is what the sliders
+/// show and what a lecturer quotes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Incident {
+    /// Polar angle from the normal, 0..90°.
+    pub theta_deg: f64,
+    /// Azimuth from the tangent towards the bitangent, −180..180°.
+    pub phi_deg: f64,
+}
+
+impl Default for Incident {
+    fn default() -> Self {
+        Self {
+            theta_deg: 45.0,
+            phi_deg: 0.0,
+        }
+    }
+}
+
+impl Incident {
+    /// Largest polar angle the sliders and drags allow: the horizon itself is
+    /// excluded because every reflection model is 0 there.
+    pub const MAX_THETA_DEG: f64 = 89.5;
+
+    /// The unit direction towards the light (SPEC §1 frame).
+    pub fn direction(&self) -> glam::DVec3 {
+        bv_core::frame::from_spherical(self.theta_deg.to_radians(), self.phi_deg.to_radians())
+    }
+
+    /// The same direction with θ clamped to the slider range and φ wrapped.
+    pub fn clamped(self) -> Self {
+        let theta = if self.theta_deg.is_finite() {
+            self.theta_deg.clamp(0.0, Self::MAX_THETA_DEG)
+        } else {
+            0.0
+        };
+        let phi = if self.phi_deg.is_finite() {
+            bv_core::frame::wrap_phi(self.phi_deg.to_radians()).to_degrees()
+        } else {
+            0.0
+        };
+        Self {
+            theta_deg: theta,
+            phi_deg: phi,
+        }
+    }
+
+    /// The incident direction pointing at `w` (any vector with a positive z
+    /// after clamping; the horizon is clamped to [`Self::MAX_THETA_DEG`]).
+    pub fn from_direction(w: glam::DVec3) -> Self {
+        let (theta, phi) = bv_core::frame::to_spherical(w.normalize_or(glam::DVec3::Z));
+        Self {
+            theta_deg: theta.to_degrees(),
+            phi_deg: phi.to_degrees(),
+        }
+        .clamped()
+    }
+}
+
+/// Options shared by every view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Display {
+    /// Logarithmic radius / axis.
+    pub log: bool,
+    /// Show `f · cos θo` instead of `f`.
+    pub cosine: bool,
+    /// Lobe view: draw the mesh's grid lines instead of a filled surface.
+    pub wireframe: bool,
+    /// Lobe view: colour the selected lobe by value (otherwise by its own colour).
+    pub color_by_value: bool,
+    /// Lobe view: scale the scene so that the largest lobe fills the unit
+    /// hemisphere; otherwise keep the last scale while parameters change.
+    pub auto_scale: bool,
+}
+
+impl Default for Display {
+    fn default() -> Self {
+        Self {
+            log: false,
+            cosine: false,
+            wireframe: false,
+            color_by_value: true,
+            auto_scale: true,
+        }
+    }
+}
+
+/// The orbit camera of the lobe view.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Camera {
+    /// Azimuth of the eye around +z, degrees (90 puts the eye on +y, so that
+    /// light at φi = 0 comes from the left and its mirror lobe leans right,
+    /// like the polar plot).
+    pub yaw_deg: f32,
+    /// Elevation of the eye above the ground plane, degrees.
+    pub pitch_deg: f32,
+    /// Distance from the target in units of the unit hemisphere.
+    pub distance: f32,
+    /// World units per radius unit when auto-scale is off (1/sr per unit).
+    pub fixed_scale: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Self {
+            yaw_deg: 90.0,
+            pitch_deg: 20.0,
+            distance: 4.9,
+            fixed_scale: 1.0,
+        }
+    }
+}
+
+impl Camera {
+    /// Closest and farthest eye distances.
+    pub const DISTANCE_RANGE: (f32, f32) = (1.5, 30.0);
+    /// Elevation limits (a little below the ground to look at transmission).
+    pub const PITCH_RANGE: (f32, f32) = (-85.0, 89.0);
+
+    /// The same camera with its angles and distance in range.
+    pub fn clamped(mut self) -> Self {
+        let ok = |x: f32, d: f32| if x.is_finite() { x } else { d };
+        let d = Self::default();
+        self.yaw_deg = ok(self.yaw_deg, d.yaw_deg).rem_euclid(360.0);
+        self.pitch_deg =
+            ok(self.pitch_deg, d.pitch_deg).clamp(Self::PITCH_RANGE.0, Self::PITCH_RANGE.1);
+        self.distance =
+            ok(self.distance, d.distance).clamp(Self::DISTANCE_RANGE.0, Self::DISTANCE_RANGE.1);
+        self.fixed_scale = if self.fixed_scale.is_finite() && self.fixed_scale > 0.0 {
+            self.fixed_scale
+        } else {
+            1.0
+        };
+        self
+    }
+}
+
+/// What the Cartesian plot's horizontal axis is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum CartesianAxis {
+    /// θo in the plane of incidence, signed (negative on the light's side).
+    #[default]
+    ThetaO,
+    /// θh at a fixed θd (φd = 90°, φh = 0).
+    ThetaH,
+    /// θd at a fixed θh (φd = 90°, φh = 0).
+    ThetaD,
+}
+
+/// Plot settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct PlotSettings {
+    /// The Cartesian plot's horizontal axis.
+    pub axis: CartesianAxis,
+    /// The fixed θd (for θh curves), degrees.
+    pub fixed_theta_d_deg: f64,
+    /// The fixed θh (for θd curves), degrees.
+    pub fixed_theta_h_deg: f64,
+}
+
+impl Default for PlotSettings {
+    fn default() -> Self {
+        Self {
+            axis: CartesianAxis::ThetaO,
+            fixed_theta_d_deg: 30.0,
+            fixed_theta_h_deg: 0.0,
+        }
+    }
+}
+
+/// Colour theme.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Theme {
+    /// Light text on dark grey.
+    #[default]
+    Dark,
+    /// Dark text on white (projectors in bright rooms).
+    Light,
+}
+
+/// Everything that persists between runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AppState {
+    /// Layout version of this record.
+    pub version: u32,
+    /// Loaded BRDFs, in list order.
+    #[serde(deserialize_with = "lenient_entries")]
+    pub brdfs: Vec<BrdfEntry>,
+    /// Id of the BRDF whose parameters the panel shows.
+    pub selected: Option<u64>,
+    /// Id of the BRDF shown alone, if any.
+    pub solo: Option<u64>,
+    /// Next id to hand out.
+    pub next_id: u64,
+    /// Light direction.
+    pub incident: Incident,
+    /// Options shared by all views.
+    pub display: Display,
+    /// The lobe view's camera.
+    pub camera: Camera,
+    /// Plot settings.
+    pub plots: PlotSettings,
+    /// Id of the maximised view (see `views::REGISTRY`), if any.
+    pub maximised: Option<String>,
+    /// Colour theme.
+    pub theme: Theme,
+}
+
+impl Default for AppState {
+    fn default() -> Self {
+        Self {
+            version: STATE_VERSION,
+            brdfs: Vec::new(),
+            selected: None,
+            solo: None,
+            next_id: 1,
+            incident: Incident::default(),
+            display: Display::default(),
+            camera: Camera::default(),
+            plots: PlotSettings::default(),
+            maximised: None,
+            theme: Theme::default(),
+        }
+    }
+}
+
+impl AppState {
+    /// The state a first run starts with: the first model of the catalogue
+    /// (with its defaults) lit from 45°.
+    pub fn first_run() -> Self {
+        let mut s = Self::default();
+        if let Some(info) = bv_core::catalogue().first()
+            && let Ok(spec) = ModelSpec::new(info.id)
+        {
+            s.add(spec);
+        }
+        s
+    }
+
+    /// Adds a BRDF with the first palette colour not in use; selects it and
+    /// returns its id.
+    pub fn add(&mut self, spec: ModelSpec) -> u64 {
+        let id = self.next_id.max(1);
+        self.next_id = id + 1;
+        let color = PALETTE
+            .iter()
+            .copied()
+            .find(|c| !self.brdfs.iter().any(|b| b.color == *c))
+            .unwrap_or(PALETTE[self.brdfs.len() % PALETTE.len()]);
+        self.brdfs.push(BrdfEntry {
+            id,
+            spec,
+            color,
+            visible: true,
+        });
+        self.selected = Some(id);
+        id
+    }
+
+    /// The entry with id `id`.
+    pub fn entry(&self, id: u64) -> Option<&BrdfEntry> {
+        self.brdfs.iter().find(|b| b.id == id)
+    }
+
+    /// The entry with id `id`, mutably.
+    pub fn entry_mut(&mut self, id: u64) -> Option<&mut BrdfEntry> {
+        self.brdfs.iter_mut().find(|b| b.id == id)
+    }
+
+    /// The selected entry, if any.
+    pub fn selected_entry(&self) -> Option<&BrdfEntry> {
+        self.selected.and_then(|id| self.entry(id))
+    }
+
+    /// Whether entry `e` is drawn (its own toggle, and the solo if one is set).
+    pub fn is_drawn(&self, e: &BrdfEntry) -> bool {
+        match self.solo {
+            Some(s) if self.entry(s).is_some() => s == e.id,
+            _ => e.visible,
+        }
+    }
+
+    /// Repairs whatever a hand-edited or old saved state may hold: ids unique,
+    /// selection and solo pointing at existing entries, ranges clamped.
+    pub fn sanitised(mut self) -> Self {
+        let mut seen = std::collections::HashSet::new();
+        self.brdfs.retain(|b| seen.insert(b.id));
+        let max_id = self.brdfs.iter().map(|b| b.id).max().unwrap_or(0);
+        self.next_id = self.next_id.max(max_id + 1);
+        if self.selected.is_none_or(|id| self.entry(id).is_none()) {
+            self.selected = self.brdfs.first().map(|b| b.id);
+        }
+        if self.solo.is_some_and(|id| self.entry(id).is_none()) {
+            self.solo = None;
+        }
+        self.incident = self.incident.clamped();
+        self.camera = self.camera.clamped();
+        let p = &mut self.plots;
+        p.fixed_theta_d_deg = clamp_deg(p.fixed_theta_d_deg, 0.0, 89.5);
+        p.fixed_theta_h_deg = clamp_deg(p.fixed_theta_h_deg, 0.0, 89.5);
+        self.version = STATE_VERSION;
+        self
+    }
+
+    /// The state as a JSON string (what is stored).
+    pub fn to_json_string(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// Parses a stored state; `None` when it is not a state at all.
+    pub fn from_json_str(text: &str) -> Option<Self> {
+        serde_json::from_str::<Self>(text).ok().map(Self::sanitised)
+    }
+}
+
+fn clamp_deg(x: f64, lo: f64, hi: f64) -> f64 {
+    if x.is_finite() { x.clamp(lo, hi) } else { lo }
+}
+
+/// Serialises a spec as `{"model": …, "params": {…}}`.
+mod spec_json {
+    use super::*;
+
+    pub fn serialize<S: Serializer>(spec: &ModelSpec, s: S) -> Result<S::Ok, S::Error> {
+        spec.to_json().serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ModelSpec, D::Error> {
+        let v = Value::deserialize(d)?;
+        spec_from_json(&v).map_err(serde::de::Error::custom)
+    }
+}
+
+/// A spec from its `{"model", "params"}` JSON form.
+pub fn spec_from_json(v: &Value) -> Result<ModelSpec, String> {
+    let model = v
+        .get("model")
+        .and_then(Value::as_str)
+        .ok_or_else(|| "no `model` id".to_string())?;
+    ModelSpec::from_json(model, v.get("params").unwrap_or(&Value::Null)).map_err(|e| e.to_string())
+}
+
+/// Keeps the saved entries that still parse; reports the others on stderr.
+fn lenient_entries<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<BrdfEntry>, D::Error> {
+    let items = Vec::<Value>::deserialize(d)?;
+    Ok(items
+        .into_iter()
+        .filter_map(|v| match serde_json::from_value::<BrdfEntry>(v) {
+            Ok(e) => Some(e),
+            Err(e) => {
+                eprintln!("bv: dropping a saved BRDF that no longer loads: {e}");
+                None
+            }
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn state_round_trips_through_json() {
+        let mut s = AppState::first_run();
+        s.incident.theta_deg = 12.5;
+        s.camera.yaw_deg = 33.0;
+        s.display.log = true;
+        let text = s.to_json_string();
+        let back = AppState::from_json_str(&text).unwrap();
+        assert_eq!(back, s);
+    }
+
+    #[test]
+    fn bad_entries_are_dropped_and_ids_repaired() {
+        let text = r#"{"brdfs": [
+            {"id": 3, "spec": {"model": "no-such-model", "params": {}}, "color": [1,2,3], "visible": true},
+            {"id": 4, "spec": {"model": "lambert", "params": {"albedo": 0.25}}, "color": [1,2,3], "visible": true},
+            {"id": 4, "spec": {"model": "lambert", "params": {}}, "color": [1,2,3], "visible": true}
+        ], "selected": 99, "solo": 3, "next_id": 0, "incident": {"theta_deg": 120, "phi_deg": 270}}"#;
+        let s = AppState::from_json_str(text).unwrap();
+        assert_eq!(s.brdfs.len(), 1);
+        assert_eq!(s.brdfs[0].id, 4);
+        assert_eq!(s.selected, Some(4));
+        assert_eq!(s.solo, None);
+        assert_eq!(s.next_id, 5);
+        assert_eq!(s.incident.theta_deg, Incident::MAX_THETA_DEG);
+        assert!((s.incident.phi_deg - (-90.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn colours_are_distinct_until_the_palette_runs_out() {
+        let mut s = AppState::default();
+        for _ in 0..PALETTE.len() {
+            s.add(ModelSpec::new("lambert").unwrap());
+        }
+        let mut colours: Vec<_> = s.brdfs.iter().map(|b| b.color).collect();
+        colours.sort();
+        colours.dedup();
+        assert_eq!(colours.len(), PALETTE.len());
+    }
+
+    #[test]
+    fn solo_hides_the_others() {
+        let mut s = AppState::default();
+        let a = s.add(ModelSpec::new("lambert").unwrap());
+        let b = s.add(ModelSpec::new("lambert").unwrap());
+        s.solo = Some(b);
+        assert!(!s.is_drawn(s.entry(a).unwrap()));
+        assert!(s.is_drawn(s.entry(b).unwrap()));
+    }
+
+    #[test]
+    fn incident_from_direction_round_trips() {
+        let i = Incident {
+            theta_deg: 30.0,
+            phi_deg: -45.0,
+        };
+        let back = Incident::from_direction(i.direction());
+        assert!((back.theta_deg - 30.0).abs() < 1e-9);
+        assert!((back.phi_deg + 45.0).abs() < 1e-9);
+        // Below the horizon clamps to the slider's limit.
+        let low = Incident::from_direction(glam::DVec3::new(1.0, 0.0, -0.2));
+        assert_eq!(low.theta_deg, Incident::MAX_THETA_DEG);
+    }
+}

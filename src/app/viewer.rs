@@ -1,0 +1,492 @@
+//! The whole viewer UI as one value with a `ui()` method, so that the same
+//! code runs in eframe's window, in kittest harnesses and in scripted drivers.
+//!
+//! A frame: rebuild the evaluators whose specs changed, build the [`Scene`],
+//! lay out the panels and the views (which push [`Command`]s), handle
+//! shortcuts, then apply the commands.
+
+use super::command::Command;
+use super::panel;
+use super::runtime::Runtime;
+use super::state::{AppState, Theme};
+use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
+use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
+
+/// Keyboard shortcuts, as shown in the help overlay.
+pub const SHORTCUTS: &[(&str, &str)] = &[
+    ("F1 or ?", "show or hide this help"),
+    ("R", "reset the camera"),
+    ("L", "logarithmic scale"),
+    ("C", "multiply by cos θo"),
+    ("W", "wireframe lobe"),
+    ("N / P", "next / previous model for the selected BRDF"),
+    ("PageDown / PageUp", "select the next / previous BRDF"),
+    (
+        "M",
+        "maximise the view under the pointer (again to restore)",
+    ),
+    ("1, 2, 3", "maximise view 1, 2, 3 (again to restore)"),
+    ("Esc", "restore the layout"),
+    ("T", "switch between dark and light themes"),
+    ("Ctrl+Q", "quit (the session is saved)"),
+];
+
+/// Mouse gestures, as shown in the help overlay.
+pub const GESTURES: &[(&str, &str)] = &[
+    ("drag (lobe)", "orbit the camera"),
+    ("scroll (lobe)", "zoom"),
+    ("shift + drag (lobe)", "move the light"),
+    ("double-click (lobe)", "reset the camera"),
+    ("drag (light disc)", "move the light"),
+    ("double-click (slider)", "reset the value to its default"),
+    ("drag / scroll (plots)", "pan / zoom; double-click to fit"),
+];
+
+/// The viewer.
+pub struct Viewer {
+    state: AppState,
+    runtime: Runtime,
+    views: Vec<(&'static ViewEntry, Box<dyn View>)>,
+    pending: Vec<Command>,
+    status: Option<String>,
+    help: bool,
+    applied_theme: Option<Theme>,
+    /// Treat the frame as if a pointer button were held (scripted drags).
+    pub force_interacting: bool,
+}
+
+impl Viewer {
+    /// A viewer showing `state`.
+    pub fn new(state: AppState) -> Self {
+        Self {
+            state: state.sanitised(),
+            runtime: Runtime::default(),
+            views: REGISTRY.iter().map(|e| (e, (e.make)())).collect(),
+            pending: Vec::new(),
+            status: None,
+            help: false,
+            applied_theme: None,
+            force_interacting: false,
+        }
+    }
+
+    /// The current state (what is saved).
+    pub fn state(&self) -> &AppState {
+        &self.state
+    }
+
+    /// Queues a command, applied at the start of the next frame.
+    pub fn push(&mut self, c: Command) {
+        self.pending.push(c);
+    }
+
+    /// Applies the queued commands now.
+    pub fn apply_pending(&mut self) {
+        let cmds = std::mem::take(&mut self.pending);
+        self.apply(cmds);
+    }
+
+    /// The view of concrete type `T`, if registered.
+    pub fn view<T: View>(&self) -> Option<&T> {
+        self.views
+            .iter()
+            .find_map(|(_, v)| v.as_any().downcast_ref::<T>())
+    }
+
+    /// Whether the help overlay is open.
+    pub fn help_open(&self) -> bool {
+        self.help
+    }
+
+    /// The last status message (refused values, unknown models).
+    pub fn status(&self) -> Option<&str> {
+        self.status.as_deref()
+    }
+
+    /// The built evaluators.
+    pub fn runtime(&self) -> &Runtime {
+        &self.runtime
+    }
+
+    fn apply(&mut self, cmds: Vec<Command>) {
+        for c in cmds {
+            let r = c.apply(&mut self.state);
+            if r.toggle_help {
+                self.help = !self.help;
+            }
+            if let Some(m) = r.message {
+                self.status = Some(m);
+            }
+        }
+    }
+
+    /// Draws the viewer into `ui` (the whole window) and applies what the UI
+    /// asked for.
+    pub fn ui(&mut self, ui: &mut Ui) {
+        let ctx = ui.ctx().clone();
+        if self.applied_theme != Some(self.state.theme) {
+            ctx.set_theme(match self.state.theme {
+                Theme::Dark => egui::Theme::Dark,
+                Theme::Light => egui::Theme::Light,
+            });
+            self.applied_theme = Some(self.state.theme);
+        }
+        self.apply_pending();
+        self.runtime.sync(&self.state);
+        let interacting = self.force_interacting || ctx.input(|i| i.pointer.any_down());
+        let mut out = Vec::new();
+        self.top_bar(ui, &mut out);
+        self.left_panel(ui, &mut out);
+        {
+            let scene = build_scene(&self.state, &self.runtime, interacting);
+            let views = &mut self.views;
+            egui::CentralPanel::default().show(ui, |ui| {
+                central(ui, views, &scene, &mut out);
+            });
+        }
+        self.shortcuts(&ctx, &mut out);
+        self.help_window(&ctx);
+        if !out.is_empty() {
+            // Repaint only for real changes, so a widget that re-sends the same
+            // value cannot keep the app busy.
+            let before = self.state.clone();
+            let help = self.help;
+            self.apply(out);
+            if self.state != before || self.help != help {
+                ctx.request_repaint();
+            }
+        }
+    }
+
+    fn top_bar(&mut self, ui: &mut Ui, out: &mut Vec<Command>) {
+        egui::Panel::top("bv top").show(ui, |ui| {
+            ui.horizontal(|ui| {
+                ui.label(RichText::new("bv").strong().size(16.0));
+                ui.weak("BRDF viewer");
+                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                    if ui
+                        .button("? help")
+                        .on_hover_text("Keyboard shortcuts (F1)")
+                        .clicked()
+                    {
+                        out.push(Command::ToggleHelp);
+                    }
+                    let (label, next) = match self.state.theme {
+                        Theme::Dark => ("light theme", Theme::Light),
+                        Theme::Light => ("dark theme", Theme::Dark),
+                    };
+                    if ui.button(label).on_hover_text("Switch theme (T)").clicked() {
+                        out.push(Command::SetTheme(next));
+                    }
+                });
+            });
+        });
+    }
+
+    fn left_panel(&mut self, ui: &mut Ui, out: &mut Vec<Command>) {
+        egui::Panel::left("bv brdfs")
+            .resizable(true)
+            .default_size(350.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical()
+                    .auto_shrink([false, false])
+                    .show(ui, |ui| {
+                        panel::brdf_list(ui, &self.state, &self.runtime, out);
+                        ui.separator();
+                        panel::light_ui(ui, &self.state, out);
+                        ui.separator();
+                        panel::params_section(ui, &self.state, &self.runtime, out);
+                        if let Some(msg) = &self.status {
+                            ui.separator();
+                            ui.horizontal_wrapped(|ui| {
+                                ui.colored_label(ui.visuals().warn_fg_color, msg);
+                            });
+                            if ui.small_button("dismiss").clicked() {
+                                self.status = None;
+                            }
+                        }
+                    });
+            });
+    }
+
+    fn hovered_view(&self, ctx: &egui::Context) -> Option<&'static str> {
+        let pos = ctx.pointer_hover_pos()?;
+        let area = ctx.memory(|m| {
+            m.data
+                .get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"))
+        })?;
+        area.iter()
+            .find(|(_, r)| r.contains(pos))
+            .and_then(|(id, _)| REGISTRY.iter().find(|e| e.id == id).map(|e| e.id))
+    }
+
+    fn shortcuts(&mut self, ctx: &egui::Context, out: &mut Vec<Command>) {
+        if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (pressed, question) = ctx.input(|i| {
+            let keys = [
+                Key::F1,
+                Key::R,
+                Key::L,
+                Key::C,
+                Key::W,
+                Key::N,
+                Key::P,
+                Key::PageDown,
+                Key::PageUp,
+                Key::M,
+                Key::Num1,
+                Key::Num2,
+                Key::Num3,
+                Key::Escape,
+                Key::T,
+            ];
+            let pressed: Vec<Key> = keys
+                .into_iter()
+                .filter(|k| i.key_pressed(*k) && i.modifiers.is_none())
+                .collect();
+            let question = i.key_pressed(Key::Questionmark)
+                || i.events
+                    .iter()
+                    .any(|e| matches!(e, egui::Event::Text(t) if t == "?"));
+            (pressed, question)
+        });
+        if question {
+            out.push(Command::ToggleHelp);
+        }
+        for k in pressed {
+            match k {
+                Key::F1 => out.push(Command::ToggleHelp),
+                Key::R => out.push(Command::ResetCamera),
+                Key::L => out.push(Command::ToggleLog),
+                Key::C => out.push(Command::ToggleCosine),
+                Key::W => out.push(Command::ToggleWireframe),
+                Key::N => out.push(Command::StepModel(1)),
+                Key::P => out.push(Command::StepModel(-1)),
+                Key::PageDown => out.push(Command::SelectStep(1)),
+                Key::PageUp => out.push(Command::SelectStep(-1)),
+                Key::M => {
+                    let id = self
+                        .hovered_view(ctx)
+                        .or_else(|| REGISTRY.first().map(|e| e.id));
+                    if let Some(id) = id {
+                        out.push(Command::ToggleMaximise(id.to_string()));
+                    }
+                }
+                Key::Num1 | Key::Num2 | Key::Num3 => {
+                    let i = match k {
+                        Key::Num1 => 0,
+                        Key::Num2 => 1,
+                        _ => 2,
+                    };
+                    if let Some(e) = REGISTRY.get(i) {
+                        out.push(Command::ToggleMaximise(e.id.to_string()));
+                    }
+                }
+                Key::Escape => {
+                    if self.help {
+                        out.push(Command::ToggleHelp);
+                    } else {
+                        out.push(Command::Maximise(None));
+                    }
+                }
+                Key::T => out.push(Command::SetTheme(match self.state.theme {
+                    Theme::Dark => Theme::Light,
+                    Theme::Light => Theme::Dark,
+                })),
+                _ => {}
+            }
+        }
+    }
+
+    fn help_window(&mut self, ctx: &egui::Context) {
+        if !self.help {
+            return;
+        }
+        let mut open = true;
+        egui::Window::new("Keyboard shortcuts")
+            .open(&mut open)
+            .collapsible(false)
+            .resizable(false)
+            .anchor(egui::Align2::CENTER_CENTER, Vec2::ZERO)
+            .show(ctx, |ui| {
+                egui::Grid::new("bv help keys")
+                    .num_columns(2)
+                    .spacing([24.0, 4.0])
+                    .show(ui, |ui| {
+                        for (k, what) in SHORTCUTS {
+                            ui.label(RichText::new(*k).monospace().strong());
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
+                ui.separator();
+                egui::Grid::new("bv help mouse")
+                    .num_columns(2)
+                    .spacing([24.0, 4.0])
+                    .show(ui, |ui| {
+                        for (k, what) in GESTURES {
+                            ui.label(RichText::new(*k).strong());
+                            ui.label(*what);
+                            ui.end_row();
+                        }
+                    });
+            });
+        if !open {
+            self.help = false;
+        }
+    }
+}
+
+/// Lays out the views in the central area.
+fn central(
+    ui: &mut Ui,
+    views: &mut [(&'static ViewEntry, Box<dyn View>)],
+    scene: &Scene<'_>,
+    out: &mut Vec<Command>,
+) {
+    let area = ui.available_rect_before_wrap();
+    let maximised = scene
+        .state
+        .maximised
+        .as_deref()
+        .and_then(|id| views.iter().position(|(e, _)| e.id == id));
+    for (i, rect) in layout(area, views.len(), maximised) {
+        let (entry, view) = &mut views[i];
+        let is_max = maximised == Some(i);
+        ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {
+            ui.set_clip_rect(rect.intersect(ui.clip_rect()));
+            view_frame(ui, entry, view.as_mut(), is_max, scene, out);
+        });
+    }
+}
+
+/// Builds the frame's scene from the state and the built evaluators.
+pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool) -> Scene<'a> {
+    let brdfs = state
+        .brdfs
+        .iter()
+        .filter(|e| state.is_drawn(e))
+        .filter_map(|e| {
+            let built = runtime.get(e.id)?;
+            let brdf = built.brdf.clone()?;
+            let [r, g, b] = e.color;
+            Some(SceneBrdf {
+                id: e.id,
+                label: panel::display_name(state, e),
+                color: Color32::from_rgb(r, g, b),
+                brdf,
+                revision: built.revision,
+                selected: state.selected == Some(e.id),
+            })
+        })
+        .collect();
+    Scene {
+        state,
+        brdfs,
+        incident: state.incident,
+        interacting,
+    }
+}
+
+/// Where each view goes: the maximised one fills the area; otherwise the
+/// first view takes the left part and the others stack on the right.
+pub fn layout(area: Rect, n: usize, maximised: Option<usize>) -> Vec<(usize, Rect)> {
+    const GAP: f32 = 6.0;
+    if let Some(i) = maximised.filter(|&i| i < n) {
+        return vec![(i, area)];
+    }
+    match n {
+        0 => Vec::new(),
+        1 => vec![(0, area)],
+        _ => {
+            let left_w = (area.width() * 0.56).round();
+            let left = Rect::from_min_size(area.min, Vec2::new(left_w - GAP * 0.5, area.height()));
+            let right_x = area.min.x + left_w + GAP * 0.5;
+            let rest = n - 1;
+            let h = (area.height() - GAP * (rest as f32 - 1.0)) / rest as f32;
+            let mut out = vec![(0, left)];
+            for k in 0..rest {
+                let y = area.min.y + k as f32 * (h + GAP);
+                out.push((
+                    k + 1,
+                    Rect::from_min_max(egui::pos2(right_x, y), egui::pos2(area.max.x, y + h)),
+                ));
+            }
+            out
+        }
+    }
+}
+
+/// A view's frame: a header with its title, toolbar and maximise button, and
+/// the view below.
+fn view_frame(
+    ui: &mut Ui,
+    entry: &ViewEntry,
+    view: &mut dyn View,
+    is_max: bool,
+    scene: &Scene<'_>,
+    out: &mut Vec<Command>,
+) {
+    let rect = ui.max_rect();
+    // Remember where views are, for the M shortcut.
+    ui.ctx().data_mut(|d| {
+        let list =
+            d.get_temp_mut_or_default::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"));
+        list.retain(|(id, _)| id != entry.id);
+        list.push((entry.id.to_string(), rect));
+    });
+    egui::Frame::group(ui.style())
+        .inner_margin(4.0)
+        .show(ui, |ui| {
+            ui.set_min_size(rect.size() - Vec2::splat(10.0));
+            ui.horizontal_wrapped(|ui| {
+                let title = ui.label(RichText::new(entry.title).strong());
+                if title.double_clicked() {
+                    out.push(Command::ToggleMaximise(entry.id.to_string()));
+                }
+                let (text, hint) = if is_max {
+                    ("restore", "Show all views again (Esc)")
+                } else {
+                    ("maximise", "Fill the window with this view (M)")
+                };
+                let r = ui.small_button(text).on_hover_text(hint);
+                let label = if is_max {
+                    format!("Restore {}", entry.title)
+                } else {
+                    format!("Maximise {}", entry.title)
+                };
+                r.widget_info(|| egui::WidgetInfo::labeled(egui::Role::Button, true, &label));
+                if r.clicked() {
+                    out.push(Command::ToggleMaximise(entry.id.to_string()));
+                }
+                ui.separator();
+                view.toolbar(ui, scene, out);
+            });
+            ui.separator();
+            view.ui(ui, scene, out);
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn layout_fills_the_area() {
+        let area = Rect::from_min_size(egui::pos2(10.0, 20.0), Vec2::new(1000.0, 600.0));
+        let l = layout(area, 3, None);
+        assert_eq!(l.len(), 3);
+        for (_, r) in &l {
+            assert!(area.contains_rect(*r), "{r:?}");
+        }
+        assert!(l[0].1.width() > l[1].1.width());
+        assert!((l[1].1.height() + l[2].1.height() + 6.0 - 600.0).abs() < 1e-3);
+        assert_eq!(layout(area, 3, Some(2)), vec![(2, area)]);
+        assert_eq!(layout(area, 3, Some(7)).len(), 3);
+    }
+}

@@ -1,0 +1,333 @@
+//! Cartesian plot of `f` versus an angle: θo in the plane of incidence
+//! (negative on the light's side), or θh at a fixed θd, or θd at a fixed θh
+//! (Rusinkiewicz angles with φh = 0 and φd = 90°). Every drawn BRDF in its
+//! colour, a legend, a log toggle and the exact values under the pointer.
+
+use super::curves::{self, HalfDiffAxis};
+use super::polar::{Readout, readout_ui};
+use super::{Scene, View};
+use crate::app::command::Command;
+use crate::app::state::CartesianAxis;
+use eframe::egui::{self, Color32, RichText, Ui};
+use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text, VLine};
+
+/// Samples per curve over 180° (0.25° steps).
+const SAMPLES: usize = 720;
+
+/// The Cartesian plot view.
+#[derive(Default)]
+pub struct CartesianView {
+    /// The values under the pointer in the last frame.
+    pub readout: Option<Readout>,
+    /// Where the plot was drawn in the last frame.
+    pub plot_rect: Option<egui::Rect>,
+}
+
+fn axis_name(a: CartesianAxis) -> &'static str {
+    match a {
+        CartesianAxis::ThetaO => "θo",
+        CartesianAxis::ThetaH => "θh",
+        CartesianAxis::ThetaD => "θd",
+    }
+}
+
+impl View for CartesianView {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        super::display_toggles(ui, scene, out);
+        let p = scene.state.plots;
+        let mut axis = p.axis;
+        egui::ComboBox::new(super::view_id("cartesian").with("axis"), "x axis")
+            .selected_text(axis_name(axis))
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut axis, CartesianAxis::ThetaO, "θo (plane of incidence)");
+                ui.selectable_value(&mut axis, CartesianAxis::ThetaH, "θh (fixed θd)");
+                ui.selectable_value(&mut axis, CartesianAxis::ThetaD, "θd (fixed θh)");
+            });
+        if axis != p.axis {
+            out.push(Command::SetCartesianAxis(axis));
+        }
+        let mut p2 = p;
+        match axis {
+            CartesianAxis::ThetaO => {}
+            CartesianAxis::ThetaH => {
+                ui.add(
+                    egui::Slider::new(&mut p2.fixed_theta_d_deg, 0.0..=89.5)
+                        .text("θd")
+                        .suffix("°"),
+                );
+            }
+            CartesianAxis::ThetaD => {
+                ui.add(
+                    egui::Slider::new(&mut p2.fixed_theta_h_deg, 0.0..=89.5)
+                        .text("θh")
+                        .suffix("°"),
+                );
+            }
+        }
+        if p2 != p {
+            // Keep the axis chosen in this same frame.
+            p2.axis = axis;
+            out.push(Command::SetPlots(p2));
+        }
+    }
+
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+        let dark = ui.visuals().dark_mode;
+        let d = scene.state.display;
+        let p = scene.state.plots;
+        let (theta_i, phi_i) = (
+            scene.incident.theta_deg.to_radians(),
+            scene.incident.phi_deg.to_radians(),
+        );
+        let eval = |b: &super::SceneBrdf| -> Vec<curves::Sample> {
+            match p.axis {
+                CartesianAxis::ThetaO => {
+                    let n = if b.brdf.transmits() {
+                        2 * SAMPLES
+                    } else {
+                        SAMPLES
+                    };
+                    curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+                }
+                CartesianAxis::ThetaH => curves::half_diff_slice(
+                    b.brdf.as_ref(),
+                    HalfDiffAxis::ThetaH,
+                    p.fixed_theta_d_deg.to_radians(),
+                    SAMPLES / 2,
+                    d.cosine,
+                ),
+                CartesianAxis::ThetaD => curves::half_diff_slice(
+                    b.brdf.as_ref(),
+                    HalfDiffAxis::ThetaD,
+                    p.fixed_theta_h_deg.to_radians(),
+                    SAMPLES / 2,
+                    d.cosine,
+                ),
+            }
+        };
+        let data: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
+            scene.brdfs.iter().map(|b| (b, eval(b))).collect();
+        let vmax = data
+            .iter()
+            .flat_map(|(_, s)| s.iter())
+            .map(|s| s.value)
+            .fold(0.0, f64::max);
+        let floor = curves::log_floor(vmax);
+        let log = d.log;
+        let y_of = move |v: f64| {
+            if log {
+                curves::log_ordinate(v, floor)
+            } else {
+                v
+            }
+        };
+        let value_name = super::value_label(d.cosine);
+        let axis = p.axis;
+        let x_name = axis_name(axis);
+
+        let readout_h = 22.0;
+        let size = ui.available_size() - egui::vec2(0.0, readout_h);
+        let x_label = match axis {
+            CartesianAxis::ThetaO => "θo (°), negative on the light's side".to_string(),
+            CartesianAxis::ThetaH => format!("θh (°), θd = {:.1}°, φd = 90°", p.fixed_theta_d_deg),
+            CartesianAxis::ThetaD => format!("θd (°), θh = {:.1}°, φd = 90°", p.fixed_theta_h_deg),
+        };
+        let y_label = if log {
+            format!("{value_name} (1/sr, log scale)")
+        } else {
+            format!("{value_name} (1/sr)")
+        };
+        // Headroom above the largest value for the legend and markers.
+        let (bottom, top) = if log {
+            (floor.log10(), y_of(vmax.max(1e-30)) + 0.4)
+        } else {
+            (0.0, vmax.max(1e-6) * 1.3)
+        };
+        let mut plot = Plot::new(super::view_id("cartesian"))
+            .width(size.x.max(50.0))
+            .height(size.y.max(50.0))
+            .legend(Legend::default().position(Corner::RightTop))
+            .x_axis_label(x_label)
+            .y_axis_label(y_label)
+            .y_axis_min_width(44.0)
+            // Angles read in steps a lecturer uses: 15°, 45°, 90°.
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+                let span = input.bounds.1 - input.bounds.0;
+                if span > 200.0 {
+                    [10.0, 30.0, 90.0]
+                } else if span > 50.0 {
+                    [5.0, 15.0, 45.0]
+                } else {
+                    [1.0, 5.0, 15.0]
+                }
+            }))
+            .allow_scroll(false)
+            .include_y(bottom)
+            .include_y(top)
+            .label_formatter(move |hover| match hover {
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
+                    let v = if log {
+                        10f64.powf(position.y)
+                    } else {
+                        position.y
+                    };
+                    Some(format!(
+                        "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
+                        position.x,
+                        curves::fmt_value(v)
+                    ))
+                }
+                _ => None,
+            });
+        if log {
+            plot = plot
+                .y_axis_formatter(|mark, _| {
+                    let k = mark.value.round();
+                    if (mark.value - k).abs() < 1e-9 {
+                        super::decade_label(k as i32)
+                    } else {
+                        String::new()
+                    }
+                })
+                .y_grid_spacer(egui_plot::uniform_grid_spacer(|_| [10.0, 1.0, 0.5]));
+        }
+        let light = super::light_color(dark);
+        let mirror = super::mirror_color(dark);
+        let wi = scene.wi();
+        let response = plot.show(ui, |pui| {
+            if axis == CartesianAxis::ThetaO {
+                let li = curves::incident_signed_angle(theta_i).to_degrees();
+                pui.vline(
+                    VLine::new("", li)
+                        .color(light)
+                        .width(2.0)
+                        .allow_hover(false),
+                );
+                pui.vline(
+                    VLine::new("", theta_i.to_degrees())
+                        .color(mirror)
+                        .style(LineStyle::Dashed { length: 6.0 })
+                        .width(1.5)
+                        .allow_hover(false),
+                );
+                pui.text(
+                    Text::new(
+                        "",
+                        PlotPoint::new(li, bottom),
+                        RichText::new(" ωi ").size(14.0),
+                    )
+                    .color(light)
+                    .anchor(egui::Align2::RIGHT_BOTTOM)
+                    .allow_hover(false),
+                );
+                pui.text(
+                    Text::new(
+                        "",
+                        PlotPoint::new(theta_i.to_degrees(), bottom),
+                        RichText::new(" ωr ").size(14.0),
+                    )
+                    .color(mirror)
+                    .anchor(egui::Align2::LEFT_BOTTOM)
+                    .allow_hover(false),
+                );
+                // Delta lobes: where they point, with their weight.
+                for (b, _) in &data {
+                    for dl in b.brdf.deltas(wi) {
+                        let along = -(dl.direction.x * phi_i.cos() + dl.direction.y * phi_i.sin());
+                        let a = along.atan2(dl.direction.z).to_degrees();
+                        let w = bv_core::mean_rgb(dl.weight);
+                        pui.vline(
+                            VLine::new(format!("{} δ", b.label), a)
+                                .color(b.color)
+                                .style(LineStyle::Dotted { spacing: 4.0 })
+                                .width(2.0),
+                        );
+                        pui.text(
+                            Text::new(
+                                "",
+                                PlotPoint::new(a, bottom + (top - bottom) * 0.85),
+                                RichText::new(format!("δ {w:.3}")).size(11.0),
+                            )
+                            .color(b.color)
+                            .anchor(egui::Align2::LEFT_TOP)
+                            .allow_hover(false),
+                        );
+                    }
+                }
+            }
+            let mut order: Vec<&(&super::SceneBrdf, Vec<curves::Sample>)> = data.iter().collect();
+            order.sort_by_key(|(b, _)| b.selected);
+            for (b, samples) in order {
+                let pts: Vec<[f64; 2]> = samples
+                    .iter()
+                    .map(|s| [s.x.to_degrees(), y_of(s.value)])
+                    .collect();
+                pui.line(
+                    Line::new(b.label.clone(), PlotPoints::from(pts))
+                        .color(b.color)
+                        .width(if b.selected { 2.5 } else { 1.8 }),
+                );
+            }
+            pui.pointer_coordinate()
+        });
+
+        self.readout = None;
+        self.plot_rect = Some(response.response.rect);
+        if response.response.hovered()
+            && let Some(pc) = response.inner
+        {
+            let x = pc.x.to_radians();
+            let values: Vec<(String, Color32, curves::Sample)> = scene
+                .brdfs
+                .iter()
+                .map(|b| {
+                    let s = match axis {
+                        CartesianAxis::ThetaO => {
+                            curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, x, d.cosine)
+                        }
+                        CartesianAxis::ThetaH => curves::half_diff_value(
+                            b.brdf.as_ref(),
+                            HalfDiffAxis::ThetaH,
+                            p.fixed_theta_d_deg.to_radians(),
+                            x,
+                            d.cosine,
+                        ),
+                        CartesianAxis::ThetaD => curves::half_diff_value(
+                            b.brdf.as_ref(),
+                            HalfDiffAxis::ThetaD,
+                            p.fixed_theta_h_deg.to_radians(),
+                            x,
+                            d.cosine,
+                        ),
+                    };
+                    (b.label.clone(), b.color, s)
+                })
+                .collect();
+            let limit = match axis {
+                CartesianAxis::ThetaO if scene.brdfs.iter().any(|b| b.brdf.transmits()) => 180.0,
+                CartesianAxis::ThetaO => 90.0,
+                _ => 90.0,
+            };
+            let in_range = match axis {
+                CartesianAxis::ThetaO => pc.x.abs() <= limit,
+                _ => (0.0..=limit).contains(&pc.x),
+            };
+            if in_range {
+                self.readout = Some(Readout {
+                    axis: x_name.into(),
+                    x_deg: pc.x,
+                    values,
+                });
+            }
+        }
+        readout_ui(ui, self.readout.as_ref(), d.cosine);
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}

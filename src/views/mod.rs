@@ -1,0 +1,227 @@
+//! The viewer's views: the 3D polar lobe, the polar plot of the plane of
+//! incidence and the Cartesian plot. Each is a struct with its own `ui()`; they
+//! read one [`Scene`] per frame and ask for changes by pushing
+//! [`Command`]s. A view is added by writing its module and one line in
+//! [`REGISTRY`].
+
+pub mod camera;
+pub mod cartesian;
+pub mod colormap;
+pub mod curves;
+pub mod lobe3d;
+pub mod lobe_gpu;
+pub mod polar;
+
+use crate::app::command::Command;
+use crate::app::state::{AppState, Incident};
+use bv_core::Brdf;
+use eframe::egui::{self, Color32, Ui};
+use std::any::Any;
+use std::sync::Arc;
+
+/// One drawn BRDF, ready to evaluate.
+#[derive(Clone)]
+pub struct SceneBrdf {
+    /// Its id in the state's list.
+    pub id: u64,
+    /// Display name (model name, numbered when the same model is loaded twice).
+    pub label: String,
+    /// Display colour.
+    pub color: Color32,
+    /// The evaluator.
+    pub brdf: Arc<dyn Brdf>,
+    /// Changes whenever its parameters change (cache key).
+    pub revision: u64,
+    /// Whether it is the selected BRDF.
+    pub selected: bool,
+}
+
+impl std::fmt::Debug for SceneBrdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SceneBrdf")
+            .field("id", &self.id)
+            .field("label", &self.label)
+            .field("revision", &self.revision)
+            .finish_non_exhaustive()
+    }
+}
+
+/// What every view reads in one frame.
+pub struct Scene<'a> {
+    /// The whole saved state (display options, camera, plot settings).
+    pub state: &'a AppState,
+    /// The drawn BRDFs, in list order.
+    pub brdfs: Vec<SceneBrdf>,
+    /// The light direction.
+    pub incident: Incident,
+    /// A pointer button is held somewhere (a slider or the light is being
+    /// dragged): views may trade resolution for speed.
+    pub interacting: bool,
+}
+
+impl Scene<'_> {
+    /// The BRDF drawn opaque and coloured by value in the lobe view: the
+    /// selected one if drawn, else the first drawn.
+    pub fn primary(&self) -> Option<&SceneBrdf> {
+        self.brdfs
+            .iter()
+            .find(|b| b.selected)
+            .or_else(|| self.brdfs.first())
+    }
+
+    /// The unit direction towards the light.
+    pub fn wi(&self) -> glam::DVec3 {
+        self.incident.direction()
+    }
+}
+
+/// A view of the scene.
+pub trait View: Any {
+    /// Widgets in the view's header bar (toggles).
+    fn toolbar(&mut self, _ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {}
+
+    /// Draws the view into the whole of `ui`'s available rectangle.
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>);
+
+    /// For tests and drivers that need the concrete view.
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// A registered view.
+pub struct ViewEntry {
+    /// Stable id (saved as the maximised view, used by shortcuts).
+    pub id: &'static str,
+    /// Title in the view's header.
+    pub title: &'static str,
+    /// Creates the view.
+    pub make: fn() -> Box<dyn View>,
+}
+
+/// Every view, in layout order: the first fills the left of the central area,
+/// the others stack on the right. Add a view here.
+pub const REGISTRY: &[ViewEntry] = &[
+    ViewEntry {
+        id: "lobe",
+        title: "3D lobe",
+        make: || Box::new(lobe3d::Lobe3dView::new()),
+    },
+    ViewEntry {
+        id: "polar",
+        title: "Plane of incidence (polar)",
+        make: || Box::new(polar::PolarView::default()),
+    },
+    ViewEntry {
+        id: "cartesian",
+        title: "f versus angle",
+        make: || Box::new(cartesian::CartesianView::default()),
+    },
+];
+
+/// The registry entry with id `id`.
+pub fn entry(id: &str) -> Option<&'static ViewEntry> {
+    REGISTRY.iter().find(|v| v.id == id)
+}
+
+/// The label of the value the views show.
+pub fn value_label(cosine: bool) -> &'static str {
+    if cosine { "f·cos θo" } else { "f" }
+}
+
+/// Convert an egui colour to sRGB 0..1 floats.
+pub fn srgb_f32(c: Color32) -> [f32; 3] {
+    [
+        c.r() as f32 / 255.0,
+        c.g() as f32 / 255.0,
+        c.b() as f32 / 255.0,
+    ]
+}
+
+/// A text colour that reads on the current background.
+pub fn strong_text(ui: &Ui) -> Color32 {
+    ui.visuals().strong_text_color()
+}
+
+/// Marker colour of the light (ωi) in every view.
+pub fn light_color(dark: bool) -> Color32 {
+    if dark {
+        Color32::from_rgb(255, 200, 60)
+    } else {
+        Color32::from_rgb(210, 130, 0)
+    }
+}
+
+/// Marker colour of the mirror direction in every view.
+pub fn mirror_color(dark: bool) -> Color32 {
+    if dark {
+        Color32::from_rgb(200, 200, 200)
+    } else {
+        Color32::from_rgb(90, 90, 90)
+    }
+}
+
+/// A faint colour for grids.
+pub fn grid_color(dark: bool) -> Color32 {
+    if dark {
+        Color32::from_rgba_unmultiplied(150, 150, 150, 90)
+    } else {
+        Color32::from_rgba_unmultiplied(110, 110, 110, 90)
+    }
+}
+
+/// Adds a toggle to a toolbar and returns whether it was clicked (labels are
+/// what tests and screen readers find).
+pub fn toolbar_toggle(ui: &mut Ui, on: bool, label: &str, hint: &str) -> bool {
+    ui.selectable_label(on, label).on_hover_text(hint).clicked()
+}
+
+/// The label of the decade 10^k on a log axis: plain decimals near 1 (what
+/// students read fastest), `1e-6` style beyond. (egui's default fonts have no
+/// superscript minus.)
+pub fn decade_label(k: i32) -> String {
+    if (-3..=4).contains(&k) {
+        let v = 10f64.powi(k);
+        let digits = (-k).max(0) as usize;
+        format!("{v:.digits$}")
+    } else {
+        format!("1e{k}")
+    }
+}
+
+/// Shared by plots: the toggles for log and cosine.
+pub fn display_toggles(ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+    let d = scene.state.display;
+    if toolbar_toggle(ui, d.log, "log", "Logarithmic scale (L)") {
+        out.push(Command::ToggleLog);
+    }
+    if toolbar_toggle(ui, d.cosine, "× cos θo", "Multiply by cos θo (C)") {
+        out.push(Command::ToggleCosine);
+    }
+}
+
+/// The id egui uses for a view's widgets.
+pub fn view_id(id: &str) -> egui::Id {
+    egui::Id::unique(("bv view", id))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn registry_ids_are_unique() {
+        let mut ids: Vec<_> = REGISTRY.iter().map(|v| v.id).collect();
+        ids.sort();
+        ids.dedup();
+        assert_eq!(ids.len(), REGISTRY.len());
+        assert!(entry("lobe").is_some());
+    }
+
+    #[test]
+    fn decade_labels() {
+        assert_eq!(decade_label(-3), "0.001");
+        assert_eq!(decade_label(0), "1");
+        assert_eq!(decade_label(2), "100");
+        assert_eq!(decade_label(-6), "1e-6");
+        assert_eq!(decade_label(-4), "1e-4");
+    }
+}

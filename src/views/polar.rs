@@ -1,0 +1,353 @@
+//! Polar plot of the plane of incidence: the radius is `f` (or `f cos θo`, or
+//! ln(1 + f) on the log scale, the same radius as the 3D lobe) along the
+//! outgoing direction, the light on the left, the mirror direction on the
+//! right, the surface horizontal. Every drawn BRDF in its colour, with a legend
+//! and the exact values under the pointer.
+
+use super::curves::{self, Sample};
+use super::{Scene, View};
+use crate::app::command::Command;
+use eframe::egui::{self, Color32, RichText, Ui};
+use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
+use std::f64::consts::FRAC_PI_2;
+
+/// Samples per curve (half circle); 0.25° steps keep a Phong lobe of exponent
+/// 10⁴ (≈ 1° wide) smooth.
+const SAMPLES: usize = 720;
+
+/// The polar plot view.
+#[derive(Default)]
+pub struct PolarView {
+    /// The values under the pointer in the last frame (for tests and the readout).
+    pub readout: Option<Readout>,
+    /// Where the plot was drawn in the last frame.
+    pub plot_rect: Option<egui::Rect>,
+}
+
+/// Exact values at one hovered angle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Readout {
+    /// What the abscissa is ("θo", "θh", …).
+    pub axis: String,
+    /// The hovered abscissa, degrees.
+    pub x_deg: f64,
+    /// Per BRDF: label, colour, exact sample.
+    pub values: Vec<(String, Color32, Sample)>,
+}
+
+/// Shows a readout line under a plot.
+pub fn readout_ui(ui: &mut Ui, readout: Option<&Readout>, cosine: bool) {
+    ui.horizontal_wrapped(|ui| {
+        ui.spacing_mut().item_spacing.x = 10.0;
+        match readout {
+            Some(r) => {
+                ui.label(RichText::new(format!("{} = {:.1}°", r.axis, r.x_deg)).monospace());
+                for (label, color, s) in &r.values {
+                    let rgb = s.rgb;
+                    ui.label(
+                        RichText::new(format!("{label}: {}", curves::fmt_value(s.value)))
+                            .color(*color)
+                            .strong(),
+                    )
+                    .on_hover_text(format!(
+                        "{} = {} 1/sr\nf (r, g, b) = ({}, {}, {}) 1/sr",
+                        super::value_label(cosine),
+                        s.value,
+                        rgb.x,
+                        rgb.y,
+                        rgb.z
+                    ));
+                }
+                ui.weak("1/sr");
+            }
+            None => {
+                ui.weak("hover a plot to read exact values");
+            }
+        }
+    });
+}
+
+/// The radius of a value on the current scale.
+fn radius(v: f64, log: bool) -> f64 {
+    if log { v.ln_1p() } else { v }
+}
+
+/// The value at a radius (inverse of [`radius`]).
+fn value_at(r: f64, log: bool) -> f64 {
+    if log { r.exp_m1() } else { r }
+}
+
+impl View for PolarView {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        super::display_toggles(ui, scene, out);
+    }
+
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+        let dark = ui.visuals().dark_mode;
+        let d = scene.state.display;
+        let (theta_i, phi_i) = (
+            scene.incident.theta_deg.to_radians(),
+            scene.incident.phi_deg.to_radians(),
+        );
+        let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
+
+        // Curves and the largest radius.
+        let curves: Vec<(String, Color32, bool, Vec<[f64; 2]>)> = scene
+            .brdfs
+            .iter()
+            .map(|b| {
+                let n = if b.brdf.transmits() {
+                    2 * SAMPLES
+                } else {
+                    SAMPLES
+                };
+                let pts = curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+                    .iter()
+                    .map(|s| {
+                        let r = radius(s.value, d.log);
+                        [r * s.x.sin(), r * s.x.cos()]
+                    })
+                    .collect();
+                (b.label.clone(), b.color, b.selected, pts)
+            })
+            .collect();
+        let rmax = curves
+            .iter()
+            .flat_map(|c| c.3.iter())
+            .map(|p| p[0].hypot(p[1]))
+            .fold(0.0, f64::max);
+        let outer = curves::nice_ceil(if rmax > 0.0 { rmax } else { radius(1.0, d.log) });
+
+        let grid = super::grid_color(dark);
+        let text_col = super::strong_text(ui);
+        let light = super::light_color(dark);
+        let mirror = super::mirror_color(dark);
+        let readout_h = 22.0;
+        let size = ui.available_size() - egui::vec2(0.0, readout_h);
+        let value_name = super::value_label(d.cosine);
+        let log = d.log;
+
+        let plot = Plot::new(super::view_id("polar"))
+            .width(size.x.max(50.0))
+            .height(size.y.max(50.0))
+            .data_aspect(1.0)
+            .show_axes(false)
+            .show_grid(false)
+            .allow_scroll(false)
+            .legend(Legend::default().position(Corner::RightTop))
+            .label_formatter(move |hover| match hover {
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
+                    let angle = position.x.atan2(position.y).to_degrees();
+                    let v = value_at(position.x.hypot(position.y), log);
+                    Some(format!(
+                        "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
+                        angle,
+                        curves::fmt_value(v)
+                    ))
+                }
+                _ => None,
+            });
+
+        let span: i32 = if transmits { 180 } else { 90 };
+        let brdfs = &scene.brdfs;
+        let response = plot.show(ui, |pui| {
+            // Rings with the value they stand for, and spokes every 15°.
+            for k in 1..=4 {
+                // On the log scale the rings stand at round values of f.
+                let r = if log {
+                    radius(curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2), log)
+                } else {
+                    outer * k as f64 / 4.0
+                };
+                let n = 4 * span as usize;
+                let pts: Vec<[f64; 2]> = (0..=n)
+                    .map(|j| {
+                        let a =
+                            (-(span as f64) + 2.0 * span as f64 * j as f64 / n as f64).to_radians();
+                        [r * a.sin(), r * a.cos()]
+                    })
+                    .collect();
+                pui.line(
+                    Line::new("", PlotPoints::from(pts))
+                        .color(grid)
+                        .width(1.0)
+                        .allow_hover(false),
+                );
+                // Ring values read along the surface line, like a radial axis.
+                let label = curves::fmt_tick(value_at(r, log));
+                pui.text(
+                    Text::new(
+                        "",
+                        PlotPoint::new(r, -outer * 0.015),
+                        RichText::new(label).size(11.0),
+                    )
+                    .color(text_col.gamma_multiply(0.8))
+                    .anchor(egui::Align2::CENTER_TOP)
+                    .allow_hover(false),
+                );
+            }
+            for deg in (-span..=span).step_by(15) {
+                let a = (deg as f64).to_radians();
+                let pts = vec![[0.0, 0.0], [outer * a.sin(), outer * a.cos()]];
+                pui.line(
+                    Line::new("", PlotPoints::from(pts))
+                        .color(grid)
+                        .width(1.0)
+                        .allow_hover(false),
+                );
+                if deg % 30 == 0 {
+                    // ±90° sit just above the surface line, clear of the ring values.
+                    let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
+                    let p = PlotPoint::new(outer * 1.09 * a.sin(), outer * 1.09 * a.cos() + lift);
+                    pui.text(
+                        Text::new("", p, RichText::new(format!("{}°", deg.abs())).size(11.0))
+                            .color(text_col.gamma_multiply(0.8))
+                            .allow_hover(false),
+                    );
+                }
+            }
+            // The surface.
+            pui.line(
+                Line::new(
+                    "",
+                    PlotPoints::from(vec![[-outer * 1.15, 0.0], [outer * 1.15, 0.0]]),
+                )
+                .color(text_col.gamma_multiply(0.7))
+                .width(1.5)
+                .allow_hover(false),
+            );
+            // Light (left) and mirror direction (right).
+            let li = curves::incident_signed_angle(theta_i);
+            let lp = [outer * 1.2 * li.sin(), outer * 1.2 * li.cos()];
+            pui.line(
+                Line::new("", PlotPoints::from(vec![lp, [0.0, 0.0]]))
+                    .color(light)
+                    .width(2.5)
+                    .allow_hover(false),
+            );
+            pui.text(
+                Text::new(
+                    "",
+                    PlotPoint::new(lp[0] * 1.06, lp[1] * 1.06 + outer * 0.04),
+                    RichText::new("ωi").size(14.0),
+                )
+                .color(light)
+                .allow_hover(false),
+            );
+            let mp = [outer * 1.12 * theta_i.sin(), outer * 1.12 * theta_i.cos()];
+            pui.line(
+                Line::new("", PlotPoints::from(vec![[0.0, 0.0], mp]))
+                    .color(mirror)
+                    .style(LineStyle::Dashed { length: 6.0 })
+                    .width(1.5)
+                    .allow_hover(false),
+            );
+            pui.text(
+                Text::new(
+                    "",
+                    PlotPoint::new(mp[0] * 1.08, mp[1] * 1.08),
+                    RichText::new("ωr").size(14.0),
+                )
+                .color(mirror)
+                .allow_hover(false),
+            );
+            // The curves, selected one on top.
+            let mut order: Vec<&(String, Color32, bool, Vec<[f64; 2]>)> = curves.iter().collect();
+            order.sort_by_key(|c| c.2);
+            for (label, color, selected, pts) in order {
+                pui.line(
+                    Line::new(label.clone(), PlotPoints::from(pts.clone()))
+                        .color(*color)
+                        .width(if *selected { 2.5 } else { 1.8 }),
+                );
+            }
+            // Delta lobes in the plane, as spikes reaching `weight` of the outer ring.
+            for b in brdfs {
+                for dl in b.brdf.deltas(scene.wi()) {
+                    let dir = dl.direction;
+                    let plane_n = glam::DVec3::new(-phi_i.sin(), phi_i.cos(), 0.0);
+                    if dir.dot(plane_n).abs() > 1e-6 {
+                        continue;
+                    }
+                    // Signed in-plane angle: positive towards the mirror side.
+                    let along = -(dir.x * phi_i.cos() + dir.y * phi_i.sin());
+                    let a = along.atan2(dir.z);
+                    let w = bv_core::mean_rgb(dl.weight);
+                    let tip = [outer * w * a.sin(), outer * w * a.cos()];
+                    pui.arrows(
+                        egui_plot::Arrows::new(
+                            format!("{} δ", b.label),
+                            PlotPoints::from(vec![[0.0, 0.0]]),
+                            PlotPoints::from(vec![tip]),
+                        )
+                        .color(b.color),
+                    );
+                    pui.text(
+                        Text::new(
+                            "",
+                            PlotPoint::new(tip[0] * 1.05, tip[1] * 1.05),
+                            RichText::new(format!("δ {w:.3}")).size(11.0),
+                        )
+                        .color(b.color)
+                        .allow_hover(false),
+                    );
+                }
+            }
+            pui.pointer_coordinate()
+        });
+
+        // Exact values along the hovered direction.
+        self.readout = None;
+        self.plot_rect = Some(response.response.rect);
+        if response.response.hovered()
+            && let Some(p) = response.inner
+        {
+            let a = p.x.atan2(p.y);
+            let limit = if transmits {
+                std::f64::consts::PI
+            } else {
+                FRAC_PI_2
+            };
+            if a.abs() <= limit {
+                self.readout = Some(Readout {
+                    axis: "θo".into(),
+                    x_deg: a.to_degrees(),
+                    values: scene
+                        .brdfs
+                        .iter()
+                        .map(|b| {
+                            (
+                                b.label.clone(),
+                                b.color,
+                                curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine),
+                            )
+                        })
+                        .collect(),
+                });
+            }
+        }
+        readout_ui(ui, self.readout.as_ref(), d.cosine);
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radius_and_value_are_inverse() {
+        for v in [0.0, 0.3, 5.0, 1234.0] {
+            for log in [false, true] {
+                assert!((value_at(radius(v, log), log) - v).abs() < 1e-9 * (1.0 + v));
+            }
+        }
+    }
+}
