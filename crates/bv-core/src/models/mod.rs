@@ -9,8 +9,8 @@ pub mod blinn_phong;
 pub mod hapke;
 pub mod lambert;
 pub mod lobes;
-pub mod modified_phong;
 pub mod mix;
+pub mod modified_phong;
 pub mod oren_nayar;
 pub mod phong;
 

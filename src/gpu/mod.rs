@@ -1,0 +1,15 @@
+//! The GPU side (issue 4): WGSL ports of bv-core's models composed from
+//! `shaders/`, their parameter layout generated from the declarations, and
+//! offscreen renderers (lit sphere, environment lighting) that a GUI view can
+//! call every frame and `bv render` once.
+//!
+//! bv-core stays free of wgpu: it only provides the layout and packer
+//! ([`bv_core::params::gpu_layout`], [`bv_core::params::pack_model`]).
+
+pub mod context;
+pub mod eval;
+pub mod layout;
+pub mod shaders;
+
+pub use context::{Gpu, gpu_for_test};
+pub use eval::GpuEvaluator;
