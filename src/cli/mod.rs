@@ -1,25 +1,116 @@
 //! Command line (SPEC §5).
+//!
+//! `bv` with no sub-command opens the viewer ([`crate::app::run`]); each
+//! sub-command lives in its own module and prints results for scripts:
+//!
+//! - [`eval`]: JSON Lines queries on stdin, one answer per line on stdout;
+//! - [`models`]: the model catalogue with every parameter's range and default;
+//! - [`check`]: the properties of SPEC §3 for one parameter set;
+//! - [`bench`]: batch evaluation speed.
+//!
+//! Errors are reported as `bv: <message>` on stderr with a non-zero exit
+//! status; nothing a user types makes the program panic.
 
-use clap::Parser;
+pub mod bench;
+pub mod check;
+pub mod eval;
+pub mod models;
+pub mod output;
+pub mod params;
+
+use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 /// `bv`: an interactive BRDF viewer and its command-line tools.
 #[derive(Debug, Parser)]
-#[command(name = "bv", version, about)]
+#[command(
+    name = "bv",
+    version,
+    about,
+    long_about = "bv: an interactive BRDF viewer (lobes, slices, properties).\n\n\
+                  With no sub-command it opens the viewer window; the sub-commands \
+                  print results for scripts. Conventions: normal +z, tangent +x; \
+                  wi (towards the light) and wo (towards the viewer) point away \
+                  from the surface; f(wi, wo) is given WITHOUT the cosine factor, \
+                  in 1/sr per linear-RGB channel.",
+    args_conflicts_with_subcommands = true
+)]
 pub struct Cli {
+    /// What to do; the viewer opens when none is given.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
     /// Options of the viewer window (used when no sub-command is given).
     #[command(flatten)]
     pub viewer: crate::app::ViewerArgs,
 }
 
+/// The sub-commands of SPEC §5.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Evaluate f(wi, wo) for JSON Lines queries read from stdin.
+    Eval(eval::EvalArgs),
+    /// List every model with its parameters (ranges, defaults, units).
+    Models(models::ModelsArgs),
+    /// Report a model's properties: positivity, reciprocity, isotropy, energy.
+    Check(check::CheckArgs),
+    /// Measure batch evaluation speed on fixed-seed random direction pairs.
+    Bench(bench::BenchArgs),
+}
+
 /// Entry point of the binary.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match crate::app::run(&cli.viewer) {
-        Ok(()) => ExitCode::SUCCESS,
+    let result = match &cli.command {
+        None => crate::app::run(&cli.viewer).map(|()| ExitCode::SUCCESS),
+        Some(Command::Eval(a)) => eval::run(a),
+        Some(Command::Models(a)) => models::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Check(a)) => check::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
+    };
+    match result {
+        Ok(code) => code,
+        // A reader that went away (`bv models | head`) is not an error worth a message.
+        Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("bv: {e:#}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn no_sub_command_means_viewer() {
+        let cli = Cli::try_parse_from(["bv"]).unwrap();
+        assert!(cli.command.is_none());
+    }
+
+    #[test]
+    fn params_are_repeatable() {
+        let cli = Cli::try_parse_from([
+            "bv",
+            "bench",
+            "--model",
+            "lambert",
+            "--param",
+            "albedo=0.2",
+            "-p",
+            "albedo=0.3",
+        ])
+        .unwrap();
+        match cli.command {
+            Some(Command::Bench(b)) => assert_eq!(b.model.params, ["albedo=0.2", "albedo=0.3"]),
+            other => panic!("parsed as {other:?}"),
         }
     }
 }

@@ -94,19 +94,35 @@ fn grid_direction(i: usize, j: usize, n_theta: usize, n_phi: usize, full: bool) 
 }
 
 /// Builds the lobe of `brdf` for light from `wi`. Resolution below 2×3 is raised
-/// to it. Evaluation runs in parallel over rings for large grids.
+/// to it. Rows are evaluated in parallel for large grids; the trigonometry comes
+/// from per-row and per-column tables, so the cost is the model's evaluations
+/// plus a few vector operations per vertex.
 pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
     let n_theta = opts.n_theta.max(2);
     let n_phi = opts.n_phi.max(3);
     let full = brdf.transmits();
     let rows = n_theta + 1;
     let count = rows * n_phi;
+    let parallel = count >= 4096;
+
+    let theta_max = if full { PI } else { FRAC_PI_2 };
+    let ring: Vec<(f64, f64)> = (0..rows)
+        .map(|i| (theta_max * i as f64 / n_theta as f64).sin_cos())
+        .collect();
+    let column: Vec<(f64, f64)> = (0..n_phi)
+        .map(|j| (2.0 * PI * j as f64 / n_phi as f64).sin_cos())
+        .collect();
+    let dir = |i: usize, j: usize| {
+        let (st, ct) = ring[i];
+        let (sp, cp) = column[j];
+        DVec3::new(st * cp, st * sp, ct)
+    };
 
     let mut values = vec![[0f32; 3]; count];
     let mut positions = vec![[0f32; 3]; count];
-    let fill_row = |i: usize, vals: &mut [[f32; 3]], pos: &mut [[f32; 3]]| {
+    let fill_row = |i: usize, (vals, pos): (&mut [[f32; 3]], &mut [[f32; 3]])| {
         for j in 0..n_phi {
-            let wo = grid_direction(i, j, n_theta, n_phi, full);
+            let wo = dir(i, j);
             let mut f: Rgb = brdf.eval(wi, wo);
             if opts.cosine {
                 f *= wo.z.abs();
@@ -121,46 +137,32 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
             pos[j] = (wo * r).as_vec3().to_array();
         }
     };
-    if count >= 4096 {
+    if parallel {
         values
             .par_chunks_mut(n_phi)
             .zip(positions.par_chunks_mut(n_phi))
             .enumerate()
-            .for_each(|(i, (v, p))| fill_row(i, v, p));
+            .for_each(|(i, rows)| fill_row(i, rows));
     } else {
-        for (i, (v, p)) in values
-            .chunks_mut(n_phi)
-            .zip(positions.chunks_mut(n_phi))
-            .enumerate()
-        {
-            fill_row(i, v, p);
+        let rows = values.chunks_mut(n_phi).zip(positions.chunks_mut(n_phi));
+        for (i, rows) in rows.enumerate() {
+            fill_row(i, rows);
         }
     }
 
-    // Two triangles per grid cell; the φ seam wraps.
-    let mut indices = Vec::with_capacity(n_theta * n_phi * 6);
-    for i in 0..n_theta {
-        for j in 0..n_phi {
-            let j1 = (j + 1) % n_phi;
-            let a = (i * n_phi + j) as u32;
-            let b = (i * n_phi + j1) as u32;
-            let c = ((i + 1) * n_phi + j) as u32;
-            let d = ((i + 1) * n_phi + j1) as u32;
-            // θ grows away from the pole and φ counter-clockwise about +z, so
-            // (a, c, d) faces outwards.
-            indices.extend_from_slice(&[a, c, d, a, d, b]);
-        }
-    }
-
-    let normals = vertex_normals(&positions, &indices, &grid_fallback(n_theta, n_phi, full));
+    let indices = grid_indices(n_theta, n_phi, parallel);
+    let normals = grid_normals(&positions, n_theta, n_phi, parallel, |i, j| {
+        dir(i, j).as_vec3()
+    });
     let max_value = values
         .iter()
         .map(|v| mean_rgb(Vec3::from_array(*v).as_dvec3()))
         .fold(0.0, f64::max);
     let max_radius = positions
         .iter()
-        .map(|p| Vec3::from_array(*p).length() as f64)
-        .fold(0.0, f64::max);
+        .map(|p| Vec3::from_array(*p).length_squared())
+        .fold(0.0f32, f32::max)
+        .sqrt() as f64;
 
     LobeMesh {
         positions,
@@ -176,35 +178,95 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
     }
 }
 
-fn grid_fallback(n_theta: usize, n_phi: usize, full: bool) -> Vec<Vec3> {
-    (0..=n_theta)
-        .flat_map(|i| (0..n_phi).map(move |j| grid_direction(i, j, n_theta, n_phi, full).as_vec3()))
-        .collect()
+/// Two triangles per grid cell; the φ seam wraps. θ grows away from the pole
+/// and φ counter-clockwise about +z, so `(a, c, d)` faces outwards.
+fn grid_indices(n_theta: usize, n_phi: usize, parallel: bool) -> Vec<u32> {
+    let mut indices = vec![0u32; n_theta * n_phi * 6];
+    let row = |i: usize, out: &mut [u32]| {
+        for j in 0..n_phi {
+            let j1 = (j + 1) % n_phi;
+            let a = (i * n_phi + j) as u32;
+            let b = (i * n_phi + j1) as u32;
+            let c = ((i + 1) * n_phi + j) as u32;
+            let d = ((i + 1) * n_phi + j1) as u32;
+            out[j * 6..j * 6 + 6].copy_from_slice(&[a, c, d, a, d, b]);
+        }
+    };
+    if parallel {
+        indices
+            .par_chunks_mut(n_phi * 6)
+            .enumerate()
+            .for_each(|(i, out)| row(i, out));
+    } else {
+        for (i, out) in indices.chunks_mut(n_phi * 6).enumerate() {
+            row(i, out);
+        }
+    }
+    indices
 }
 
-/// Area-weighted vertex normals; a vertex with no area around it (a collapsed
+/// Smooth normals from the grid: the cross product of the central differences
+/// along θ and along φ (`∂P/∂θ × ∂P/∂φ` points outwards, as `sinθ e_r` does on a
+/// sphere). On a pole ring, where `∂P/∂φ` vanishes, the normal is the sum of the
+/// fan of triangles around it. A vertex with no area around it (a collapsed
 /// lobe) gets its grid direction, so shading never sees a NaN.
-fn vertex_normals(positions: &[[f32; 3]], indices: &[u32], fallback: &[Vec3]) -> Vec<[f32; 3]> {
-    let mut acc = vec![Vec3::ZERO; positions.len()];
-    for t in indices.chunks_exact(3) {
-        let (a, b, c) = (t[0] as usize, t[1] as usize, t[2] as usize);
-        let pa = Vec3::from_array(positions[a]);
-        let n = (Vec3::from_array(positions[b]) - pa).cross(Vec3::from_array(positions[c]) - pa);
-        acc[a] += n;
-        acc[b] += n;
-        acc[c] += n;
-    }
-    acc.iter()
-        .zip(fallback)
-        .map(|(n, f)| {
-            let l = n.length();
-            if l > 1e-20 && l.is_finite() {
-                (*n / l).to_array()
+fn grid_normals(
+    positions: &[[f32; 3]],
+    n_theta: usize,
+    n_phi: usize,
+    parallel: bool,
+    fallback: impl Fn(usize, usize) -> Vec3 + Sync,
+) -> Vec<[f32; 3]> {
+    let p = |i: usize, j: usize| Vec3::from_array(positions[i * n_phi + j]);
+    let fan = |i: usize, next: usize| {
+        let c = p(i, 0);
+        (0..n_phi)
+            .map(|j| (p(next, j) - c).cross(p(next, (j + 1) % n_phi) - c))
+            .sum::<Vec3>()
+    };
+    // Pole rows: the north pole (row 0) always; the south pole on a full sphere
+    // (its fan winds the other way round).
+    let north = fan(0, 1);
+    let south = -fan(n_theta, n_theta - 1);
+    let is_pole = |i: usize| {
+        let (x, y) = (positions[i * n_phi][0], positions[i * n_phi][1]);
+        x == 0.0 && y == 0.0 && (0..n_phi).all(|j| p(i, j) == p(i, 0))
+    };
+    let north_is_pole = is_pole(0);
+    let south_is_pole = is_pole(n_theta);
+    let normal_row = |i: usize, out: &mut [[f32; 3]]| {
+        for (j, o) in out.iter_mut().enumerate() {
+            let n = if i == 0 && north_is_pole {
+                north
+            } else if i == n_theta && south_is_pole {
+                south
             } else {
-                f.to_array()
-            }
-        })
-        .collect()
+                let up = if i == 0 { p(0, j) } else { p(i - 1, j) };
+                let down = if i == n_theta { p(i, j) } else { p(i + 1, j) };
+                let left = p(i, (j + n_phi - 1) % n_phi);
+                let right = p(i, (j + 1) % n_phi);
+                (down - up).cross(right - left)
+            };
+            let l = n.length();
+            *o = if l > 1e-20 && l.is_finite() {
+                (n / l).to_array()
+            } else {
+                fallback(i, j).to_array()
+            };
+        }
+    };
+    let mut normals = vec![[0f32; 3]; positions.len()];
+    if parallel {
+        normals
+            .par_chunks_mut(n_phi)
+            .enumerate()
+            .for_each(|(i, out)| normal_row(i, out));
+    } else {
+        for (i, out) in normals.chunks_mut(n_phi).enumerate() {
+            normal_row(i, out);
+        }
+    }
+    normals
 }
 
 #[cfg(test)]
@@ -232,6 +294,29 @@ mod tests {
         let n = Vec3::from_array(m.normals[10 * 128 + 5]);
         let p = Vec3::from_array(m.positions[10 * 128 + 5]).normalize();
         assert!(n.dot(p) > 0.99);
+    }
+
+    #[test]
+    fn normals_point_outwards_including_the_pole() {
+        let b = Lambert::new(Rgb::splat(0.5));
+        for (n_theta, n_phi) in [(8, 16), (64, 128)] {
+            let opts = LobeOptions {
+                n_theta,
+                n_phi,
+                ..LobeOptions::default()
+            };
+            let m = build(&b, DVec3::Z, &opts);
+            assert!(Vec3::from_array(m.normals[0]).dot(Vec3::Z) > 0.999_999);
+            // Every ring strictly between the pole and the horizon is on the
+            // sphere of radius 1/(2π): its normal is the radial direction.
+            for i in 1..n_theta - 1 {
+                for j in 0..n_phi {
+                    let n = Vec3::from_array(m.normals[i * n_phi + j]);
+                    let d = m.direction(i, j).as_vec3();
+                    assert!(n.dot(d) > 0.99, "ring {i} column {j}: {n} vs {d}");
+                }
+            }
+        }
     }
 
     #[test]

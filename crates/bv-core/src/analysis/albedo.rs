@@ -234,7 +234,18 @@ pub fn rho_hd_curve(
     samples: usize,
     seed: u64,
 ) -> AlbedoCurve {
-    let thetas = theta_grid(n_theta);
+    rho_hd_angles(brdf, phi_i, &theta_grid(n_theta), samples, seed)
+}
+
+/// ρhd at the given θi (radians) for azimuth `phi_i` (radians), `samples` per
+/// angle, in parallel over the angles.
+pub fn rho_hd_angles(
+    brdf: &dyn Brdf,
+    phi_i: f64,
+    thetas: &[f64],
+    samples: usize,
+    seed: u64,
+) -> AlbedoCurve {
     let rho = thetas
         .par_iter()
         .enumerate()

@@ -82,7 +82,8 @@ impl BlinnPhong {
         if c <= 0.0 {
             return 0.0;
         }
-        sampling::power_cosine_pdf(DVec3::Z, self.e, h) / (4.0 * c)
+        // Floored like the cosine in `eval`: a subnormal wi·h would give ∞.
+        sampling::power_cosine_pdf(DVec3::Z, self.e, h) / (4.0 * c.max(COS_FLOOR))
     }
 }
 

@@ -38,25 +38,42 @@ pub const INFO: ModelInfo = ModelInfo {
     build,
 };
 
-/// The default component list: two Lamberts of different albedo, built without
-/// the registry so that it cannot fail.
-// LEAD: switch default to a diffuse + glossy pair once cook-torrance is merged
-// (e.g. 0.7 · lambert + 0.3 · cook-torrance).
+/// The default component list: the seed's "complex BRDF" as a sum of a
+/// diffuse and a glossy part (0.6 · orange Lambert + 0.4 · pure-specular GGX
+/// Cook-Torrance), built from the declarations directly so that it cannot fail.
 fn default_components() -> Vec<Component> {
-    let lambert = |weight: f64, albedo: [f64; 3]| {
-        let mut params = Params::defaults(super::lambert::PARAMS);
-        params
-            .0
-            .insert("albedo".to_string(), ParamValue::Color(albedo));
+    let component = |weight: f64, info: &ModelInfo, set: &[(&str, ParamValue)]| {
+        let mut params = Params::defaults(info.params);
+        for (k, v) in set {
+            params.0.insert((*k).to_string(), v.clone());
+        }
         Component {
             weight,
             spec: ModelSpec {
-                model: super::lambert::INFO.id.to_string(),
+                model: info.id.to_string(),
                 params,
             },
         }
     };
-    vec![lambert(0.7, [0.8, 0.8, 0.8]), lambert(0.3, [0.8, 0.3, 0.1])]
+    vec![
+        component(
+            0.6,
+            &super::lambert::INFO,
+            &[("albedo", ParamValue::Color([0.8, 0.3, 0.1]))],
+        ),
+        component(
+            0.4,
+            &super::cook_torrance::INFO,
+            &[
+                ("kd", ParamValue::Color([0.0; 3])),
+                ("ks", ParamValue::Float(1.0)),
+                ("distribution", ParamValue::Text("ggx".into())),
+                ("geometry", ParamValue::Text("smith-correlated".into())),
+                ("alpha_x", ParamValue::Float(0.2)),
+                ("alpha_y", ParamValue::Float(0.2)),
+            ],
+        ),
+    ]
 }
 
 /// One weighted, built component.
@@ -431,19 +448,18 @@ mod tests {
     }
 
     #[test]
-    fn default_is_two_lamberts_and_round_trips() {
+    fn default_is_diffuse_plus_glossy_and_round_trips() {
         let spec = ModelSpec::new("mix").unwrap();
         let comps = spec.params.components("components").unwrap();
         assert_eq!(comps.len(), 2);
         assert!(comps.iter().all(|c| registry::find(&c.spec.model).is_ok()));
         let b = spec.build().unwrap();
-        // 0.7 · 0.8/π + 0.3 · (0.8, 0.3, 0.1)/π.
-        let want = Rgb::new(
-            0.7 * 0.8 + 0.3 * 0.8,
-            0.7 * 0.8 + 0.3 * 0.3,
-            0.7 * 0.8 + 0.3 * 0.1,
-        ) / PI;
-        assert!(rel_close(b.eval(DVec3::Z, DVec3::Z), want, 1e-15));
+        // Lambert part 0.6 · (0.8, 0.3, 0.1)/π. At wi = wo = n the GGX part is
+        // F(1) D(n) G / 4 with F(1) = ((1.5 − 1)/(1.5 + 1))² = 0.04 (the default
+        // dielectric), D(n) = 1/(π α²) = 1/(0.04 π), G = 1: exactly 1/(4π),
+        // weighted by 0.4.
+        let want = (Rgb::new(0.8, 0.3, 0.1) * 0.6 + Rgb::splat(0.4 / 4.0)) / PI;
+        assert!(rel_close(b.eval(DVec3::Z, DVec3::Z), want, 1e-12));
         assert!(b.claims().energy_conserving);
         let back = ModelSpec::from_json("mix", &spec.to_json()["params"]).unwrap();
         assert_eq!(back, spec);

@@ -5,26 +5,40 @@
 use crate::registry::ModelInfo;
 
 pub mod ashikhmin_shirley;
+pub mod banks;
 pub mod blinn_phong;
+pub mod cook_torrance;
+pub mod disney;
+pub mod glass;
 pub mod hapke;
+pub mod lafortune;
 pub mod lambert;
 pub mod lobes;
+pub mod mirror;
 pub mod mix;
 pub mod modified_phong;
 pub mod oren_nayar;
 pub mod phong;
+pub mod ward;
 
 #[cfg(test)]
 pub(crate) mod testkit;
 
-/// Every model, in presentation order.
+/// Every model, in presentation order (SPEC §2).
 pub static CATALOGUE: &[&ModelInfo] = &[
     &lambert::INFO,
     &phong::INFO,
     &blinn_phong::INFO,
     &modified_phong::INFO,
+    &ward::INFO,
+    &lafortune::INFO,
+    &banks::INFO,
+    &cook_torrance::INFO,
     &ashikhmin_shirley::INFO,
     &oren_nayar::INFO,
     &hapke::INFO,
+    &disney::INFO,
+    &mirror::INFO,
+    &glass::INFO,
     &mix::INFO,
 ];

@@ -1,0 +1,161 @@
+//! Speed of every model of the catalogue (issue 2): evaluations per second on
+//! one core, lobe mesh construction, and ρhd curves.
+//!
+//! Targets reported against (never asserted: machines are noisy): a lobe mesh
+//! of 128 × 256 in ≤ 1 ms for every analytic model, Cook-Torrance GGX at
+//! ≥ 50 M evaluations/s on one core.
+//!
+//! Run: `cargo bench -p bv-core -- --quick` (or a filter such as `eval/`).
+
+use bv_core::analysis::albedo;
+use bv_core::lobe::{self, LobeOptions};
+use bv_core::params::ParamKind;
+use bv_core::{Brdf, ModelInfo, ModelSpec, Rgb, catalogue, frame, sampling};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::DVec3;
+use std::hint::black_box;
+use std::time::Duration;
+
+/// Pairs per evaluation batch.
+const PAIRS: usize = 1_000_000;
+
+/// Fixed-seed pairs of directions drawn uniformly on the upper hemisphere
+/// (the same pairs for every model and every run).
+fn random_pairs(n: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
+    let mut rng = sampling::rng(seed);
+    (0..n)
+        .map(|_| {
+            let wi = sampling::uniform_hemisphere(sampling::uniform2(&mut rng));
+            let wo = sampling::uniform_hemisphere(sampling::uniform2(&mut rng));
+            (wi, wo)
+        })
+        .collect()
+}
+
+/// Measured models read a file; everything else is analytic.
+fn analytic(m: &ModelInfo) -> bool {
+    !m.params
+        .iter()
+        .any(|d| matches!(d.kind, ParamKind::Path { .. }))
+}
+
+/// A MERL-format table of the public set's size (90 × 90 × 180, SPEC §4)
+/// with smooth made-up values, for measured models whose defaults name no
+/// file: lookup speed does not depend on the data.
+fn synthetic_table() -> String {
+    static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    PATH.get_or_init(write_synthetic_table).clone()
+}
+
+fn write_synthetic_table() -> String {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+    let path = dir.join("bv-bench-90x90x180.binary");
+    let tmp = dir.join(format!("bv-bench-90x90x180.binary.{}", std::process::id()));
+    let dims = [90i32, 90, 180];
+    let n = (dims[0] * dims[1] * dims[2]) as usize;
+    let mut bytes = Vec::with_capacity(12 + 24 * n);
+    for d in dims {
+        bytes.extend_from_slice(&d.to_le_bytes());
+    }
+    for c in 0..3 {
+        for i in 0..n {
+            let v = 100.0 + 50.0 * ((i as f64) * 1e-3 + c as f64).sin();
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    // A private name, then a rename: a concurrent run never reads half a file.
+    if let Err(e) = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path)) {
+        eprintln!("cannot write {}: {e}", path.display());
+    }
+    path.to_string_lossy().into_owned()
+}
+
+/// Every model of the catalogue with its defaults (a measured model whose
+/// defaults name no file reads a synthetic table), plus Cook-Torrance with GGX.
+fn models() -> Vec<(String, &'static ModelInfo, Box<dyn Brdf>)> {
+    let mut out = Vec::new();
+    for &m in catalogue() {
+        let built = ModelSpec::new(m.id).and_then(|mut s| {
+            if !analytic(m) {
+                for d in m.params {
+                    if matches!(d.kind, ParamKind::Path { .. }) {
+                        s.set_json(d.id, &serde_json::Value::String(synthetic_table()))?;
+                    }
+                }
+            }
+            s.build()
+        });
+        match built {
+            Ok(b) => out.push((m.id.to_string(), m, b)),
+            Err(e) => eprintln!("skipping `{}`: {e}", m.id),
+        }
+    }
+    if let Ok(m) = bv_core::find("cook-torrance") {
+        let spec = ModelSpec::from_json(m.id, &serde_json::json!({"distribution": "ggx"}));
+        match spec.and_then(|s| s.build()) {
+            Ok(b) => out.push(("cook-torrance-ggx".to_string(), m, b)),
+            Err(e) => eprintln!("skipping cook-torrance with GGX: {e}"),
+        }
+    }
+    out
+}
+
+fn eval(c: &mut Criterion) {
+    let pairs = random_pairs(PAIRS, 0xB5);
+    let mut out = vec![Rgb::ZERO; PAIRS];
+    let mut g = c.benchmark_group("eval");
+    g.throughput(Throughput::Elements(PAIRS as u64));
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_millis(500));
+    g.measurement_time(Duration::from_secs(2));
+    for (name, _, b) in models() {
+        // One core: eval_batch is a plain loop on the calling thread.
+        g.bench_function(&name, |bench| {
+            bench.iter(|| {
+                b.eval_batch(black_box(&pairs), &mut out);
+                black_box(&out);
+            })
+        });
+    }
+    g.finish();
+}
+
+fn lobes(c: &mut Criterion) {
+    let wi = frame::from_spherical(45f64.to_radians(), 0.3);
+    let mut g = c.benchmark_group("lobe");
+    g.warm_up_time(Duration::from_millis(300));
+    g.measurement_time(Duration::from_secs(1));
+    for (name, m, b) in models() {
+        if !analytic(m) {
+            continue;
+        }
+        for (n_theta, n_phi) in [(64, 128), (128, 256)] {
+            let opts = LobeOptions {
+                n_theta,
+                n_phi,
+                ..LobeOptions::default()
+            };
+            g.bench_function(format!("{name}/{n_theta}x{n_phi}"), |bench| {
+                bench.iter(|| black_box(lobe::build(b.as_ref(), black_box(wi), &opts)))
+            });
+        }
+    }
+    g.finish();
+}
+
+fn albedo_curves(c: &mut Criterion) {
+    let mut g = c.benchmark_group("rho_hd_curve");
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_millis(300));
+    g.measurement_time(Duration::from_secs(1));
+    for (name, _, b) in models() {
+        // 90 angles × 4096 samples, as `bv check` does by default.
+        g.bench_function(format!("{name}/90x4096"), |bench| {
+            bench.iter(|| black_box(albedo::rho_hd_curve(b.as_ref(), 0.0, 90, 4096, 1)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, eval, lobes, albedo_curves);
+criterion_main!(benches);

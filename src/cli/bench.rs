@@ -1,0 +1,237 @@
+//! `bv bench`: batch evaluation speed of one model on fixed-seed random
+//! direction pairs (SPEC §5). Prints `<number> M evals/s`.
+//!
+//! The pairs are drawn once, uniformly on the upper hemisphere, from
+//! [`bv_core::sampling::rng`] with a fixed seed, so every run evaluates the same
+//! pairs. They are split into chunks that a rayon pool of `--threads` workers
+//! hands to [`Brdf::eval_batch`]. One untimed pass warms up (threads started,
+//! output pages touched, caches filled); then passes are timed until at least
+//! [`MIN_TIMED`] has elapsed, so that small `--pairs` still give a stable rate.
+
+use super::output::print;
+use super::params::ModelArgs;
+use anyhow::Context;
+use bv_core::{Brdf, Rgb, sampling};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Seed of the benchmark pairs (fixed: every run evaluates the same pairs).
+pub const SEED: u64 = 0x6276_6265_6e63_6801;
+
+/// Pairs handed to one `eval_batch` call: large enough to amortise the call
+/// and scheduling, small enough to balance the work across threads.
+pub const CHUNK: usize = 4096;
+
+/// Most pairs accepted (each costs 72 bytes: two directions and a result).
+pub const MAX_PAIRS: usize = 50_000_000;
+
+/// Shortest total timed duration; passes repeat until it is reached.
+pub const MIN_TIMED: Duration = Duration::from_millis(200);
+
+/// Options of `bv bench`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BenchArgs {
+    /// The model and its parameters.
+    #[command(flatten)]
+    pub model: ModelArgs,
+
+    /// Number of random direction pairs (an integer, or e.g. 1e6).
+    #[arg(long, value_name = "N", default_value = "1e6", value_parser = parse_count)]
+    pub pairs: usize,
+
+    /// Worker threads [default: all cores].
+    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u16).range(1..=1024))]
+    pub threads: Option<u16>,
+
+    /// Print JSON instead of one line of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Parses a pair count: `1000`, `1e6` or `2.5e5` (a whole number from 1 to
+/// [`MAX_PAIRS`]).
+pub fn parse_count(s: &str) -> Result<usize, String> {
+    let s = s.trim().replace('_', "");
+    let n = match s.parse::<usize>() {
+        Ok(n) => n as f64,
+        Err(_) => s
+            .parse::<f64>()
+            .map_err(|_| format!("`{s}` is not a number"))?,
+    };
+    if !(n.is_finite() && n.fract() == 0.0) {
+        return Err(format!("`{s}` is not a whole number"));
+    }
+    if n < 1.0 || n > MAX_PAIRS as f64 {
+        return Err(format!("{s} is outside 1..={MAX_PAIRS}"));
+    }
+    Ok(n as usize)
+}
+
+/// What one benchmark measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchResult {
+    /// Pairs per pass.
+    pub pairs: usize,
+    /// Worker threads.
+    pub threads: usize,
+    /// Timed passes over all pairs.
+    pub passes: usize,
+    /// Timed duration.
+    pub seconds: f64,
+    /// Results that were NaN or infinite (a model bug when non-zero).
+    pub non_finite: usize,
+}
+
+impl BenchResult {
+    /// Evaluations per second.
+    pub fn rate(&self) -> f64 {
+        (self.pairs * self.passes) as f64 / self.seconds.max(1e-9)
+    }
+}
+
+/// The benchmark's direction pairs: `n` pairs, both directions uniform on the
+/// upper hemisphere, from the fixed [`SEED`].
+pub fn random_pairs(n: usize) -> Vec<(DVec3, DVec3)> {
+    let mut rng = sampling::rng(SEED);
+    (0..n)
+        .map(|_| {
+            let wi = sampling::uniform_hemisphere(sampling::uniform2(&mut rng));
+            let wo = sampling::uniform_hemisphere(sampling::uniform2(&mut rng));
+            (wi, wo)
+        })
+        .collect()
+}
+
+/// Times batch evaluation of `brdf` on `pairs` with `threads` workers.
+pub fn measure(
+    brdf: &dyn Brdf,
+    pairs: &[(DVec3, DVec3)],
+    threads: usize,
+    min_timed: Duration,
+) -> anyhow::Result<BenchResult> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("could not start the worker threads")?;
+    let mut out = vec![Rgb::ZERO; pairs.len()];
+    let pass = |out: &mut [Rgb]| {
+        pool.install(|| {
+            pairs
+                .par_chunks(CHUNK)
+                .zip(out.par_chunks_mut(CHUNK))
+                .for_each(|(p, o)| brdf.eval_batch(p, o));
+        });
+        std::hint::black_box(&*out);
+    };
+    pass(&mut out);
+    let start = Instant::now();
+    let mut passes = 0;
+    loop {
+        pass(&mut out);
+        passes += 1;
+        if start.elapsed() >= min_timed {
+            break;
+        }
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let non_finite = out.iter().filter(|f| !f.is_finite()).count();
+    Ok(BenchResult {
+        pairs: pairs.len(),
+        threads,
+        passes,
+        seconds,
+        non_finite,
+    })
+}
+
+/// Runs `bv bench`.
+pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
+    let spec = args.model.spec()?;
+    let brdf = spec
+        .build()
+        .with_context(|| format!("building model `{}`", spec.model))?;
+    let threads = match args.threads {
+        Some(t) => usize::from(t),
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let pairs = random_pairs(args.pairs);
+    let r = measure(brdf.as_ref(), &pairs, threads, MIN_TIMED)?;
+    if r.non_finite > 0 {
+        eprintln!(
+            "bv bench: warning: {} of {} results were not finite (a bug in model `{}`)",
+            r.non_finite, r.pairs, spec.model
+        );
+    }
+    let rate = r.rate();
+    let text = if args.json {
+        let v = serde_json::json!({
+            "model": spec.model,
+            "params": spec.params.to_json(),
+            "pairs": r.pairs,
+            "threads": r.threads,
+            "passes": r.passes,
+            "seconds": r.seconds,
+            "evals_per_second": rate,
+            "m_evals_per_second": rate / 1e6,
+            "non_finite": r.non_finite,
+        });
+        format!("{v}\n")
+    } else {
+        let s = |n: usize| if n == 1 { "" } else { "s" };
+        format!(
+            "{:.*} M evals/s (model {}, {} pair{}, {} thread{}, {} pass{} in {:.3} s)\n",
+            // Slow models (below 1 M evals/s) keep three significant digits.
+            if rate >= 1e6 { 2 } else { 4 },
+            rate / 1e6,
+            spec.model,
+            r.pairs,
+            s(r.pairs),
+            r.threads,
+            s(r.threads),
+            r.passes,
+            if r.passes == 1 { "" } else { "es" },
+            r.seconds
+        )
+    };
+    print(&text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_in_both_notations() {
+        assert_eq!(parse_count("1000"), Ok(1000));
+        assert_eq!(parse_count("1e6"), Ok(1_000_000));
+        assert_eq!(parse_count("2.5e3"), Ok(2500));
+        assert_eq!(parse_count("1_000"), Ok(1000));
+        for bad in ["0", "-5", "1.5", "abc", "1e300", "inf", "NaN", ""] {
+            assert!(parse_count(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn pairs_are_fixed_and_on_the_upper_hemisphere() {
+        let a = random_pairs(100);
+        assert_eq!(a, random_pairs(100));
+        for (wi, wo) in a {
+            for w in [wi, wo] {
+                assert!((w.length() - 1.0).abs() < 1e-12 && w.z >= 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn measure_evaluates_every_pair() {
+        let brdf = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
+        let pairs = random_pairs(10_000);
+        let r = measure(brdf.as_ref(), &pairs, 2, Duration::ZERO).unwrap();
+        assert_eq!(
+            (r.pairs, r.threads, r.passes, r.non_finite),
+            (10_000, 2, 1, 0)
+        );
+        assert!(r.rate() > 0.0 && r.rate().is_finite());
+    }
+}
