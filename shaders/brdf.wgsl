@@ -12,6 +12,13 @@
 #import bv::models::ashikhmin_shirley
 #import bv::models::oren_nayar
 #import bv::models::hapke
+#import bv::models::ward
+#import bv::models::lafortune
+#import bv::models::banks
+#import bv::models::cook_torrance
+#import bv::models::disney
+#import bv::models::mirror
+#import bv::models::glass
 
 // A model that is not a mix. Unknown indices (a model without a port) give 0,
 // which the parity test reports as a failure.
@@ -24,6 +31,14 @@ fn eval_leaf(model: u32, o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         case L::MODEL_ASHIKHMIN_SHIRLEY: { return ashikhmin_shirley::eval(o, wi, wo); }
         case L::MODEL_OREN_NAYAR: { return oren_nayar::eval(o, wi, wo); }
         case L::MODEL_HAPKE: { return hapke::eval(o, wi, wo); }
+        case L::MODEL_WARD: { return ward::eval(o, wi, wo); }
+        case L::MODEL_LAFORTUNE: { return lafortune::eval(o, wi, wo); }
+        case L::MODEL_BANKS: { return banks::eval(o, wi, wo); }
+        case L::MODEL_COOK_TORRANCE: { return cook_torrance::eval(o, wi, wo); }
+        case L::MODEL_DISNEY: { return disney::eval(o, wi, wo); }
+        // Delta models: 0 at every finite pair (their lobes are in env.wgsl).
+        case L::MODEL_MIRROR: { return mirror::eval(o, wi, wo); }
+        case L::MODEL_GLASS: { return glass::eval(o, wi, wo); }
         default: { return vec3<f32>(0.0); }
     }
 }

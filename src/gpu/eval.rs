@@ -1,10 +1,10 @@
 //! Batch evaluation of a model on the GPU (the parity test's compute pass, also
 //! usable by any tool that wants GPU values of f).
 
+use super::pack::pack;
 use super::{Gpu, shaders::ShaderLibrary};
 use anyhow::Result;
 use bv_core::ModelSpec;
-use bv_core::params::pack_model;
 use wgpu::util::DeviceExt;
 
 /// Evaluates packed models on batches of direction pairs with the `parity`
@@ -43,7 +43,7 @@ impl GpuEvaluator {
     /// `f(wi, wo)` of `spec` for every pair, computed by the WGSL port in f32.
     pub fn eval(&self, spec: &ModelSpec, pairs: &[([f32; 3], [f32; 3])]) -> Result<Vec<[f32; 3]>> {
         let mut params = Vec::new();
-        let r = pack_model(spec, &mut params)?;
+        let r = pack(spec, &mut params)?;
         if params.is_empty() {
             params.push(0.0);
         }

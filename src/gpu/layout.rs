@@ -111,4 +111,25 @@ mod tests {
         assert!(src.contains("const MODIFIED_PHONG_SIZE: u32 = 7u;"));
         assert_eq!(ident("cook-torrance"), "COOK_TORRANCE");
     }
+
+    #[test]
+    fn shared_modules_may_use_cook_torrance_choice_indices() {
+        // shaders/common/fresnel.wgsl and microfacet.wgsl take the option
+        // indices from cook-torrance's layout; every other model with a Fresnel
+        // choice must list the same options in the same order.
+        let options =
+            |model: &str, id: &str| match bv_core::find(model).unwrap().param(id).unwrap().kind {
+                bv_core::ParamKind::Choice { options, .. } => options,
+                _ => panic!("{model}.{id} is not a choice"),
+            };
+        for m in bv_core::catalogue() {
+            if let Ok(d) = m.param("fresnel") {
+                assert!(matches!(d.kind, bv_core::ParamKind::Choice { .. }));
+                assert_eq!(
+                    options(m.id, "fresnel"),
+                    options("cook-torrance", "fresnel")
+                );
+            }
+        }
+    }
 }

@@ -9,6 +9,7 @@
 pub mod context;
 pub mod eval;
 pub mod layout;
+pub mod pack;
 pub mod shaders;
 
 pub use context::{Gpu, gpu_for_test};

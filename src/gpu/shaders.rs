@@ -39,6 +39,13 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("models/ashikhmin_shirley.wgsl"),
     shader!("models/oren_nayar.wgsl"),
     shader!("models/hapke.wgsl"),
+    shader!("models/ward.wgsl"),
+    shader!("models/lafortune.wgsl"),
+    shader!("models/banks.wgsl"),
+    shader!("models/cook_torrance.wgsl"),
+    shader!("models/disney.wgsl"),
+    shader!("models/mirror.wgsl"),
+    shader!("models/glass.wgsl"),
     shader!("brdf.wgsl"),
 ];
 

@@ -30,6 +30,11 @@
 //! leaf models with the products of the weights along the path. A shader can
 //! then evaluate a mix with one loop and no recursion (WGSL has none).
 //!
+//! Derived slots ([`pack_model_with`]): a renderer may store, right after a
+//! model's block, quantities computed from its parameters by bv-core's own
+//! functions (e.g. Blinn's normalisation constant, a quadrature), so that the
+//! shader reads them instead of recomputing them per evaluation.
+//!
 //! All integers (counts, indices, offsets) are stored as `f32`, which
 //! represents every integer up to 2²⁴ exactly; [`pack_model`] refuses buffers
 //! that would grow beyond that.
@@ -183,10 +188,30 @@ fn to_slot(x: usize) -> Result<f32> {
 /// Values are stored as `f32` (rounded to nearest). Mixes are flattened into a
 /// table of leaf models (module docs), each leaf's block appended after the table.
 pub fn pack_model(spec: &ModelSpec, buf: &mut Vec<f32>) -> Result<GpuModelRef> {
-    pack_nested(spec, buf, 0)
+    pack_model_with(spec, buf, &mut |_| Ok(Vec::new()))
 }
 
-fn pack_nested(spec: &ModelSpec, buf: &mut Vec<f32>, depth: usize) -> Result<GpuModelRef> {
+/// Quantities a shader needs that are not parameters but functions of them,
+/// computed once on the CPU (by bv-core's own code) rather than per evaluation:
+/// called for every packed model (mix leaves included); what it returns is
+/// stored right after the model's block, at offset `gpu_layout(..).size`.
+pub type DerivedSlots<'a> = dyn FnMut(&ModelSpec) -> Result<Vec<f32>> + 'a;
+
+/// [`pack_model`] with derived slots after each model's block.
+pub fn pack_model_with(
+    spec: &ModelSpec,
+    buf: &mut Vec<f32>,
+    derived: &mut DerivedSlots<'_>,
+) -> Result<GpuModelRef> {
+    pack_nested(spec, buf, 0, derived)
+}
+
+fn pack_nested(
+    spec: &ModelSpec,
+    buf: &mut Vec<f32>,
+    depth: usize,
+    derived: &mut DerivedSlots<'_>,
+) -> Result<GpuModelRef> {
     let info = registry::find(&spec.model)?;
     let model = gpu_model_index(info.id)?;
     let layout = gpu_layout(info.params);
@@ -197,6 +222,11 @@ fn pack_nested(spec: &ModelSpec, buf: &mut Vec<f32>, depth: usize) -> Result<Gpu
     buf.resize(offset + layout.size as usize, 0.0);
     let mut deferred = Vec::new();
     write_block(&layout, &spec.params, buf, offset, &mut deferred)?;
+    let extra = derived(spec)?;
+    if buf.len() + extra.len() >= MAX_SLOTS {
+        return Err(too_big());
+    }
+    buf.extend_from_slice(&extra);
     // Components: flatten into (weight, leaf) pairs, then write the table and
     // the leaves' blocks after this model's block.
     for (slot, components) in deferred {
@@ -207,7 +237,7 @@ fn pack_nested(spec: &ModelSpec, buf: &mut Vec<f32>, depth: usize) -> Result<Gpu
         buf[slot + 1] = to_slot(table)?;
         buf.resize(table + leaves.len() * COMPONENT_ENTRY_SLOTS as usize, 0.0);
         for (j, (w, leaf)) in leaves.iter().enumerate() {
-            let r = pack_nested(leaf, buf, depth + 1)?;
+            let r = pack_nested(leaf, buf, depth + 1, derived)?;
             let e = table + j * COMPONENT_ENTRY_SLOTS as usize;
             buf[e] = *w as f32;
             buf[e + 1] = r.model as f32;
