@@ -116,3 +116,107 @@ pub fn gpu_for_test() -> Option<Gpu> {
         ),
     }
 }
+
+impl Gpu {
+    /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image.
+    pub fn read_rgba8(&self, texture: &wgpu::Texture) -> Result<image::RgbaImage> {
+        let (w, h) = (texture.width(), texture.height());
+        let row = 4 * w;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let size = u64::from(padded) * u64::from(h);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read_buffer(&buffer, size)?;
+        let mut pixels = Vec::with_capacity((row * h) as usize);
+        for y in 0..h as usize {
+            let start = y * padded as usize;
+            pixels.extend_from_slice(&bytes[start..start + row as usize]);
+        }
+        image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
+    }
+}
+
+/// An offscreen colour target that is re-created only when its size changes.
+#[derive(Debug)]
+pub struct Target {
+    /// The texture (`Rgba8Unorm`, sRGB-encoded values; render attachment,
+    /// texture binding and copy source, so that a GUI can show it directly).
+    pub texture: wgpu::Texture,
+    /// Its default view.
+    pub view: wgpu::TextureView,
+}
+
+/// Format of every offscreen target (values are already sRGB-encoded by the shaders).
+pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+impl Target {
+    /// A target of the given size (at least 1×1, at most the device's limit).
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            anyhow::bail!("image size {width}×{height} is outside 1..={max} on this device");
+        }
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("bv target"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: TARGET_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        Ok(Self { texture, view })
+    }
+
+    /// Keeps `slot`'s target if it has the size, else makes a new one.
+    pub fn ensure<'a>(
+        slot: &'a mut Option<Target>,
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+    ) -> Result<&'a Target> {
+        let fits = slot
+            .as_ref()
+            .is_some_and(|t| t.texture.width() == width && t.texture.height() == height);
+        if !fits {
+            *slot = Some(Target::new(gpu, width, height)?);
+        }
+        slot.as_ref().context("target")
+    }
+}

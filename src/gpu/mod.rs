@@ -7,10 +7,15 @@
 //! ([`bv_core::params::gpu_layout`], [`bv_core::params::pack_model`]).
 
 pub mod context;
+pub mod display;
 pub mod eval;
 pub mod layout;
+pub mod lit_sphere;
 pub mod pack;
 pub mod shaders;
+pub mod sphere;
 
-pub use context::{Gpu, gpu_for_test};
+pub use context::{Gpu, Target, gpu_for_test};
+pub use display::ToneMap;
 pub use eval::GpuEvaluator;
+pub use lit_sphere::{Background, LitSphereRenderer, LitSphereSettings};

@@ -32,6 +32,8 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("common/frame.wgsl"),
     shader!("common/fresnel.wgsl"),
     shader!("common/microfacet.wgsl"),
+    shader!("common/display.wgsl"),
+    shader!("common/sphere.wgsl"),
     shader!("models/lambert.wgsl"),
     shader!("models/phong.wgsl"),
     shader!("models/blinn_phong.wgsl"),
@@ -50,7 +52,10 @@ pub const MODULES: &[(&str, &str)] = &[
 ];
 
 /// Entry shaders (with entry points): (name, (path, source)).
-pub const ENTRIES: &[(&str, (&str, &str))] = &[("parity", shader!("parity.wgsl"))];
+pub const ENTRIES: &[(&str, (&str, &str))] = &[
+    ("parity", shader!("parity.wgsl")),
+    ("lit_sphere", shader!("lit_sphere.wgsl")),
+];
 
 /// A composer holding every module of `shaders/`.
 pub struct ShaderLibrary {
