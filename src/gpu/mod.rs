@@ -8,6 +8,7 @@
 
 pub mod context;
 pub mod display;
+pub mod env;
 pub mod eval;
 pub mod layout;
 pub mod lit_sphere;
@@ -17,5 +18,6 @@ pub mod sphere;
 
 pub use context::{Gpu, Target, gpu_for_test};
 pub use display::ToneMap;
+pub use env::{EnvRenderer, EnvSettings, EnvironmentMap};
 pub use eval::GpuEvaluator;
 pub use lit_sphere::{Background, LitSphereRenderer, LitSphereSettings};

@@ -34,6 +34,8 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("common/microfacet.wgsl"),
     shader!("common/display.wgsl"),
     shader!("common/sphere.wgsl"),
+    shader!("common/sampling.wgsl"),
+    shader!("common/envmap.wgsl"),
     shader!("models/lambert.wgsl"),
     shader!("models/phong.wgsl"),
     shader!("models/blinn_phong.wgsl"),
@@ -49,12 +51,15 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("models/mirror.wgsl"),
     shader!("models/glass.wgsl"),
     shader!("brdf.wgsl"),
+    shader!("brdf_sampling.wgsl"),
 ];
 
 /// Entry shaders (with entry points): (name, (path, source)).
 pub const ENTRIES: &[(&str, (&str, &str))] = &[
     ("parity", shader!("parity.wgsl")),
     ("lit_sphere", shader!("lit_sphere.wgsl")),
+    ("env", shader!("env.wgsl")),
+    ("env_display", shader!("env_display.wgsl")),
 ];
 
 /// A composer holding every module of `shaders/`.
