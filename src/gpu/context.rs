@@ -198,7 +198,9 @@ impl Target {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
+            // A GUI that samples through an sRGB view (decoding to linear) may
+            // create one of the same texture.
+            view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
         });
         let view = texture.create_view(&Default::default());
         Ok(Self { texture, view })
