@@ -25,7 +25,9 @@ pub fn from_spherical(theta: f64, phi: f64) -> DVec3 {
 /// Polar angle θ ∈ [0, π] and azimuth φ ∈ (−π, π] of a unit direction.
 #[inline]
 pub fn to_spherical(w: DVec3) -> (f64, f64) {
-    let theta = w.z.clamp(-1.0, 1.0).acos();
+    // atan2 rather than acos(z): acos loses half the digits near the poles
+    // (θ ≈ √(2(1 − z))), exactly where MERL's √θh index mapping is steepest.
+    let theta = (w.x * w.x + w.y * w.y).sqrt().atan2(w.z);
     let phi = w.y.atan2(w.x);
     (theta, phi)
 }
@@ -77,7 +79,9 @@ pub fn half_vector(wi: DVec3, wo: DVec3) -> Option<DVec3> {
     let h = wi + wo;
     let l2 = h.length_squared();
     if l2 > 1e-24 && l2.is_finite() {
-        Some(h / l2.sqrt())
+        // One division and three products (not three divisions): this sits on
+        // every microfacet model's hot path.
+        Some(h * (1.0 / l2.sqrt()))
     } else {
         None
     }

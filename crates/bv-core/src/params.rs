@@ -503,6 +503,9 @@ pub fn cli_text_to_json(decl: &ParamDecl, text: &str) -> Result<Value> {
             .trim()
             .parse()
             .map_err(|_| bad(format!("`{s}` is not a number")))?;
+        if !x.is_finite() {
+            return Err(bad(format!("`{s}` is not a finite number")));
+        }
         Ok(json_number(x))
     };
     match decl.kind {
@@ -737,5 +740,7 @@ mod tests {
             json!([0.2, 0.92, 1.1])
         );
         assert!(cli_text_to_json(&DECLS[0], "abc").is_err());
+        let nan = cli_text_to_json(&DECLS[0], "nan").unwrap_err().to_string();
+        assert_eq!(nan, "parameter `e`: `nan` is not a finite number");
     }
 }
