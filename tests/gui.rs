@@ -622,10 +622,18 @@ fn render_window_states() {
         ("default", vec![]),
         ("log_cos", vec![Command::ToggleLog, Command::ToggleCosine]),
         ("wireframe", vec![Command::ToggleWireframe]),
-        ("light", vec![Command::SetTheme(bv::app::state::Theme::Light)]),
+        (
+            "light",
+            vec![Command::SetTheme(bv::app::state::Theme::Light)],
+        ),
         ("help", vec![Command::ToggleHelp]),
         ("lobe_max", vec![Command::Maximise(Some("lobe".into()))]),
-        ("theta_h", vec![Command::SetCartesianAxis(bv::app::state::CartesianAxis::ThetaH)]),
+        (
+            "theta_h",
+            vec![Command::SetCartesianAxis(
+                bv::app::state::CartesianAxis::ThetaH,
+            )],
+        ),
     ];
     for (name, cmds) in variants {
         let mut h = gpu_builder()

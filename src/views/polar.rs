@@ -159,7 +159,10 @@ impl View for PolarView {
             for k in 1..=4 {
                 // On the log scale the rings stand at round values of f.
                 let r = if log {
-                    radius(curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2), log)
+                    radius(
+                        curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2),
+                        log,
+                    )
                 } else {
                     outer * k as f64 / 4.0
                 };
