@@ -86,6 +86,13 @@ fn add_a_brdf_by_its_label_and_remove_it() {
     assert_eq!(h.state().state().brdfs.len(), 1);
     assert!(h.query_by_label(&format!("Remove {second}")).is_none());
     assert!(lobe(&h).mesh(ids[1]).is_none(), "its mesh is dropped");
+
+    // Removing the last one leaves an empty, working window.
+    h.get_by_label(&format!("Remove {}", first.name)).click();
+    h.run();
+    assert!(h.state().state().brdfs.is_empty());
+    assert_eq!(h.state().state().selected, None);
+    h.get_by_label("Add BRDF");
 }
 
 #[test]
