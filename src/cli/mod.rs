@@ -14,9 +14,11 @@
 pub mod bench;
 pub mod check;
 pub mod eval;
+pub mod info;
 pub mod models;
 pub mod output;
 pub mod params;
+pub mod tabulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -56,6 +58,10 @@ pub enum Command {
     Check(check::CheckArgs),
     /// Measure batch evaluation speed on fixed-seed random direction pairs.
     Bench(bench::BenchArgs),
+    /// Sample a model into a MERL-layout .binary table.
+    Tabulate(tabulate::TabulateArgs),
+    /// Describe a MERL .binary file: dimensions, ranges, ρhd, reciprocity.
+    Info(info::InfoArgs),
 }
 
 /// Entry point of the binary.
@@ -67,6 +73,8 @@ pub fn main() -> ExitCode {
         Some(Command::Models(a)) => models::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Check(a)) => check::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Tabulate(a)) => tabulate::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

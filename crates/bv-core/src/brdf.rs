@@ -96,4 +96,16 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
             *o = self.eval(wi, wo);
         }
     }
+
+    /// The measured table behind a tabulated model (`merl`) and its lookup
+    /// mode, for views that upload the table to the GPU. `None` for analytic
+    /// models.
+    fn measured(
+        &self,
+    ) -> Option<(
+        &std::sync::Arc<crate::measured::MerlTable>,
+        crate::measured::Interpolation,
+    )> {
+        None
+    }
 }

@@ -17,10 +17,12 @@ pub mod error;
 pub mod frame;
 pub mod fresnel;
 pub mod lobe;
+pub mod measured;
 pub mod microfacet;
 pub mod models;
 pub mod params;
 pub mod registry;
+pub mod represent;
 pub mod sampling;
 
 pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, Ndf};

@@ -10,6 +10,12 @@ use crate::{BvError, Result, registry};
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
 
+mod gpu;
+pub use gpu::{
+    COMPONENT_ENTRY_SLOTS, DerivedSlots, GpuLayout, GpuModelRef, GpuParam, GpuSlot, MAX_SLOTS,
+    gpu_layout, gpu_model_index, pack_model, pack_model_with,
+};
+
 /// How deeply `mix` components may nest (a mix of mixes of …), so that a hostile
 /// scene cannot overflow the stack.
 pub const MAX_NESTING: usize = 4;

@@ -14,6 +14,7 @@ pub mod hapke;
 pub mod lafortune;
 pub mod lambert;
 pub mod lobes;
+pub mod merl;
 pub mod mirror;
 pub mod mix;
 pub mod modified_phong;
@@ -40,5 +41,6 @@ pub static CATALOGUE: &[&ModelInfo] = &[
     &disney::INFO,
     &mirror::INFO,
     &glass::INFO,
+    &merl::INFO,
     &mix::INFO,
 ];

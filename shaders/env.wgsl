@@ -1,0 +1,149 @@
+// Environment lighting (issue 4, item 4): spheres under an equirectangular
+// environment, one BRDF sample and one environment sample per pixel and pass,
+// combined with the power heuristic (Veach & Guibas 1995), accumulated into a
+// float buffer across frames. Delta models (mirror, glass) add their exact
+// specular paths.
+#import bv::brdf
+#import bv::brdf_sampling
+#import bv::envmap
+#import bv::params::{pf, pu}
+#import bv::layout as L
+#import bv::models::mirror
+#import bv::models::glass
+#import bv::frame::PI
+#import bv::sampling::{pcg, rand}
+#import bv::sphere::{sphere_at, to_local, to_view, SpherePoint}
+
+struct Frame {
+    size: vec2<f32>,
+    tiles: u32,
+    // Index of this pass since the last restart (seeds the random numbers).
+    frame: u32,
+    // Samples of each strategy per pixel in this pass.
+    spp: u32,
+    // tan of half the background's field of view.
+    fov_tan: f32,
+    pad: vec2<f32>,
+}
+
+@group(0) @binding(1) var<uniform> view: Frame;
+@group(0) @binding(2) var<storage, read> models: array<vec2<u32>>;
+// Running sums of radiance per pixel (rgb) and the number of samples (a).
+@group(0) @binding(3) var<storage, read_write> accum: array<vec4<f32>>;
+
+fn balance2(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    return a2 / (a2 + b * b);
+}
+
+// Radiance of the glass sphere along the view ray entering at normal n (view
+// space; sphere of radius 1 at the origin): Fresnel reflection plus the
+// refracted path through the ball, with internal reflections (up to 8 exits).
+fn glass_path(o: u32, n: vec3<f32>) -> vec3<f32> {
+    let eta = glass::eta(o);
+    let d = vec3<f32>(0.0, 0.0, -1.0);
+    let c = -dot(d, n);
+    let f = glass::reflectance(o, c);
+    var l = f * envmap::radiance(reflect(d, n));
+    var dir = refract(d, n, 1.0 / eta);
+    if (dot(dir, dir) == 0.0) {
+        return l;
+    }
+    var p = n;
+    var through = 1.0 - f;
+    for (var k = 0; k < 8; k++) {
+        // Next hit of the unit sphere from inside: p + t dir with t = −2 p·dir.
+        p = p + (-2.0 * dot(p, dir)) * dir;
+        let m = normalize(p);
+        let ci = dot(dir, m);
+        // From inside: the Fresnel term of the interface seen from −z.
+        let fi = glass::reflectance(o, -ci);
+        let out = refract(dir, -m, eta);
+        if (dot(out, out) > 0.0) {
+            l += through * (1.0 - fi) * envmap::radiance(out);
+        }
+        through *= fi;
+        dir = reflect(dir, -m);
+        if (through < 1e-4) {
+            break;
+        }
+    }
+    return l;
+}
+
+// Radiance of the delta parts of a (non-mix) model at sphere point s.
+fn delta_leaf(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
+    if (model == L::MODEL_MIRROR) {
+        let v = vec3<f32>(0.0, 0.0, 1.0);
+        let c = dot(v, s.n);
+        return mirror::reflectance(o, c) * envmap::radiance(2.0 * c * s.n - v);
+    }
+    if (model == L::MODEL_GLASS) {
+        return glass_path(o, s.n);
+    }
+    return vec3<f32>(0.0);
+}
+
+fn delta_radiance(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
+    if (model != L::MODEL_MIX) {
+        return delta_leaf(model, o, s);
+    }
+    let n = pu(o + L::MIX_COMPONENTS);
+    let table = pu(o + L::MIX_COMPONENTS + 1u);
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < n; j++) {
+        let e = table + L::COMPONENT_ENTRY_SLOTS * j;
+        sum += pf(e) * delta_leaf(pu(e + 1u), pu(e + 2u), s);
+    }
+    return sum;
+}
+
+@compute @workgroup_size(8, 8)
+fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
+    let w = u32(view.size.x);
+    let h = u32(view.size.y);
+    if (id.x >= w || id.y >= h) {
+        return;
+    }
+    let pixel = id.y * w + id.x;
+    let p = vec2<f32>(id.xy) + vec2<f32>(0.5);
+    let s = sphere_at(p, view.size, view.tiles);
+    var sum = vec3<f32>(0.0);
+    if (s.tile < 0) {
+        // Background: the environment through a pinhole of the given field of view.
+        let q = (p - 0.5 * view.size) / (0.5 * view.size.y) * view.fov_tan;
+        sum = envmap::radiance(normalize(vec3<f32>(q.x, -q.y, -1.0))) * f32(view.spp);
+    } else {
+        let m = models[u32(s.tile)];
+        let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
+        var rng = pcg(pixel ^ pcg(view.frame * 9781u + 1u));
+        for (var k = 0u; k < view.spp; k++) {
+            // BRDF strategy.
+            let u = vec3<f32>(rand(&rng), rand(&rng), rand(&rng));
+            let wi = brdf_sampling::sample(m.x, m.y, wo, u);
+            if (wi.z > 0.0) {
+                let pb = brdf_sampling::pdf(m.x, m.y, wo, wi);
+                if (pb > 0.0) {
+                    let d = to_view(s, wi);
+                    let pe = envmap::pdf(d);
+                    let f = brdf::eval(m.x, m.y, wi, wo);
+                    sum += f * wi.z * envmap::radiance(d) * (balance2(pb, pe) / pb);
+                }
+            }
+            // Environment strategy.
+            if (envmap::env.sampling != 0u) {
+                let ue = vec4<f32>(rand(&rng), rand(&rng), rand(&rng), rand(&rng));
+                let d = envmap::sample(ue);
+                let wi2 = to_local(s, d);
+                let pe = envmap::pdf(d);
+                if (wi2.z > 0.0 && pe > 0.0) {
+                    let pb = brdf_sampling::pdf(m.x, m.y, wo, wi2);
+                    let f = brdf::eval(m.x, m.y, wi2, wo);
+                    sum += f * wi2.z * envmap::radiance(d) * (balance2(pe, pb) / pe);
+                }
+            }
+        }
+        sum += delta_radiance(m.x, m.y, s) * f32(view.spp);
+    }
+    accum[pixel] += vec4<f32>(sum, f32(view.spp));
+}

@@ -1,0 +1,57 @@
+// Cook-Torrance (bv_core::models::cook_torrance):
+// kd/π + ks F(wi·h) D(h) G(wi, wo) / (4 cosθi cosθo), D, G, F by choice.
+// Derived slots after the block (bv-core computes them; src/gpu/pack.rs):
+// Blinn's normalisation constants for alpha_x and alpha2.
+#define_import_path bv::models::cook_torrance
+
+#import bv::params::{pf, prgb, pu}
+#import bv::frame::INV_PI
+#import bv::fresnel::fresnel
+#import bv::microfacet::{Scale, mixture_d, mixture_g}
+#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_SIZE}
+
+fn first_scale(o: u32) -> Scale {
+    return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), pf(o + COOK_TORRANCE_ALPHA_X),
+        pf(o + COOK_TORRANCE_ALPHA_Y), pf(o + COOK_TORRANCE_SIZE));
+}
+
+fn second_scale(o: u32) -> Scale {
+    let a2 = pf(o + COOK_TORRANCE_ALPHA2);
+    return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), a2, a2, pf(o + COOK_TORRANCE_SIZE + 1u));
+}
+
+fn weight2(o: u32) -> f32 {
+    return clamp(pf(o + COOK_TORRANCE_WEIGHT2), 0.0, 1.0);
+}
+
+// The specular factor F D G / (4 cosθi cosθo) without ks (0 where bv-core's is).
+fn specular(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let v = wi + wo;
+    let l2 = dot(v, v);
+    if (l2 <= 1e-24) {
+        return vec3<f32>(0.0);
+    }
+    let h = v / sqrt(l2);
+    let first = first_scale(o);
+    let second = second_scale(o);
+    let w2 = weight2(o);
+    let d = mixture_d(first, second, w2, h);
+    if (d == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let g = mixture_g(pu(o + COOK_TORRANCE_GEOMETRY), first, second, w2, wi, wo, h);
+    let scalar = d * g / (4.0 * wi.z * wo.z);
+    if (!(scalar <= 3.0e38)) {
+        return vec3<f32>(0.0);
+    }
+    let f = fresnel(pu(o + COOK_TORRANCE_FRESNEL), prgb(o + COOK_TORRANCE_ETA),
+        prgb(o + COOK_TORRANCE_K), prgb(o + COOK_TORRANCE_F0), dot(wi, h));
+    return f * scalar;
+}
+
+fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return prgb(o + COOK_TORRANCE_KD) * INV_PI + pf(o + COOK_TORRANCE_KS) * specular(o, wi, wo);
+}

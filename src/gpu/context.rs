@@ -1,0 +1,224 @@
+//! The device the renderers share: opened headless here, or handed over by the
+//! GUI's egui-wgpu render state.
+
+use anyhow::{Context, Result, anyhow};
+
+/// Environment variable that lets GPU tests pass without an adapter (for
+/// machines that cannot install lavapipe); CI installs it and must not skip.
+pub const SKIP_ENV: &str = "BV_SKIP_GPU_TESTS";
+
+/// A wgpu device and its queue.
+#[derive(Debug, Clone)]
+pub struct Gpu {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// What the adapter is (name, backend, device type), for reports.
+    pub info: wgpu::AdapterInfo,
+}
+
+impl Gpu {
+    /// Opens the first adapter wgpu finds (on a machine without a GPU, Mesa's
+    /// lavapipe: `apt-get install libvulkan1 mesa-vulkan-drivers`).
+    pub fn headless() -> Result<Self> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| {
+            anyhow!(
+                "no GPU adapter found ({e}); on a machine without a GPU install Mesa's \
+                 software Vulkan (apt-get install libvulkan1 mesa-vulkan-drivers)"
+            )
+        })?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("bv"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .with_context(|| format!("opening a device on {}", info.name))?;
+        Ok(Self {
+            device,
+            queue,
+            info,
+        })
+    }
+
+    /// Wraps a device opened elsewhere (the GUI's render state).
+    pub fn from_parts(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        Self {
+            device,
+            queue,
+            info,
+        }
+    }
+
+    /// One line naming the adapter: `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Blocks until all submitted work is done.
+    pub fn wait(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| anyhow!("waiting for the GPU: {e}"))
+    }
+
+    /// Copies a `MAP_READ` buffer's first `len` bytes back to the CPU.
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>> {
+        let slice = buffer.slice(..len);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            // The receiver lives until recv() below returns.
+            let _ = tx.send(r);
+        });
+        self.wait()?;
+        rx.recv()
+            .context("the GPU dropped a buffer mapping")?
+            .map_err(|e| anyhow!("mapping a readback buffer: {e}"))?;
+        let bytes = slice
+            .get_mapped_range()
+            .map_err(|e| anyhow!("reading a mapped buffer: {e:?}"))?
+            .to_vec();
+        buffer.unmap();
+        Ok(bytes)
+    }
+}
+
+/// Opens the headless device for a test. Without an adapter the test FAILS
+/// with a clear message (CI installs lavapipe, so a silent skip would hide
+/// breakage) unless `BV_SKIP_GPU_TESTS=1`, in which case `None` is returned
+/// and the caller returns early.
+pub fn gpu_for_test() -> Option<Gpu> {
+    match Gpu::headless() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var(SKIP_ENV).as_deref() == Ok("1") => {
+            eprintln!("skipping GPU test ({SKIP_ENV}=1): {e:#}");
+            None
+        }
+        Err(e) => panic!(
+            "GPU test needs an adapter: {e:#}\n(set {SKIP_ENV}=1 to skip GPU tests on a machine \
+             without one)"
+        ),
+    }
+}
+
+impl Gpu {
+    /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image.
+    pub fn read_rgba8(&self, texture: &wgpu::Texture) -> Result<image::RgbaImage> {
+        let (w, h) = (texture.width(), texture.height());
+        let row = 4 * w;
+        let padded =
+            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let size = u64::from(padded) * u64::from(h);
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        self.queue.submit([enc.finish()]);
+        let bytes = self.read_buffer(&buffer, size)?;
+        let mut pixels = Vec::with_capacity((row * h) as usize);
+        for y in 0..h as usize {
+            let start = y * padded as usize;
+            pixels.extend_from_slice(&bytes[start..start + row as usize]);
+        }
+        image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
+    }
+}
+
+/// An offscreen colour target that is re-created only when its size changes.
+#[derive(Debug)]
+pub struct Target {
+    /// The texture (`Rgba8Unorm`, sRGB-encoded values; render attachment,
+    /// texture binding and copy source, so that a GUI can show it directly).
+    pub texture: wgpu::Texture,
+    /// Its default view.
+    pub view: wgpu::TextureView,
+}
+
+/// Format of every offscreen target (values are already sRGB-encoded by the shaders).
+pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+impl Target {
+    /// A target of the given size (at least 1×1, at most the device's limit).
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            anyhow::bail!("image size {width}×{height} is outside 1..={max} on this device");
+        }
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("bv target"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: TARGET_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            // A GUI that samples through an sRGB view (decoding to linear) may
+            // create one of the same texture.
+            view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
+        });
+        let view = texture.create_view(&Default::default());
+        Ok(Self { texture, view })
+    }
+
+    /// Keeps `slot`'s target if it has the size, else makes a new one.
+    pub fn ensure<'a>(
+        slot: &'a mut Option<Target>,
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+    ) -> Result<&'a Target> {
+        let fits = slot
+            .as_ref()
+            .is_some_and(|t| t.texture.width() == width && t.texture.height() == height);
+        if !fits {
+            *slot = Some(Target::new(gpu, width, height)?);
+        }
+        slot.as_ref().context("target")
+    }
+}

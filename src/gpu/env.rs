@@ -1,0 +1,642 @@
+//! Environment lighting (issue 4, items 4 and 5): spheres under an
+//! equirectangular HDR environment, rendered progressively with multiple
+//! importance sampling of the BRDF and of the environment
+//! (`shaders/env.wgsl`). Each [`EnvRenderer::render`] call adds one pass of
+//! samples to a float accumulation buffer and shows the mean; any change of
+//! models, settings, size or map restarts the accumulation.
+
+use super::context::{Gpu, TARGET_FORMAT, Target};
+use super::display::ToneMap;
+use super::pack::pack_all;
+use super::shaders::ShaderLibrary;
+use anyhow::{Context, Result, bail};
+use bv_core::ModelSpec;
+use std::f64::consts::PI;
+use std::path::Path;
+use wgpu::util::DeviceExt;
+
+/// An equirectangular environment: `width × height` linear-RGB texels, row 0 at
+/// the zenith (+y), column 0 at azimuth −π (φ measured from −z towards +x).
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvironmentMap {
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// Row-major radiance.
+    pub texels: Vec<[f32; 3]>,
+}
+
+/// Largest accepted side of a loaded map (a hostile header must not allocate
+/// gigabytes).
+pub const MAX_ENV_SIDE: u32 = 16384;
+
+impl EnvironmentMap {
+    /// A constant environment (the white furnace when `c` is 1).
+    pub fn constant(c: [f32; 3]) -> Self {
+        Self {
+            width: 8,
+            height: 4,
+            texels: vec![c; 32],
+        }
+    }
+
+    /// Loads a Radiance `.hdr` or OpenEXR file (equirectangular).
+    pub fn load(path: &Path) -> Result<Self> {
+        let reader = image::ImageReader::open(path)
+            .with_context(|| format!("opening {}", path.display()))?
+            .with_guessed_format()
+            .with_context(|| format!("reading {}", path.display()))?;
+        let (w, h) = reader
+            .into_dimensions()
+            .with_context(|| format!("reading the size of {}", path.display()))?;
+        if w == 0 || h == 0 || w > MAX_ENV_SIDE || h > MAX_ENV_SIDE {
+            bail!(
+                "{}: {w}×{h} is not a usable environment (1..={MAX_ENV_SIDE} per side)",
+                path.display()
+            );
+        }
+        let img = image::open(path)
+            .with_context(|| format!("decoding {}", path.display()))?
+            .into_rgb32f();
+        let texels = img
+            .pixels()
+            .map(|p| {
+                let c = p.0.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+                [c[0], c[1], c[2]]
+            })
+            .collect();
+        Ok(Self {
+            width: img.width(),
+            height: img.height(),
+            texels,
+        })
+    }
+
+    /// Writes the map as a Radiance `.hdr` file.
+    pub fn save_hdr(&self, path: &Path) -> Result<()> {
+        let file =
+            std::fs::File::create(path).with_context(|| format!("creating {}", path.display()))?;
+        let pixels: Vec<image::Rgb<f32>> = self.texels.iter().map(|&c| image::Rgb(c)).collect();
+        image::codecs::hdr::HdrEncoder::new(std::io::BufWriter::new(file))
+            .encode(&pixels, self.width as usize, self.height as usize)
+            .with_context(|| format!("writing {}", path.display()))?;
+        Ok(())
+    }
+
+    /// The procedural studio shipped as `assets/studio.hdr`: a dim grey
+    /// cyclorama (lighter towards the horizon, darker floor) lit by three soft
+    /// boxes: a large warm key upper left in front, a cooler fill on the right
+    /// and a narrow strip light behind, above. Soft boxes are rectangles in
+    /// (φ, θ) with smoothstep edges.
+    pub fn studio(width: u32, height: u32) -> Self {
+        // (centre φ, centre θ, half width, half height, radiance) in radians.
+        let boxes: [(f64, f64, f64, f64, [f64; 3]); 3] = [
+            (-0.6, 0.75, 0.35, 0.28, [14.0, 12.5, 10.5]),
+            (1.3, 1.2, 0.25, 0.35, [3.0, 3.4, 4.0]),
+            (3.0, 0.45, 0.6, 0.08, [9.0, 9.0, 9.0]),
+        ];
+        let smooth = |e0: f64, e1: f64, x: f64| {
+            let t = ((x - e0) / (e1 - e0)).clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
+        };
+        let mut texels = Vec::with_capacity((width * height) as usize);
+        for j in 0..height {
+            let theta = (f64::from(j) + 0.5) / f64::from(height) * PI;
+            for i in 0..width {
+                let phi = (f64::from(i) + 0.5) / f64::from(width) * 2.0 * PI - PI;
+                let up = theta.cos();
+                let mut c = if up >= 0.0 {
+                    [0.18 + 0.1 * (1.0 - up); 3]
+                } else {
+                    [0.06, 0.055, 0.05]
+                };
+                for (p0, t0, hw, hh, l) in boxes {
+                    let dphi = (phi - p0 + PI).rem_euclid(2.0 * PI) - PI;
+                    let wx = 1.0 - smooth(hw * 0.8, hw, dphi.abs());
+                    let wy = 1.0 - smooth(hh * 0.8, hh, (theta - t0).abs());
+                    for k in 0..3 {
+                        c[k] += wx * wy * l[k];
+                    }
+                }
+                texels.push(c.map(|x| x as f32));
+            }
+        }
+        Self {
+            width,
+            height,
+            texels,
+        }
+    }
+
+    /// Marginal and conditional CDFs of the texel probabilities
+    /// ∝ luminance × solid angle (what `shaders/common/envmap.wgsl` samples),
+    /// and whether the map has any energy.
+    pub fn cdfs(&self) -> (Vec<f32>, Vec<f32>, bool) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut conditional = vec![0f32; h * (w + 1)];
+        let mut rows = vec![0f64; h];
+        for j in 0..h {
+            let t0 = j as f64 * PI / h as f64;
+            let t1 = (j + 1) as f64 * PI / h as f64;
+            let omega = 2.0 * PI / w as f64 * (t0.cos() - t1.cos());
+            let mut acc = vec![0f64; w + 1];
+            for i in 0..w {
+                let c = self.texels[j * w + i];
+                let lum =
+                    0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2]);
+                acc[i + 1] = acc[i] + lum.max(0.0) * omega;
+            }
+            rows[j] = acc[w];
+            for i in 0..=w {
+                conditional[j * (w + 1) + i] = if acc[w] > 0.0 {
+                    (acc[i] / acc[w]) as f32
+                } else {
+                    i as f32 / w as f32
+                };
+            }
+        }
+        let total: f64 = rows.iter().sum();
+        let mut marginal = vec![0f32; h + 1];
+        let mut acc = 0.0;
+        for j in 0..h {
+            acc += rows[j];
+            marginal[j + 1] = if total > 0.0 {
+                (acc / total) as f32
+            } else {
+                (j + 1) as f32 / h as f32
+            };
+        }
+        marginal[h] = 1.0;
+        for j in 0..h {
+            conditional[j * (w + 1) + w] = 1.0;
+        }
+        (marginal, conditional, total > 0.0 && total.is_finite())
+    }
+}
+
+/// Settings of an environment-lit frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvSettings {
+    /// Rotation of the environment about the vertical axis (radians).
+    pub rotation: f64,
+    /// Exposure in stops.
+    pub exposure_ev: f64,
+    /// Tone map after exposure.
+    pub tone_map: ToneMap,
+    /// Field of view of the background (degrees, vertical).
+    pub background_fov_deg: f64,
+}
+
+impl Default for EnvSettings {
+    fn default() -> Self {
+        Self {
+            rotation: 0.0,
+            exposure_ev: 0.0,
+            tone_map: ToneMap::Aces,
+            background_fov_deg: 60.0,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct FrameUniform {
+    size: [f32; 2],
+    tiles: u32,
+    frame: u32,
+    spp: u32,
+    fov_tan: f32,
+    pad: [f32; 2],
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct EnvUniform {
+    width: u32,
+    height: u32,
+    sampling: u32,
+    marginal: u32,
+    conditional: u32,
+    rotation: f32,
+    pad: [f32; 2],
+}
+
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShowUniform {
+    size: [f32; 2],
+    exposure: f32,
+    tone: u32,
+}
+
+struct EnvBuffers {
+    /// Texels (rgb), marginal CDF, conditional CDFs, one after the other.
+    data: wgpu::Buffer,
+    marginal: u32,
+    conditional: u32,
+    size: (u32, u32),
+    sampling: bool,
+    generation: u64,
+}
+
+/// What the accumulated samples belong to; any difference restarts them.
+#[derive(Debug, Clone, PartialEq)]
+struct Key {
+    models: Vec<ModelSpec>,
+    rotation: f64,
+    fov: f64,
+    size: (u32, u32),
+    env: u64,
+}
+
+/// The progressive environment renderer.
+pub struct EnvRenderer {
+    gpu: Gpu,
+    accumulate: wgpu::ComputePipeline,
+    show: wgpu::RenderPipeline,
+    env: EnvBuffers,
+    accum: Option<wgpu::Buffer>,
+    key: Option<Key>,
+    frame: u32,
+    samples: u64,
+    target: Option<Target>,
+}
+
+impl std::fmt::Debug for EnvRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("EnvRenderer")
+            .field("frame", &self.frame)
+            .field("samples", &self.samples)
+            .finish_non_exhaustive()
+    }
+}
+
+const WORKGROUP: u32 = 8;
+
+impl EnvRenderer {
+    /// Builds the pipelines and uploads `map`.
+    pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
+        let module = library.shader_module(&gpu.device, "env")?;
+        let accumulate = gpu
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("env accumulate"),
+                layout: None,
+                module: &module,
+                entry_point: Some("accumulate"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        let show_module = library.shader_module(&gpu.device, "env_display")?;
+        let show = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("env display"),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &show_module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &show_module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(TARGET_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        let env = Self::upload(&gpu, map, 0)?;
+        Ok(Self {
+            gpu,
+            accumulate,
+            show,
+            env,
+            accum: None,
+            key: None,
+            frame: 0,
+            samples: 0,
+            target: None,
+        })
+    }
+
+    fn upload(gpu: &Gpu, map: &EnvironmentMap, generation: u64) -> Result<EnvBuffers> {
+        if map.width == 0
+            || map.height == 0
+            || map.texels.len() != (map.width * map.height) as usize
+        {
+            bail!(
+                "environment map {}×{} has {} texels",
+                map.width,
+                map.height,
+                map.texels.len()
+            );
+        }
+        let (marginal, conditional, sampling) = map.cdfs();
+        let mut data: Vec<f32> = map.texels.iter().flatten().copied().collect();
+        let m = u32::try_from(data.len())?;
+        data.extend_from_slice(&marginal);
+        let c = u32::try_from(data.len())?;
+        data.extend_from_slice(&conditional);
+        let buffer = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("env data"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        Ok(EnvBuffers {
+            data: buffer,
+            marginal: m,
+            conditional: c,
+            size: (map.width, map.height),
+            sampling,
+            generation,
+        })
+    }
+
+    /// Replaces the environment (restarts the accumulation).
+    pub fn set_environment(&mut self, map: &EnvironmentMap) -> Result<()> {
+        self.env = Self::upload(&self.gpu, map, self.env.generation + 1)?;
+        Ok(())
+    }
+
+    /// Samples per pixel accumulated so far (each counts one BRDF and one
+    /// environment sample).
+    pub fn samples_per_pixel(&self) -> u64 {
+        self.samples
+    }
+
+    /// The device it renders on.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Adds one pass of `spp` samples per pixel (restarting first if anything
+    /// changed) and returns the displayed mean in the renderer's texture.
+    pub fn render(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<&wgpu::Texture> {
+        self.accumulate_pass(models, settings, width, height, spp)?;
+        self.show(settings, width, height)
+    }
+
+    /// Renders until `spp` samples per pixel are accumulated (in passes of at
+    /// most 64) and reads the frame back (headless export).
+    pub fn render_image(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<image::RgbaImage> {
+        self.accumulate_to(models, settings, width, height, spp)?;
+        let texture = self.show(settings, width, height)?.clone();
+        self.gpu.read_rgba8(&texture)
+    }
+
+    /// Accumulates until `spp` samples per pixel and returns the mean
+    /// radiance per pixel (row-major rgb), for tests and HDR export.
+    pub fn render_radiance(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<Vec<[f32; 3]>> {
+        self.accumulate_to(models, settings, width, height, spp)?;
+        let accum = self.accum.as_ref().context("no accumulation buffer")?;
+        let size = accum.size();
+        let rb = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accum readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(accum, 0, &rb, 0, size);
+        self.gpu.queue.submit([enc.finish()]);
+        let bytes = self.gpu.read_buffer(&rb, size)?;
+        let v: &[f32] = bytemuck::cast_slice(&bytes);
+        Ok(v.chunks_exact(4)
+            .map(|c| {
+                let n = c[3].max(1.0);
+                [c[0] / n, c[1] / n, c[2] / n]
+            })
+            .collect())
+    }
+
+    fn accumulate_to(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<()> {
+        // A first zero-sample-free pass establishes the key (and restarts if needed).
+        loop {
+            let done = if self.key_matches(models, settings, width, height) {
+                self.samples
+            } else {
+                0
+            };
+            if done >= u64::from(spp) {
+                break;
+            }
+            let pass = (u64::from(spp) - done).min(64) as u32;
+            self.accumulate_pass(models, settings, width, height, pass)?;
+        }
+        self.gpu.wait()
+    }
+
+    fn key(&self, models: &[ModelSpec], settings: &EnvSettings, width: u32, height: u32) -> Key {
+        Key {
+            models: models.to_vec(),
+            rotation: settings.rotation,
+            fov: settings.background_fov_deg,
+            size: (width, height),
+            env: self.env.generation,
+        }
+    }
+
+    fn key_matches(
+        &self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+    ) -> bool {
+        self.key.as_ref() == Some(&self.key(models, settings, width, height))
+    }
+
+    fn accumulate_pass(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<()> {
+        if models.is_empty() {
+            bail!("the environment view needs at least one model");
+        }
+        let key = self.key(models, settings, width, height);
+        let d = self.gpu.device.clone();
+        if self.key.as_ref() != Some(&key) || self.accum.is_none() {
+            // Restart: a fresh, zeroed accumulation buffer.
+            let size = 16 * u64::from(width) * u64::from(height);
+            if size == 0 {
+                bail!("image size {width}×{height} is empty");
+            }
+            self.accum = Some(d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("env accum"),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }));
+            self.key = Some(key);
+            self.frame = 0;
+            self.samples = 0;
+        }
+        let accum = self.accum.as_ref().context("accumulation buffer")?;
+        let (params, refs) = pack_all(models)?;
+        let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
+        let frame = FrameUniform {
+            size: [width as f32, height as f32],
+            tiles: u32::try_from(models.len())?,
+            frame: self.frame,
+            spp: spp.max(1),
+            fov_tan: (0.5 * settings.background_fov_deg.to_radians()).tan() as f32,
+            pad: [0.0; 2],
+        };
+        let env = EnvUniform {
+            width: self.env.size.0,
+            height: self.env.size.1,
+            sampling: u32::from(self.env.sampling),
+            marginal: self.env.marginal,
+            conditional: self.env.conditional,
+            rotation: settings.rotation as f32,
+            pad: [0.0; 2],
+        };
+        let init = |label: &str, contents: &[u8], usage| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let pbuf = init(
+            "params",
+            bytemuck::cast_slice(&params),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let fbuf = init(
+            "frame",
+            bytemuck::bytes_of(&frame),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let mbuf = init(
+            "models",
+            bytemuck::cast_slice(&tiles),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let ebuf = init(
+            "env info",
+            bytemuck::bytes_of(&env),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env frame"),
+            layout: &self.accumulate.get_bind_group_layout(0),
+            entries: &[
+                entry(0, &pbuf),
+                entry(1, &fbuf),
+                entry(2, &mbuf),
+                entry(3, accum),
+            ],
+        });
+        let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env map"),
+            layout: &self.accumulate.get_bind_group_layout(1),
+            entries: &[entry(0, &ebuf), entry(1, &self.env.data)],
+        });
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.accumulate);
+            pass.set_bind_group(0, &g0, &[]);
+            pass.set_bind_group(1, &g1, &[]);
+            pass.dispatch_workgroups(width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP), 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.frame = self.frame.wrapping_add(1);
+        self.samples += u64::from(spp.max(1));
+        Ok(())
+    }
+
+    fn show(&mut self, settings: &EnvSettings, width: u32, height: u32) -> Result<&wgpu::Texture> {
+        let accum = self.accum.as_ref().context("nothing rendered yet")?;
+        let d = &self.gpu.device;
+        let u = ShowUniform {
+            size: [width as f32, height as f32],
+            exposure: settings.exposure_ev.exp2() as f32,
+            tone: settings.tone_map.index(),
+        };
+        let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("show"),
+            contents: bytemuck::bytes_of(&u),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env display"),
+            layout: &self.show.get_bind_group_layout(0),
+            entries: &[entry(0, &ubuf), entry(1, accum)],
+        });
+        let target = Target::ensure(&mut self.target, &self.gpu, width, height)?;
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("env display"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target.view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.show);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        Ok(&target.texture)
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}

@@ -1,0 +1,291 @@
+//! Offscreen renderer of the lit sphere view (issue 4, items 3 and 5): every
+//! given model on its own orthographic sphere, side by side, lit by one
+//! directional light. Built once (device, pipeline), it re-renders on every
+//! call, so a GUI view can call [`LitSphereRenderer::render`] each frame and
+//! show the texture, and `bv render` can call [`LitSphereRenderer::render_image`] once.
+
+use super::context::{Gpu, TARGET_FORMAT, Target};
+use super::display::ToneMap;
+use super::pack::pack_all;
+use super::shaders::ShaderLibrary;
+use anyhow::{Result, bail};
+use bv_core::ModelSpec;
+use glam::DVec3;
+use wgpu::util::DeviceExt;
+
+/// What is behind the spheres (display values, i.e. already sRGB-encoded, 0..1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Background {
+    /// One flat colour.
+    Flat([f32; 3]),
+    /// A checkerboard of two colours with squares of `size` pixels.
+    Checker {
+        /// First colour.
+        a: [f32; 3],
+        /// Second colour.
+        b: [f32; 3],
+        /// Square size in pixels.
+        size: f32,
+    },
+}
+
+impl Default for Background {
+    fn default() -> Self {
+        Background::Flat([0.0; 3])
+    }
+}
+
+/// Everything about a lit-sphere frame except the models and the size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LitSphereSettings {
+    /// Direction towards the light in view space (x right, y up, z towards the
+    /// viewer); normalised before use.
+    pub light: DVec3,
+    /// Irradiance E of the light at normal incidence.
+    pub irradiance: f64,
+    /// Exposure in stops: radiance is scaled by `2^ev`.
+    pub exposure_ev: f64,
+    /// Tone map after exposure.
+    pub tone_map: ToneMap,
+    /// Background.
+    pub background: Background,
+}
+
+impl Default for LitSphereSettings {
+    fn default() -> Self {
+        Self {
+            light: DVec3::new(-0.4, 0.5, 0.77),
+            irradiance: 1.0,
+            exposure_ev: 0.0,
+            tone_map: ToneMap::None,
+            background: Background::default(),
+        }
+    }
+}
+
+/// The uniform block of lit_sphere.wgsl (`View`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ViewUniform {
+    size: [f32; 2],
+    tiles: u32,
+    tone: u32,
+    light: [f32; 4],
+    exposure: f32,
+    background: u32,
+    checker: f32,
+    pad: f32,
+    color: [f32; 4],
+    color2: [f32; 4],
+}
+
+/// The lit-sphere renderer: persistent pipeline, re-renders on demand.
+#[derive(Debug)]
+pub struct LitSphereRenderer {
+    gpu: Gpu,
+    pipeline: wgpu::RenderPipeline,
+    target: Option<Target>,
+}
+
+impl LitSphereRenderer {
+    /// Builds the pipeline on `gpu`.
+    pub fn new(gpu: Gpu, library: &mut ShaderLibrary) -> Result<Self> {
+        let module = library.shader_module(&gpu.device, "lit_sphere")?;
+        let pipeline = gpu
+            .device
+            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("lit sphere"),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(TARGET_FORMAT.into())],
+                }),
+                multiview_mask: None,
+                cache: None,
+            });
+        Ok(Self {
+            gpu,
+            pipeline,
+            target: None,
+        })
+    }
+
+    /// The device it renders on.
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Renders `models` side by side into the renderer's own `width`×`height`
+    /// texture (kept between calls of the same size) and returns it; the work
+    /// is submitted, not waited for.
+    pub fn render(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &LitSphereSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Texture> {
+        if models.is_empty() {
+            bail!("the lit sphere needs at least one model");
+        }
+        let (params, refs) = pack_all(models)?;
+        let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
+        let light = settings.light.try_normalize().unwrap_or(DVec3::Z);
+        let (background, checker, color, color2) = match settings.background {
+            Background::Flat(c) => (0, 1.0, c, c),
+            Background::Checker { a, b, size } => (1, size.max(1.0), a, b),
+        };
+        let uniform = ViewUniform {
+            size: [width as f32, height as f32],
+            tiles: u32::try_from(models.len())?,
+            tone: settings.tone_map.index(),
+            light: [
+                light.x as f32,
+                light.y as f32,
+                light.z as f32,
+                settings.irradiance as f32,
+            ],
+            exposure: settings.exposure_ev.exp2() as f32,
+            background,
+            checker,
+            pad: 0.0,
+            color: [color[0], color[1], color[2], 1.0],
+            color2: [color2[0], color2[1], color2[2], 1.0],
+        };
+        let d = &self.gpu.device;
+        let init = |label: &str, contents: &[u8], usage| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+        };
+        let pbuf = init(
+            "params",
+            bytemuck::cast_slice(&params),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let ubuf = init(
+            "view",
+            bytemuck::bytes_of(&uniform),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let mbuf = init(
+            "models",
+            bytemuck::cast_slice(&tiles),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lit sphere"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[entry(0, &pbuf), entry(1, &ubuf), entry(2, &mbuf)],
+        });
+        let target = Target::ensure(&mut self.target, &self.gpu, width, height)?;
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("lit sphere"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target.view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        Ok(&target.texture)
+    }
+
+    /// Renders and reads the frame back (headless export).
+    pub fn render_image(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &LitSphereSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<image::RgbaImage> {
+        self.render(models, settings, width, height)?;
+        let gpu = self.gpu.clone();
+        let texture = &self.target.as_ref().map(|t| t.texture.clone());
+        match texture {
+            Some(t) => gpu.read_rgba8(t),
+            None => bail!("no frame was rendered"),
+        }
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// The CPU reference of one frame: the same geometry, bv-core's f64 `eval`,
+/// the same display transform (for tests and for checking a port by eye).
+pub fn reference_image(
+    models: &[ModelSpec],
+    settings: &LitSphereSettings,
+    width: u32,
+    height: u32,
+) -> Result<image::RgbaImage> {
+    use super::display::{display, to_u8};
+    use super::sphere::sphere_at;
+    use glam::DVec2;
+    let brdfs = models
+        .iter()
+        .map(|m| m.build())
+        .collect::<bv_core::Result<Vec<_>>>()?;
+    let light = settings.light.try_normalize().unwrap_or(DVec3::Z);
+    let exposure = settings.exposure_ev.exp2();
+    let size = DVec2::new(f64::from(width), f64::from(height));
+    let mut img = image::RgbaImage::new(width, height);
+    for (x, y, px) in img.enumerate_pixels_mut() {
+        let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+        let c = match sphere_at(p, size, models.len()) {
+            None => {
+                let (c, c2, n, bg) = match settings.background {
+                    Background::Flat(c) => (c, c, 1.0, 0),
+                    Background::Checker { a, b, size } => (a, b, f64::from(size.max(1.0)), 1),
+                };
+                let odd = ((p.x / n).floor() as i64 + (p.y / n).floor() as i64) & 1 == 1;
+                let c = if bg == 1 && odd { c2 } else { c };
+                DVec3::new(c[0].into(), c[1].into(), c[2].into())
+            }
+            Some(s) => {
+                let wi = s.to_local(light);
+                let wo = s.to_local(DVec3::Z);
+                let radiance = if wi.z > 0.0 {
+                    brdfs[s.tile].eval(wi, wo) * wi.z * settings.irradiance
+                } else {
+                    DVec3::ZERO
+                };
+                display(radiance, exposure, settings.tone_map)
+            }
+        };
+        *px = image::Rgba([to_u8(c.x), to_u8(c.y), to_u8(c.z), 255]);
+    }
+    Ok(img)
+}
