@@ -655,3 +655,22 @@ fn render_window_states() {
         img.save(format!("{dir}/{name}.png")).unwrap();
     }
 }
+
+#[test]
+fn lobe_view_shaders_validate() {
+    use bv::views::lobe_gpu::{BLIT_WGSL, LINES_WGSL, lobe_shader_source};
+    for (name, src) in [
+        ("lobe.wgsl", lobe_shader_source()),
+        ("lines.wgsl", LINES_WGSL.to_string()),
+        ("blit.wgsl", BLIT_WGSL.to_string()),
+    ] {
+        let module = naga::front::wgsl::parse_str(&src)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+    }
+}
