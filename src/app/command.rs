@@ -70,6 +70,10 @@ pub enum Command {
     SetTheme(Theme),
     /// Opens or closes the keyboard help.
     ToggleHelp,
+    /// Sets the lit sphere view's settings.
+    SetLitView(super::lighting::LitView),
+    /// Sets the environment view's settings.
+    SetEnvView(super::lighting::EnvView),
 }
 
 /// What applying a command did, beyond changing the state.
@@ -203,6 +207,14 @@ impl Command {
             }
             Command::SetTheme(t) => state.theme = t,
             Command::ToggleHelp => out.toggle_help = true,
+            Command::SetLitView(v) => {
+                state.lighting.lit = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
+            Command::SetEnvView(v) => {
+                state.lighting.env = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
         }
         out
     }

@@ -9,6 +9,7 @@
 //!   window once it has drawn and exits.
 
 pub mod command;
+pub mod lighting;
 pub mod panel;
 pub mod params_ui;
 pub mod runtime;
@@ -167,6 +168,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         Box::new(move |cc| {
             if let Some(rs) = &cc.wgpu_render_state {
                 lobe_gpu::install(rs);
+                crate::views::gpu_image::install(&cc.egui_ctx, rs);
             }
             let saved = if load_saved {
                 cc.storage.and_then(|s| s.get_string(STORAGE_KEY))

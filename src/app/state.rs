@@ -253,6 +253,8 @@ pub struct AppState {
     pub maximised: Option<String>,
     /// Colour theme.
     pub theme: Theme,
+    /// Settings of the lit sphere and environment views.
+    pub lighting: super::lighting::Lighting,
 }
 
 impl Default for AppState {
@@ -269,6 +271,7 @@ impl Default for AppState {
             plots: PlotSettings::default(),
             maximised: None,
             theme: Theme::default(),
+            lighting: Default::default(),
         }
     }
 }
@@ -347,6 +350,7 @@ impl AppState {
         let p = &mut self.plots;
         p.fixed_theta_d_deg = clamp_deg(p.fixed_theta_d_deg, 0.0, 89.5);
         p.fixed_theta_h_deg = clamp_deg(p.fixed_theta_h_deg, 0.0, 89.5);
+        self.lighting = self.lighting.sanitised();
         self.version = STATE_VERSION;
         self
     }

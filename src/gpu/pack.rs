@@ -7,11 +7,27 @@ use bv_core::ModelSpec;
 use bv_core::microfacet::blinn_normalisation;
 use bv_core::params::{GpuModelRef, pack_model_with};
 
+/// Models without a WGSL port, and why: packing one (alone or inside a mix)
+/// is refused with a message a view can show, rather than drawn black.
+pub const NOT_PORTED: &[(&str, &str)] =
+    &[("merl", "its measured table is not uploaded to the GPU yet")];
+
+/// Refuses a model of [`NOT_PORTED`].
+pub fn check_ported(spec: &ModelSpec) -> bv_core::Result<()> {
+    match NOT_PORTED.iter().find(|(id, _)| *id == spec.model) {
+        Some((id, why)) => Err(bv_core::BvError::Invalid(format!(
+            "`{id}` cannot be drawn on the GPU: {why}"
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// Derived slots of one model (see `shaders/models/*.wgsl` for their use).
 ///
 /// - `cook-torrance`: Blinn's normalisation constant for `alpha_x` and for
 ///   `alpha2` (0 unless the distribution is `blinn`; it costs a quadrature).
 pub fn derived_slots(spec: &ModelSpec) -> bv_core::Result<Vec<f32>> {
+    check_ported(spec)?;
     Ok(match spec.model.as_str() {
         "cook-torrance" => {
             if spec.params.text("distribution")? == "blinn" {

@@ -1,5 +1,5 @@
-//! The viewer's views: the 3D polar lobe, the polar plot of the plane of
-//! incidence and the Cartesian plot. Each is a struct with its own `ui()`; they
+//! The viewer's views: the 3D polar lobe, the lit sphere, the polar plot of
+//! the plane of incidence, the Cartesian plot and the environment-lit object. Each is a struct with its own `ui()`; they
 //! read one [`Scene`] per frame and ask for changes by pushing
 //! [`Command`]s. A view is added by writing its module and one line in
 //! [`REGISTRY`].
@@ -8,6 +8,9 @@ pub mod camera;
 pub mod cartesian;
 pub mod colormap;
 pub mod curves;
+pub mod environment;
+pub mod gpu_image;
+pub mod lit_sphere;
 pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
@@ -97,13 +100,18 @@ pub struct ViewEntry {
     pub make: fn() -> Box<dyn View>,
 }
 
-/// Every view, in layout order: the first fills the left of the central area,
-/// the others stack on the right. Add a view here.
+/// Every view, in layout order (see `app::viewer::layout`: the first two share
+/// the top row, the others fill the rows below). Add a view here.
 pub const REGISTRY: &[ViewEntry] = &[
     ViewEntry {
         id: "lobe",
         title: "3D lobe",
         make: || Box::new(lobe3d::Lobe3dView::new()),
+    },
+    ViewEntry {
+        id: "lit_sphere",
+        title: "Lit sphere",
+        make: || Box::new(lit_sphere::LitSphereView::new()),
     },
     ViewEntry {
         id: "polar",
@@ -114,6 +122,11 @@ pub const REGISTRY: &[ViewEntry] = &[
         id: "cartesian",
         title: "f versus angle",
         make: || Box::new(cartesian::CartesianView::default()),
+    },
+    ViewEntry {
+        id: "environment",
+        title: "Environment",
+        make: || Box::new(environment::EnvironmentView::new()),
     },
 ];
 
