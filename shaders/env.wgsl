@@ -11,14 +11,14 @@
 #import bv::models::mirror
 #import bv::models::glass
 #import bv::frame::PI
-#import bv::sampling::{pcg, rand}
+#import bv::sampling::pcg
 #import bv::sphere::{sphere_at, to_local, to_view, SpherePoint}
 #import bv::torus
 
 struct Frame {
     size: vec2<f32>,
     tiles: u32,
-    // Index of this pass since the last restart (seeds the random numbers).
+    // Index of this pass since the last restart (the sampler uses `base`).
     frame: u32,
     // Samples of each strategy per pixel in this pass.
     spp: u32,
@@ -26,7 +26,34 @@ struct Frame {
     fov_tan: f32,
     // 0: spheres, 1: tori (src/gpu/env.rs, Object).
     object: u32,
-    pad: f32,
+    // Samples per pixel accumulated before this pass (index of its first
+    // sample in each pixel's sequence).
+    base: u32,
+}
+
+// Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
+// quasirandom sequences", 2018): point n is fract(shift + n·α) with
+// α_i = φ_d^−i, φ_d the positive root of x^(d+1) = x + 1. Kept in 0.32 fixed
+// point so that n·α wraps exactly (an f32 product loses the fraction after a
+// few thousand samples). Each pixel gets its own random shift (Cranley-
+// Patterson rotation), so every sample is still uniform (the estimate stays
+// unbiased) while the samples of one pixel are stratified, which takes the
+// visible noise down much faster than independent random numbers.
+const R3: vec3<u32> = vec3<u32>(3518319155u, 2882110345u, 2360945575u);
+const R4: vec4<u32> = vec4<u32>(3679390609u, 3152041523u, 2700274806u, 2313257605u);
+
+fn unit(v: u32) -> f32 {
+    return f32(v >> 8u) * (1.0 / 16777216.0);
+}
+
+fn r3(shift: vec3<u32>, n: u32) -> vec3<f32> {
+    let v = shift + n * R3;
+    return vec3<f32>(unit(v.x), unit(v.y), unit(v.z));
+}
+
+fn r4(shift: vec4<u32>, n: u32) -> vec4<f32> {
+    let v = shift + n * R4;
+    return vec4<f32>(unit(v.x), unit(v.y), unit(v.z), unit(v.w));
 }
 
 @group(0) @binding(1) var<uniform> view: Frame;
@@ -195,10 +222,21 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         let m = models[u32(s.tile)];
         let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
-        var rng = pcg(pixel ^ pcg(view.frame * 9781u + 1u));
+        // The pixel's shifts: fixed for the whole accumulation (the sequence
+        // goes on across passes through view.base).
+        let h0 = pcg(pixel * 7919u + 17u);
+        let h1 = pcg(h0 ^ 0x9e3779b9u);
+        let h2 = pcg(h1 ^ 0x85ebca6bu);
+        let h3 = pcg(h2 ^ 0xc2b2ae35u);
+        let h4 = pcg(h3 ^ 0x27d4eb2fu);
+        let h5 = pcg(h4 ^ 0x165667b1u);
+        let h6 = pcg(h5 ^ 0xd3a2646cu);
+        let shift_b = vec3<u32>(h0, h1, h2);
+        let shift_e = vec4<u32>(h3, h4, h5, h6);
         for (var k = 0u; k < view.spp; k++) {
+            let n = view.base + k;
             // BRDF strategy.
-            let u = vec3<f32>(rand(&rng), rand(&rng), rand(&rng));
+            let u = r3(shift_b, n);
             let wi = brdf_sampling::sample(m.x, m.y, wo, u);
             if (wi.z > 0.0) {
                 let pb = brdf_sampling::pdf(m.x, m.y, wo, wi);
@@ -215,7 +253,7 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             // Environment strategy.
             if (envmap::env.sampling != 0u) {
-                let ue = vec4<f32>(rand(&rng), rand(&rng), rand(&rng), rand(&rng));
+                let ue = r4(shift_e, n);
                 let d = envmap::sample(ue);
                 let wi2 = to_local(s, d);
                 let pe = envmap::pdf(d);

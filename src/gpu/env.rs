@@ -270,7 +270,7 @@ struct FrameUniform {
     spp: u32,
     fov_tan: f32,
     object: u32,
-    pad: f32,
+    base: u32,
 }
 
 #[repr(C)]
@@ -630,7 +630,8 @@ impl EnvRenderer {
             spp: spp.max(1),
             fov_tan: (0.5 * settings.background_fov_deg.to_radians()).tan() as f32,
             object: self.object.index(),
-            pad: 0.0,
+            // Sequences restart after 2^32 samples per pixel (never in practice).
+            base: self.samples as u32,
         };
         let env = EnvUniform {
             width: self.env.size.0,

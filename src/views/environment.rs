@@ -8,13 +8,13 @@
 //!   and tone map only re-display the samples already taken.
 //! - The view asks egui for the next frame only while it is visible and below
 //!   its target sample count, so a converged image costs no CPU.
-//! - Each frame adds a pass whose sample count adapts to the frame time (one
-//!   sample right after a restart, so dragging a slider stays smooth; more while
-//!   the image is left alone).
+//! - Each frame adds a pass whose sample count adapts to the measured cost of
+//!   a sample ([`PASS_BUDGET_S`] of device time per frame; one sample right
+//!   after a restart and during a drag, so a slider drag stays smooth).
 //! - Maps load on a worker thread (a large EXR takes a moment); a bad file is
 //!   reported in the view and the previous map stays.
 
-use super::gpu_image::{self, Drawable, GpuImage};
+use super::gpu_image::{self, Deferred, Drawable, GpuImage};
 use super::lit_sphere::{arrangement_control, exposure_control, tone_control};
 use super::{Scene, View};
 use crate::app::command::Command;
@@ -28,6 +28,17 @@ use std::time::Instant;
 
 /// Largest pass (samples per pixel per frame).
 pub const MAX_PASS_SPP: u32 = 64;
+
+/// Device time a pass may take per frame while the image is left alone: the
+/// window then still answers at about 15–20 frames per second on a software
+/// renderer, and a GPU adds its 64 samples per frame at once.
+pub const PASS_BUDGET_S: f64 = 0.045;
+
+/// Resolution of the accumulation, relative to the view's pixels, on a
+/// software renderer (lavapipe): a quarter of the samples per frame buys a
+/// clean image in a quarter of the time, and the image is stretched with
+/// linear filtering. A GPU renders at full resolution.
+pub const SOFTWARE_SCALE: f32 = 0.5;
 
 /// Field of view of the background behind the objects (vertical, degrees).
 const BACKGROUND_FOV_DEG: f64 = 60.0;
@@ -49,7 +60,7 @@ struct Loading {
 
 /// The environment view.
 pub struct EnvironmentView {
-    renderer: Option<Result<EnvRenderer, String>>,
+    renderer: Deferred<EnvRenderer>,
     image: GpuImage,
     /// The map the renderer holds (`None`: the built-in studio).
     map_in_use: Option<String>,
@@ -60,11 +71,14 @@ pub struct EnvironmentView {
     render_error: Option<String>,
     shown: Option<Shown>,
     pass_spp: u32,
+    /// Measured device seconds per sample per pixel (running average).
+    spp_cost: Option<f64>,
     restarts: u64,
     restarted_at: Option<Instant>,
     /// Seconds from the last restart to the target sample count.
     converged_after: Option<f64>,
     path_edit: Option<String>,
+    messages: Vec<String>,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
 }
@@ -79,7 +93,7 @@ impl EnvironmentView {
     /// A view that creates its renderer on first use.
     pub fn new() -> Self {
         Self {
-            renderer: None,
+            renderer: Deferred::Empty,
             image: GpuImage::default(),
             map_in_use: None,
             map_requested: None,
@@ -88,20 +102,21 @@ impl EnvironmentView {
             render_error: None,
             shown: None,
             pass_spp: 1,
+            spp_cost: None,
             restarts: 0,
             restarted_at: None,
             converged_after: None,
             path_edit: None,
+            messages: Vec::new(),
             view_rect: None,
         }
     }
 
     /// Samples per pixel accumulated in the image shown (0 before the first).
     pub fn samples_per_pixel(&self) -> u64 {
-        match &self.renderer {
-            Some(Ok(r)) => r.samples_per_pixel(),
-            _ => 0,
-        }
+        self.renderer
+            .ready()
+            .map_or(0, EnvRenderer::samples_per_pixel)
     }
 
     /// How many times the accumulation restarted.
@@ -121,6 +136,16 @@ impl EnvironmentView {
             (Some(a), None) | (None, Some(a)) => Some(a.clone()),
             (None, None) => None,
         }
+    }
+
+    /// The messages the last frame showed (BRDFs the GPU cannot draw, errors).
+    pub fn messages(&self) -> &[String] {
+        &self.messages
+    }
+
+    /// Whether the renderer is ready (it is built on a worker thread).
+    pub fn ready(&self) -> bool {
+        self.renderer.ready().is_some()
     }
 
     /// Whether a map is being loaded.
@@ -205,7 +230,7 @@ impl EnvironmentView {
     }
 
     fn install_map(&mut self, path: Option<String>, map: &EnvironmentMap) {
-        if let Some(Ok(r)) = &mut self.renderer {
+        if let Some(r) = self.renderer.ready_mut() {
             match r.set_environment(map) {
                 Ok(()) => {
                     self.map_in_use = path;
@@ -225,27 +250,30 @@ impl EnvironmentView {
         drawables: &[Drawable],
         env: &EnvView,
         size: (u32, u32),
+        interacting: bool,
     ) -> (Option<egui::TextureId>, bool) {
         let Some(rs) = gpu_image::render_state(ui.ctx()) else {
             return (None, false);
         };
-        if self.renderer.is_none() {
-            self.renderer = Some(
-                EnvironmentMap::builtin_studio()
-                    .and_then(|map| {
-                        let mut lib = gpu_image::library()?;
-                        EnvRenderer::new(gpu_image::gpu_of(&rs), &mut lib, &map)
-                    })
-                    .map_err(|e| format!("cannot build the environment renderer: {e:#}")),
-            );
-            self.map_in_use = None;
-            self.map_requested = None;
+        let gpu = gpu_image::gpu_of(&rs);
+        let built = self.renderer.poll(ui.ctx(), move || {
+            EnvironmentMap::builtin_studio()
+                .and_then(|map| {
+                    let mut lib = gpu_image::library()?;
+                    EnvRenderer::new(gpu, &mut lib, &map)
+                })
+                .map_err(|e| format!("cannot build the environment renderer: {e:#}"))
+        });
+        match built {
+            Ok(Some(_)) => {}
+            Ok(None) => return (None, false),
+            Err(e) => {
+                self.render_error = Some(e);
+                return (None, false);
+            }
         }
         self.sync_map(ui.ctx(), &env.map);
-        let Some(Ok(renderer)) = &mut self.renderer else {
-            if let Some(Err(e)) = &self.renderer {
-                self.render_error = Some(e.clone());
-            }
+        let Some(renderer) = self.renderer.ready_mut() else {
             return (None, false);
         };
         renderer.set_object(env.object.to_gpu());
@@ -257,23 +285,35 @@ impl EnvironmentView {
         let texture = if restart || done < target {
             if restart {
                 self.restarts += 1;
-                self.pass_spp = 1;
                 self.restarted_at = Some(Instant::now());
                 self.converged_after = None;
-            } else {
-                // Aim at ~30 fps on whatever device: grow the pass while frames
-                // are quick, shrink it when they are slow.
-                let dt = ui.input(|i| i.unstable_dt);
-                if dt < 0.03 {
-                    self.pass_spp = (self.pass_spp * 2).min(MAX_PASS_SPP);
-                } else if dt > 0.06 {
-                    self.pass_spp = (self.pass_spp / 2).max(1);
-                }
             }
+            // One sample right after a restart and while something is being
+            // dragged (the picture follows the pointer); otherwise as many as
+            // fit the per-frame budget at the measured cost.
+            self.pass_spp = match self.spp_cost {
+                Some(c) if !restart && !interacting && c > 0.0 => {
+                    ((PASS_BUDGET_S / c).floor() as u32).clamp(1, MAX_PASS_SPP)
+                }
+                _ => 1,
+            };
             let left = if restart { target } else { target - done };
             let pass = u64::from(self.pass_spp).min(left).max(1) as u32;
+            let t0 = Instant::now();
             match renderer.render(&specs, &settings, size.0, size.1, pass) {
-                Ok(t) => Some(t.clone()),
+                Ok(t) => {
+                    let t = t.clone();
+                    // Wait for the pass to measure its cost (the frame would
+                    // wait for it anyway before it can be shown).
+                    if renderer.gpu().wait().is_ok() {
+                        let c = t0.elapsed().as_secs_f64() / f64::from(pass);
+                        self.spp_cost = Some(match self.spp_cost {
+                            Some(old) => 0.6 * old + 0.4 * c,
+                            None => c,
+                        });
+                    }
+                    Some(t)
+                }
                 Err(e) => {
                     self.render_error = Some(format!("{e:#}"));
                     return (None, false);
@@ -396,7 +436,7 @@ impl View for EnvironmentView {
         if rect.width() < 8.0 || rect.height() < 8.0 {
             return;
         }
-        let _response = ui.allocate_rect(rect, Sense::hover());
+        let response = ui.allocate_rect(rect, Sense::hover());
         self.view_rect = Some(rect);
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, Color32::BLACK);
@@ -437,10 +477,23 @@ impl View for EnvironmentView {
             return;
         }
         let (drawables, mut errors) = gpu_image::drawables(scene, env.side_by_side);
-        let size = gpu_image::pixel_size(rect, ui.ctx().pixels_per_point());
+        let rs = gpu_image::render_state(ui.ctx());
+        let software = rs.as_ref().is_some_and(gpu_image::is_software);
+        let scale = if software { SOFTWARE_SCALE } else { 1.0 };
+        if let Some(rs) = &rs {
+            self.image.set_filter(
+                rs,
+                if software {
+                    eframe::wgpu::FilterMode::Linear
+                } else {
+                    eframe::wgpu::FilterMode::Nearest
+                },
+            );
+        }
+        let size = gpu_image::pixel_size(rect, ui.ctx().pixels_per_point() * scale);
         let mut more = false;
         if !drawables.is_empty() {
-            let (id, m) = self.step(ui, &drawables, env, size);
+            let (id, m) = self.step(ui, &drawables, env, size, scene.interacting);
             more = m;
             if let Some(id) = id {
                 painter.image(
@@ -452,16 +505,52 @@ impl View for EnvironmentView {
             }
         } else {
             // Still take a finished map load.
-            if self.renderer.is_some() {
+            if self.renderer.ready().is_some() {
                 self.sync_map(ui.ctx(), &env.map);
             }
         }
         if more || self.loading.is_some() {
             ui.ctx().request_repaint();
         }
+        let (restarted, converged, pass, cost) = (
+            self.restarted_at,
+            self.converged_after,
+            self.pass_spp,
+            self.spp_cost,
+        );
+        response.on_hover_ui(|ui| {
+            ui.label(format!(
+                "{} samples per pixel (one BRDF and one environment sample each, combined \
+                 with the power heuristic); stops at {}.",
+                self.samples_per_pixel(),
+                env.target_spp
+            ));
+            match (converged, restarted) {
+                (Some(t), _) => ui.label(format!("Reached it {t:.1} s after the last change.")),
+                (None, Some(t)) => ui.label(format!(
+                    "{:.1} s since the last change; {pass} samples per frame ({:.2} ms each).",
+                    t.elapsed().as_secs_f64(),
+                    cost.unwrap_or(0.0) * 1e3
+                )),
+                (None, None) => ui.label(""),
+            };
+            if software {
+                ui.label("Software renderer: accumulated at half the view's resolution.");
+            }
+        });
+        if self.renderer.building() {
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "compiling the shaders…",
+                egui::FontId::proportional(14.0),
+                weak,
+            );
+        }
         if let Some(e) = self.error() {
             errors.push(e);
         }
+        self.messages = errors.clone();
 
         // Overlays: sample count, map, labels, errors.
         let text = Color32::from_gray(235);
@@ -469,9 +558,6 @@ impl View for EnvironmentView {
         let mut status = format!("{spp} spp");
         if spp >= u64::from(env.target_spp) && !drawables.is_empty() {
             status.push_str(" · done");
-            if let Some(t) = self.converged_after {
-                status.push_str(&format!(" in {t:.1} s"));
-            }
         } else if self.pass_spp > 1 {
             status.push_str(&format!(" (+{} per frame)", self.pass_spp));
         }
@@ -503,7 +589,7 @@ impl View for EnvironmentView {
             let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
             gpu_image::plate_text(
                 &painter,
-                egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 20.0)),
+                egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
                 Align2::CENTER_TOP,
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),

@@ -32,6 +32,12 @@ pub fn render_state(ctx: &egui::Context) -> Option<RenderState> {
     ctx.data(|d| d.get_temp::<RenderState>(key()))
 }
 
+/// Whether the adapter is a CPU (lavapipe, llvmpipe, WARP): the views then
+/// trade resolution for speed where a GPU would not need to.
+pub fn is_software(rs: &RenderState) -> bool {
+    rs.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+}
+
 /// The renderers' device, built from egui's.
 pub fn gpu_of(rs: &RenderState) -> Gpu {
     Gpu::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info())
@@ -43,19 +49,115 @@ pub fn library() -> anyhow::Result<ShaderLibrary> {
     ShaderLibrary::new()
 }
 
+/// A renderer built on a worker thread: composing the shaders and, above
+/// all, the driver's compilation of the pipelines (seconds for the
+/// environment shader on lavapipe with a cold shader cache) must not freeze
+/// the window.
+#[derive(Default)]
+pub enum Deferred<T> {
+    /// Not asked for yet.
+    #[default]
+    Empty,
+    /// Being built.
+    Building(std::sync::mpsc::Receiver<Result<T, String>>),
+    /// Built.
+    Ready(T),
+    /// Building failed (the message says why).
+    Failed(String),
+}
+
+impl<T: Send + 'static> Deferred<T> {
+    /// Starts `build` on a worker thread the first time, takes its result when
+    /// it is there: `Ok(Some(_))` when ready, `Ok(None)` while building (the
+    /// worker asks `ctx` for a frame when it is done).
+    pub fn poll(
+        &mut self,
+        ctx: &egui::Context,
+        build: impl FnOnce() -> Result<T, String> + Send + 'static,
+    ) -> Result<Option<&mut T>, String> {
+        if matches!(self, Deferred::Empty) {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let ctx2 = ctx.clone();
+            let spawned = std::thread::Builder::new()
+                .name("bv renderer build".into())
+                .spawn(move || {
+                    // The receiver is gone only if the view was dropped.
+                    let _ = tx.send(build());
+                    ctx2.request_repaint();
+                });
+            *self = match spawned {
+                Ok(_) => Deferred::Building(rx),
+                Err(e) => Deferred::Failed(format!("cannot start a worker thread: {e}")),
+            };
+        }
+        if let Deferred::Building(rx) = self {
+            match rx.try_recv() {
+                Ok(Ok(t)) => *self = Deferred::Ready(t),
+                Ok(Err(e)) => *self = Deferred::Failed(e),
+                Err(std::sync::mpsc::TryRecvError::Empty) => return Ok(None),
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                    *self = Deferred::Failed("the renderer build stopped".into())
+                }
+            }
+        }
+        match self {
+            Deferred::Ready(t) => Ok(Some(t)),
+            Deferred::Failed(e) => Err(e.clone()),
+            Deferred::Empty | Deferred::Building(_) => Ok(None),
+        }
+    }
+
+    /// The built value, if ready.
+    pub fn ready(&self) -> Option<&T> {
+        match self {
+            Deferred::Ready(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// The built value, if ready.
+    pub fn ready_mut(&mut self) -> Option<&mut T> {
+        match self {
+            Deferred::Ready(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// Whether it is being built.
+    pub fn building(&self) -> bool {
+        matches!(self, Deferred::Building(_))
+    }
+}
+
 /// An offscreen texture shown by egui: registered once, re-pointed when the
 /// renderer replaces the texture (on a resize), freed with the view.
 #[derive(Default)]
 pub struct GpuImage {
     registered: Option<(TextureId, wgpu::Texture)>,
     render_state: Option<RenderState>,
+    filter: Option<wgpu::FilterMode>,
 }
 
 impl GpuImage {
+    /// Sets how egui samples the texture (nearest for an image at screen
+    /// resolution, linear for one rendered smaller and stretched).
+    pub fn set_filter(&mut self, rs: &RenderState, filter: wgpu::FilterMode) {
+        if self.filter.unwrap_or(wgpu::FilterMode::Nearest) != filter {
+            self.filter = Some(filter);
+            if let Some((id, t)) = &self.registered {
+                let view = t.create_view(&wgpu::TextureViewDescriptor::default());
+                rs.renderer
+                    .write()
+                    .update_egui_texture_from_wgpu_texture(&rs.device, &view, filter, *id);
+            }
+        }
+    }
+
     /// The egui id of `texture` (an `Rgba8Unorm` texture holding sRGB-encoded
     /// values: what egui-wgpu expects of a native texture).
     pub fn id(&mut self, rs: &RenderState, texture: &wgpu::Texture) -> TextureId {
         let view = || texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let filter = self.filter.unwrap_or(wgpu::FilterMode::Nearest);
         match &self.registered {
             Some((id, t)) if t == texture => *id,
             Some((id, _)) => {
@@ -63,18 +165,17 @@ impl GpuImage {
                 rs.renderer.write().update_egui_texture_from_wgpu_texture(
                     &rs.device,
                     &view(),
-                    wgpu::FilterMode::Nearest,
+                    filter,
                     id,
                 );
                 self.registered = Some((id, texture.clone()));
                 id
             }
             None => {
-                let id = rs.renderer.write().register_native_texture(
-                    &rs.device,
-                    &view(),
-                    wgpu::FilterMode::Nearest,
-                );
+                let id = rs
+                    .renderer
+                    .write()
+                    .register_native_texture(&rs.device, &view(), filter);
                 self.registered = Some((id, texture.clone()));
                 self.render_state = Some(rs.clone());
                 id

@@ -14,7 +14,7 @@
 //! pixel size, and only when something it depends on changed (BRDF specs,
 //! light, settings, size), so an idle or unrelated frame costs nothing.
 
-use super::gpu_image::{self, Drawable, GpuImage};
+use super::gpu_image::{self, Deferred, Drawable, GpuImage};
 use super::{Scene, View};
 use crate::app::command::Command;
 use crate::app::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
@@ -37,12 +37,13 @@ struct FrameKey {
 /// The lit sphere view.
 #[derive(Default)]
 pub struct LitSphereView {
-    renderer: Option<Result<LitSphereRenderer, String>>,
+    renderer: Deferred<LitSphereRenderer>,
     image: GpuImage,
     drawn: Option<FrameKey>,
     renders: u64,
     last_render_ms: f64,
     error: Option<String>,
+    messages: Vec<String>,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
     /// How many spheres the last frame showed.
@@ -64,6 +65,16 @@ impl LitSphereView {
     /// CPU time of the last render call (recording and submitting), ms.
     pub fn last_render_ms(&self) -> f64 {
         self.last_render_ms
+    }
+
+    /// The messages the last frame showed (BRDFs the GPU cannot draw, errors).
+    pub fn messages(&self) -> &[String] {
+        &self.messages
+    }
+
+    /// Whether the renderer is ready (it is built on a worker thread).
+    pub fn ready(&self) -> bool {
+        self.renderer.ready().is_some()
     }
 
     /// The last error (renderer creation or rendering), if any.
@@ -94,15 +105,16 @@ impl LitSphereView {
         size: (u32, u32),
     ) -> Option<egui::TextureId> {
         let rs = gpu_image::render_state(ui.ctx())?;
-        let renderer = self.renderer.get_or_insert_with(|| {
+        let gpu = gpu_image::gpu_of(&rs);
+        let renderer = match self.renderer.poll(ui.ctx(), move || {
             gpu_image::library()
-                .and_then(|mut lib| LitSphereRenderer::new(gpu_image::gpu_of(&rs), &mut lib))
+                .and_then(|mut lib| LitSphereRenderer::new(gpu, &mut lib))
                 .map_err(|e| format!("cannot build the lit sphere renderer: {e:#}"))
-        });
-        let renderer = match renderer {
-            Ok(r) => r,
+        }) {
+            Ok(Some(r)) => r,
+            Ok(None) => return None,
             Err(e) => {
-                self.error = Some(e.clone());
+                self.error = Some(e);
                 return None;
             }
         };
@@ -201,6 +213,7 @@ impl View for LitSphereView {
         if let Some(e) = &self.error {
             errors.push(e.clone());
         }
+        self.messages = errors.clone();
 
         // Light drag: the light goes where the pointer is on the sphere.
         if (response.dragged() || response.clicked())
@@ -216,6 +229,15 @@ impl View for LitSphereView {
             out.push(Command::SetIncident(Incident::from_direction(dir)));
         }
 
+        if self.renderer.building() {
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "compiling the shaders…",
+                egui::FontId::proportional(14.0),
+                weak,
+            );
+        }
         self.overlays(ui, rect, scene, &drawables, &errors, dark, text, weak);
         if let Some(p) = response.hover_pos() {
             self.hover_value(ui, rect, p, scene, &drawables, text);
@@ -250,16 +272,14 @@ impl LitSphereView {
             let at = c + Vec2::new(wi.x as f32, -wi.y as f32) * r;
             painter.circle_stroke(at, 5.0, Stroke::new(2.0, light));
             painter.circle_stroke(at, 6.5, Stroke::new(1.0, Color32::from_black_alpha(160)));
-            if drawables.len() > 1 || !scene.brdfs.is_empty() {
-                let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
-                gpu_image::plate_text(
-                    &painter,
-                    egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 20.0)),
-                    Align2::CENTER_TOP,
-                    &d.brdf.label,
-                    Color32::from_rgb(cr, cg, cb),
-                );
-            }
+            let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
+            gpu_image::plate_text(
+                &painter,
+                egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
+                Align2::CENTER_TOP,
+                &d.brdf.label,
+                Color32::from_rgb(cr, cg, cb),
+            );
         }
         let lit = scene.state.lighting.lit;
         let status = format!(
@@ -270,20 +290,22 @@ impl LitSphereView {
             lit.tone_map.label()
         );
         painter.text(
-            rect.left_bottom() + Vec2::new(6.0, -22.0),
-            Align2::LEFT_BOTTOM,
+            rect.left_top() + Vec2::new(6.0, 4.0),
+            Align2::LEFT_TOP,
             status,
             egui::FontId::proportional(12.0),
             text,
         );
-        painter.text(
-            rect.left_bottom() + Vec2::new(6.0, -5.0),
-            Align2::LEFT_BOTTOM,
-            "drag on a sphere: move the light · ring: where the light is",
-            egui::FontId::proportional(12.0),
-            weak,
-        );
-        let mut y = rect.min.y + 6.0;
+        if rect.height() > 220.0 {
+            painter.text(
+                rect.left_bottom() + Vec2::new(6.0, -5.0),
+                Align2::LEFT_BOTTOM,
+                "drag on a sphere: move the light · ring: where the light is",
+                egui::FontId::proportional(12.0),
+                weak,
+            );
+        }
+        let mut y = rect.min.y + 24.0;
         for e in errors {
             let r = gpu_image::plate_text(
                 &painter,
