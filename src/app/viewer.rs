@@ -8,7 +8,10 @@
 use super::command::Command;
 use super::panel;
 use super::runtime::Runtime;
+use super::scene;
+use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::state::{AppState, Theme};
+use std::path::Path;
 use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
 use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
 
@@ -25,9 +28,12 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "M",
         "maximise the view under the pointer (again to restore)",
     ),
-    ("1, 2, 3", "maximise view 1, 2, 3 (again to restore)"),
+    ("1 … 9", "maximise view 1 … 9 (again to restore)"),
     ("Esc", "restore the layout"),
     ("T", "switch between dark and light themes"),
+    ("Ctrl+O", "open a scene file"),
+    ("Ctrl+S", "save the scene (to the file it came from)"),
+    ("Ctrl+Shift+S", "export a figure: a view or the window as PNG / SVG / OBJ"),
     ("Ctrl+Q", "quit (the session is saved)"),
 ];
 
@@ -53,6 +59,8 @@ pub struct Viewer {
     applied_theme: Option<Theme>,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
+    /// Scene files, figure export and toasts.
+    pub export: ExportUi,
 }
 
 impl Viewer {
@@ -67,6 +75,82 @@ impl Viewer {
             help: false,
             applied_theme: None,
             force_interacting: false,
+            export: ExportUi::default(),
+        }
+    }
+
+    /// Replaces the whole state (a scene was opened).
+    pub fn replace_state(&mut self, state: AppState) {
+        self.state = state.sanitised();
+        self.pending.clear();
+    }
+
+    /// Opens a scene file; returns its warnings. On error the state is
+    /// unchanged.
+    pub fn open_scene(&mut self, path: &Path) -> Result<Vec<String>, scene::SceneError> {
+        let loaded = scene::load(path)?;
+        // Keep the theme the user chose for the window.
+        let theme = self.state.theme;
+        self.replace_state(AppState {
+            theme,
+            ..loaded.state
+        });
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(loaded.warnings)
+    }
+
+    /// Saves the state as a scene file (atomically).
+    pub fn save_scene(&mut self, path: &Path) -> Result<(), scene::SceneError> {
+        scene::save(path, &self.state)?;
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(())
+    }
+
+    fn handle(&mut self, r: Request, ctx: &egui::Context) {
+        match r {
+            Request::OpenScene(path) => match self.open_scene(&path) {
+                Ok(w) => {
+                    let line = screenshot::warnings_line(&path, &w);
+                    if !w.is_empty() {
+                        self.status = Some(line.clone());
+                    }
+                    self.export.toast(line, false);
+                }
+                Err(e) => {
+                    let msg = format!("Could not open {}: {e}", path.display());
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::SaveScene(path) => match self.save_scene(&path) {
+                Ok(()) => self
+                    .export
+                    .toast(format!("Saved the scene to {}", path.display()), false),
+                Err(e) => {
+                    let msg = format!("Could not save the scene: {e}");
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::Figure(settings, path) => {
+                let geometry = ScreenGeometry {
+                    window: ctx.content_rect().size(),
+                    pixels_per_point: ctx.pixels_per_point(),
+                };
+                let view_size = match &settings.target {
+                    screenshot::Target::View(id) => view_rect(ctx, id).map(|r| r.size()),
+                    screenshot::Target::Window => None,
+                };
+                match self
+                    .export
+                    .export_figure(&self.state, &settings, &path, geometry, view_size)
+                {
+                    Ok(line) => self.export.toast(line, false),
+                    Err(e) => self
+                        .export
+                        .toast(format!("Could not export the figure: {e:#}"), true),
+                }
+            }
         }
     }
 
@@ -146,6 +230,9 @@ impl Viewer {
         }
         self.shortcuts(&ctx, &mut out);
         self.help_window(&ctx);
+        for r in self.export.ui(&ctx) {
+            self.handle(r, &ctx);
+        }
         if !out.is_empty() {
             // Repaint only for real changes, so a widget that re-sends the same
             // value cannot keep the app busy.
@@ -163,6 +250,28 @@ impl Viewer {
             ui.horizontal(|ui| {
                 ui.label(RichText::new("bv").strong().size(16.0));
                 ui.weak("BRDF viewer");
+                ui.separator();
+                if ui
+                    .button("Open…")
+                    .on_hover_text("Open a scene file (Ctrl+O)")
+                    .clicked()
+                {
+                    self.export.ask_open_scene();
+                }
+                if ui
+                    .button("Save…")
+                    .on_hover_text("Save the scene as a TOML file (Ctrl+S)")
+                    .clicked()
+                {
+                    self.export.ask_save_scene();
+                }
+                if ui
+                    .button("Export…")
+                    .on_hover_text("A view or the window as PNG, SVG or OBJ (Ctrl+Shift+S)")
+                    .clicked()
+                {
+                    self.export.dialog_open = true;
+                }
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
                         .button("? help")
@@ -224,6 +333,18 @@ impl Viewer {
         if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
+        // Shift+S first: `consume_key` with COMMAND alone would also match it.
+        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S)) {
+            self.export.dialog_open = !self.export.dialog_open;
+        } else if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::S)) {
+            match self.export.scene_path.clone() {
+                Some(p) => self.handle(Request::SaveScene(p), ctx),
+                None => self.export.ask_save_scene(),
+            }
+        }
+        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::O)) {
+            self.export.ask_open_scene();
+        }
         if ctx.egui_wants_keyboard_input() {
             return;
         }
@@ -242,6 +363,12 @@ impl Viewer {
                 Key::Num1,
                 Key::Num2,
                 Key::Num3,
+                Key::Num4,
+                Key::Num5,
+                Key::Num6,
+                Key::Num7,
+                Key::Num8,
+                Key::Num9,
                 Key::Escape,
                 Key::T,
             ];
@@ -277,12 +404,27 @@ impl Viewer {
                         out.push(Command::ToggleMaximise(id.to_string()));
                     }
                 }
-                Key::Num1 | Key::Num2 | Key::Num3 => {
-                    let i = match k {
-                        Key::Num1 => 0,
-                        Key::Num2 => 1,
-                        _ => 2,
-                    };
+                Key::Num1
+                | Key::Num2
+                | Key::Num3
+                | Key::Num4
+                | Key::Num5
+                | Key::Num6
+                | Key::Num7
+                | Key::Num8
+                | Key::Num9 => {
+                    let keys = [
+                        Key::Num1,
+                        Key::Num2,
+                        Key::Num3,
+                        Key::Num4,
+                        Key::Num5,
+                        Key::Num6,
+                        Key::Num7,
+                        Key::Num8,
+                        Key::Num9,
+                    ];
+                    let i = keys.iter().position(|x| *x == k).unwrap_or(0);
                     if let Some(e) = REGISTRY.get(i) {
                         out.push(Command::ToggleMaximise(e.id.to_string()));
                     }
@@ -342,6 +484,17 @@ impl Viewer {
     }
 }
 
+/// Where view `id` was drawn in the last frame.
+pub fn view_rect(ctx: &egui::Context, id: &str) -> Option<Rect> {
+    ctx.memory(|m| {
+        m.data
+            .get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"))
+    })?
+    .into_iter()
+    .find(|(v, _)| v == id)
+    .map(|(_, r)| r)
+}
+
 /// Lays out the views in the central area.
 fn central(
     ui: &mut Ui,
@@ -390,6 +543,8 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
         brdfs,
         incident: state.incident,
         interacting,
+        figure: false,
+        transparent: false,
     }
 }
 
