@@ -153,7 +153,9 @@ pub fn labelled(ticks: Vec<f64>) -> Vec<(f64, String)> {
 pub fn angle_ticks(lo: f64, hi: f64) -> Vec<(f64, String)> {
     let span = hi - lo;
     let step = if span > 200.0 {
-        30.0
+        90.0
+    } else if span > 100.0 {
+        45.0
     } else if span > 50.0 {
         15.0
     } else {
@@ -397,7 +399,7 @@ mod tests {
         assert!(nice_ticks(1.0, 1.0, 5).is_empty());
         let a = angle_ticks(-90.0, 90.0);
         assert_eq!(a.first().unwrap().0, -90.0);
-        assert_eq!(a.len(), 13);
+        assert_eq!(a.len(), 5);
     }
 
     #[test]
