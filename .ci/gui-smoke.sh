@@ -41,8 +41,10 @@ screen="1280x800x24"
 
 # Models to show: Cook-Torrance over Lambert when this build has it.
 models=(--model lambert)
-if "$bv" --fresh --model cook-torrance --size 1x1 2>&1 | grep -q "out of range"; then
-    # `--size 1x1` is refused after the model ids were checked: cook-torrance exists.
+# `--size 1x1` is refused after the model ids are checked, so "out of range"
+# means cook-torrance exists (the probe exits 1 either way; no window opens).
+probe="$("$bv" --fresh --model cook-torrance --size 1x1 2>&1 || true)"
+if grep -q "out of range" <<<"$probe"; then
     models=(--model lambert --model cook-torrance)
 fi
 

@@ -86,6 +86,13 @@ fn add_a_brdf_by_its_label_and_remove_it() {
     assert_eq!(h.state().state().brdfs.len(), 1);
     assert!(h.query_by_label(&format!("Remove {second}")).is_none());
     assert!(lobe(&h).mesh(ids[1]).is_none(), "its mesh is dropped");
+
+    // Removing the last one leaves an empty, working window.
+    h.get_by_label(&format!("Remove {}", first.name)).click();
+    h.run();
+    assert!(h.state().state().brdfs.is_empty());
+    assert_eq!(h.state().state().selected, None);
+    h.get_by_label("Add BRDF");
 }
 
 #[test]
@@ -646,5 +653,24 @@ fn render_window_states() {
         h.run();
         let img = h.render().unwrap();
         img.save(format!("{dir}/{name}.png")).unwrap();
+    }
+}
+
+#[test]
+fn lobe_view_shaders_validate() {
+    use bv::views::lobe_gpu::{BLIT_WGSL, LINES_WGSL, lobe_shader_source};
+    for (name, src) in [
+        ("lobe.wgsl", lobe_shader_source()),
+        ("lines.wgsl", LINES_WGSL.to_string()),
+        ("blit.wgsl", BLIT_WGSL.to_string()),
+    ] {
+        let module = naga::front::wgsl::parse_str(&src)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
     }
 }

@@ -46,7 +46,8 @@ pub struct ViewerArgs {
     pub fresh: bool,
 
     /// Benchmark: drive a scripted slider sweep of the selected BRDF for N
-    /// frames, print the frame-time p50/p95 and exit.
+    /// frames, print the frame-time p50/p95 and exit. (Set
+    /// BV_BENCH_MAXIMISE=lobe|polar|cartesian to time one view alone.)
     #[arg(long, value_name = "N")]
     pub bench_frames: Option<usize>,
 

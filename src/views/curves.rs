@@ -229,10 +229,13 @@ pub fn round_significant(v: f64, digits: i32) -> f64 {
 /// (`0.2`, `0.05`, `150`).
 pub fn fmt_tick(v: f64) -> String {
     let s = fmt_value(v);
-    if s.contains('e') || !s.contains('.') {
-        return s;
+    let trim = |m: &str| m.trim_end_matches('0').trim_end_matches('.').to_string();
+    match s.split_once('e') {
+        Some((mantissa, exp)) if mantissa.contains('.') => format!("{}e{exp}", trim(mantissa)),
+        Some(_) => s,
+        None if s.contains('.') => trim(&s),
+        None => s,
     }
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 #[cfg(test)]
@@ -310,6 +313,9 @@ mod tests {
         assert_eq!(round_significant(648.7, 2), 650.0);
         assert_eq!(fmt_tick(150.0), "150");
         assert_eq!(fmt_tick(0.05), "0.05");
+        assert_eq!(fmt_tick(1e5), "1e5");
+        assert_eq!(fmt_tick(2.5e5), "2.5e5");
+        assert_eq!(fmt_tick(2e-5), "2e-5");
     }
 
     #[test]

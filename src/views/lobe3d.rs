@@ -693,6 +693,8 @@ impl Lobe3dView {
             && d.color_by_value
             && !d.wireframe
             && let Some(c) = self.cache.get(&p.id)
+            // A pure delta model has no lobe to colour.
+            && c.mesh.max_value > 0.0
         {
             let vmax = c.mesh.max_value;
             // Bottom right: below the horizon, where reflection lobes never go.

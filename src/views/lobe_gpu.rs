@@ -27,6 +27,17 @@ pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unor
 /// Depth format of the offscreen target.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// The lobe surface shader, with the colour map table filled in.
+pub fn lobe_shader_source() -> String {
+    include_str!("../../shaders/lobe.wgsl").replace("COLORMAP_TABLE", &colormap::wgsl_table())
+}
+
+/// The screen-space line shader.
+pub const LINES_WGSL: &str = include_str!("../../shaders/lines.wgsl");
+
+/// The shader that copies the offscreen image into egui's pass.
+pub const BLIT_WGSL: &str = include_str!("../../shaders/blit.wgsl");
+
 /// How one lobe is drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshStyle {
@@ -319,19 +330,18 @@ impl LobeRenderer {
             ..Default::default()
         });
 
-        let lobe_src = include_str!("../../shaders/lobe.wgsl")
-            .replace("COLORMAP_TABLE", &colormap::wgsl_table());
+        let lobe_src = lobe_shader_source();
         let lobe_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bv lobe.wgsl"),
             source: wgpu::ShaderSource::Wgsl(lobe_src.into()),
         });
         let lines_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bv lines.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/lines.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(LINES_WGSL.into()),
         });
         let blit_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("bv blit.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("../../shaders/blit.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(BLIT_WGSL.into()),
         });
 
         let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
