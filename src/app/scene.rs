@@ -104,7 +104,7 @@ pub struct Loaded {
 pub fn to_toml(state: &AppState) -> Result<String, SceneError> {
     let mut state = state.clone();
     state.version = STATE_VERSION;
-    let body = toml::to_string_pretty(&state).map_err(|e| SceneError::Syntax(e.to_string()))?;
+    let body = toml::to_string(&state).map_err(|e| SceneError::Syntax(e.to_string()))?;
     let mut out = String::new();
     out.push_str(
         "# bv scene: BRDFs (model, parameters, colour, visibility), light, camera,\n\
@@ -163,9 +163,17 @@ pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
                 reason: format!("expected a format version 1..={STATE_VERSION}, found {other}"),
             });
         }
-        None => warnings.push(format!(
-            "no `version`; assuming format version {STATE_VERSION}"
-        )),
+        // Required, so that a file cut short before bv's header is refused
+        // rather than read as an empty scene.
+        None => {
+            return Err(SceneError::BadValue {
+                key: "version".into(),
+                reason: format!(
+                    "missing: a scene file starts with `format = \"{FORMAT}\"` and \
+                     `version = {STATE_VERSION}` (an empty or truncated file?)"
+                ),
+            });
+        }
     }
     if header.generator.is_some() && !ends_with_marker(text) {
         return Err(SceneError::Truncated);
@@ -187,7 +195,11 @@ pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
                 key: key.clone(),
                 reason: e.to_string(),
             })?;
-            let entry: BrdfEntry = serde_json::from_value(json.clone()).map_err(|e| {
+            let mut unknown = Vec::new();
+            let entry: BrdfEntry = serde_ignored::deserialize(json.clone(), |p| {
+                unknown.push(p.to_string());
+            })
+            .map_err(|e: serde_json::Error| {
                 let model = json
                     .get("spec")
                     .and_then(|s| s.get("model"))
@@ -199,6 +211,9 @@ pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
                     reason: e.to_string(),
                 }
             })?;
+            for u in unknown {
+                warnings.push(format!("unknown key `{key}.{u}` ignored"));
+            }
             if !ids.insert(entry.id) {
                 return Err(SceneError::BadValue {
                     key: format!("{key}.id"),
