@@ -40,7 +40,10 @@ fn two_brdfs() -> AppState {
 fn ctrl_shift_s_opens_the_export_dialog() {
     let mut h = viewer(two_brdfs());
     assert!(h.query_by_label("Export figure").is_none());
-    h.key_press_modifiers(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, egui::Key::S);
+    h.key_press_modifiers(
+        egui::Modifiers::COMMAND | egui::Modifiers::SHIFT,
+        egui::Key::S,
+    );
     h.run();
     assert!(h.state().export.dialog_open);
     assert!(h.get_all_by_label("Export figure").count() >= 1);
@@ -59,7 +62,11 @@ fn ctrl_shift_s_opens_the_export_dialog() {
     let loaded = bv::app::scene::load(&path).unwrap();
     assert_eq!(&loaded.state, h.state().state());
     let toast = h.state().export.toast.clone().unwrap();
-    assert!(toast.text.contains("ctrl-s.toml") && !toast.error, "{}", toast.text);
+    assert!(
+        toast.text.contains("ctrl-s.toml") && !toast.error,
+        "{}",
+        toast.text
+    );
 }
 
 fn geometry(ppp: f32) -> ScreenGeometry {
@@ -127,7 +134,13 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
             transparent: false,
         };
         v.export
-            .export_figure(&state, &s, &path, geometry(1.0), Some(egui::vec2(400.0, 300.0)))
+            .export_figure(
+                &state,
+                &s,
+                &path,
+                geometry(1.0),
+                Some(egui::vec2(400.0, 300.0)),
+            )
             .unwrap();
         assert!(std::fs::metadata(&path).unwrap().len() > 1000, "{name}");
     }
@@ -169,11 +182,28 @@ fn the_albedo_view_computes_in_the_background_and_finishes() {
 #[test]
 fn the_fresnel_view_follows_the_selected_brdf() {
     let mut h = viewer(two_brdfs());
-    let c = h.state().view::<FresnelView>().unwrap().last.clone().unwrap();
+    let c = h
+        .state()
+        .view::<FresnelView>()
+        .unwrap()
+        .last
+        .clone()
+        .unwrap();
     // Cook-Torrance's default is a dielectric of η = 1.5: Rp, Rs, F, F inside;
     // Brewster's angle atan 1.5 = 56.31°, the critical angle asin(1/1.5) = 41.81°.
-    assert_eq!(c.series.len(), 4, "{:?}", c.series.iter().map(|s| &s.label).collect::<Vec<_>>());
-    let at = |prefix: &str| c.vlines.iter().find(|m| m.label.starts_with(prefix)).unwrap().at;
+    assert_eq!(
+        c.series.len(),
+        4,
+        "{:?}",
+        c.series.iter().map(|s| &s.label).collect::<Vec<_>>()
+    );
+    let at = |prefix: &str| {
+        c.vlines
+            .iter()
+            .find(|m| m.label.starts_with(prefix))
+            .unwrap()
+            .at
+    };
     assert!((at("θB") - 1.5f64.atan().to_degrees()).abs() < 1e-9);
     assert!((at("θc") - (1.0f64 / 1.5).asin().to_degrees()).abs() < 1e-9);
     // Brewster: Rp is 0 there.
@@ -188,7 +218,13 @@ fn the_fresnel_view_follows_the_selected_brdf() {
     let lambert = h.state().state().brdfs[1].id;
     h.state_mut().push(Command::Select(lambert));
     h.run();
-    let c = h.state().view::<FresnelView>().unwrap().last.clone().unwrap();
+    let c = h
+        .state()
+        .view::<FresnelView>()
+        .unwrap()
+        .last
+        .clone()
+        .unwrap();
     assert!(c.series.is_empty());
     assert!(c.note.contains("no Fresnel term"), "{}", c.note);
 }

@@ -76,7 +76,7 @@ fn view_ids() -> Vec<String> {
     plain
         .split(',')
         .map(|v| v.trim().to_string())
-        .filter(|v| !v.is_empty() && v != "all")
+        .filter(|v| !v.is_empty() && v != "all" && v != "window")
         .collect()
 }
 
@@ -143,14 +143,27 @@ fn colours(img: &image::RgbaImage) -> usize {
 fn every_view_of_two_models_matches_its_snapshot() {
     let views = view_ids();
     for v in ["lobe", "polar", "cartesian", "albedo", "fresnel"] {
-        assert!(views.iter().any(|x| x == v), "view {v} missing from {views:?}");
+        assert!(
+            views.iter().any(|x| x == v),
+            "view {v} missing from {views:?}"
+        );
     }
     let mut failures = Vec::new();
     for (model, params) in MODELS {
         let dir = out_dir(model);
         let mut args = vec![
-            "render", "--model", model, "--view", "all", "--theta-i", "40", "--width", "160",
-            "--height", "120", "--out",
+            "render",
+            "--model",
+            model,
+            "--view",
+            "all",
+            "--theta-i",
+            "40",
+            "--width",
+            "160",
+            "--height",
+            "120",
+            "--out",
         ];
         let dir_s = dir.to_string_lossy().to_string();
         args.push(&dir_s);
@@ -186,8 +199,18 @@ fn sizes_scales_and_transparency() {
     let p = dir.join("lobe.png");
     let ps = p.to_string_lossy().to_string();
     run(&[
-        "render", "--model", "lambert", "--view", "lobe3d", "--width", "320", "--height", "200",
-        "--transparent", "--out", &ps,
+        "render",
+        "--model",
+        "lambert",
+        "--view",
+        "lobe3d",
+        "--width",
+        "320",
+        "--height",
+        "200",
+        "--transparent",
+        "--out",
+        &ps,
     ]);
     let img = image::open(&p).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (320, 200));
@@ -201,8 +224,19 @@ fn sizes_scales_and_transparency() {
     let p2 = dir.join("polar2.png");
     for (p, w, h, s) in [(&p1, "300", "200", "1"), (&p2, "600", "400", "2")] {
         run(&[
-            "render", "--model", "phong", "--view", "polar", "--width", w, "--height", h,
-            "--scale", s, "--out", &p.to_string_lossy(),
+            "render",
+            "--model",
+            "phong",
+            "--view",
+            "polar",
+            "--width",
+            w,
+            "--height",
+            h,
+            "--scale",
+            s,
+            "--out",
+            &p.to_string_lossy(),
         ]);
     }
     let a = image::open(&p1).unwrap().to_rgba8();
@@ -220,14 +254,52 @@ fn sizes_scales_and_transparency() {
 #[test]
 fn bad_requests_fail_with_a_clear_message() {
     let cases: &[(&[&str], &str)] = &[
-        (&["render", "--view", "lit-sphere-x", "--out", "x.png"], "available:"),
+        (
+            &["render", "--view", "lit-sphere-x", "--out", "x.png"],
+            "available:",
+        ),
         (&["render", "--view", "polar", "--out", "x.jpg"], ".png"),
-        (&["render", "--view", "lobe", "--out", "x.svg"], "no vector form"),
+        (
+            &["render", "--view", "lobe", "--out", "x.svg"],
+            "no vector form",
+        ),
         (&["render", "--view", "polar", "--out", "x.obj"], "lobe"),
-        (&["render", "--model", "nope", "--view", "polar", "--out", "x.png"], "nope"),
-        (&["render", "--view", "polar", "--theta-i", "120", "--out", "x.png"], "--theta-i"),
-        (&["render", "--view", "polar", "--width", "0", "--out", "x.png"], "--width"),
-        (&["render", "--scene", "/nonexistent.toml", "--view", "polar", "--out", "x.png"], "nonexistent"),
+        (
+            &[
+                "render", "--model", "nope", "--view", "polar", "--out", "x.png",
+            ],
+            "nope",
+        ),
+        (
+            &[
+                "render",
+                "--view",
+                "polar",
+                "--theta-i",
+                "120",
+                "--out",
+                "x.png",
+            ],
+            "--theta-i",
+        ),
+        (
+            &[
+                "render", "--view", "polar", "--width", "0", "--out", "x.png",
+            ],
+            "--width",
+        ),
+        (
+            &[
+                "render",
+                "--scene",
+                "/nonexistent.toml",
+                "--view",
+                "polar",
+                "--out",
+                "x.png",
+            ],
+            "nonexistent",
+        ),
     ];
     for (args, want) in cases {
         let out = Command::new(bin()).args(*args).output().unwrap();
@@ -244,15 +316,28 @@ fn svg_plots_parse_as_xml_and_carry_the_curves() {
     for v in ["polar", "cartesian", "albedo", "fresnel"] {
         let p = dir.join(format!("{v}.svg"));
         run(&[
-            "render", "--model", "cook-torrance", "--view", v, "--width", "800", "--height",
-            "600", "--light", "--out", &p.to_string_lossy(),
+            "render",
+            "--model",
+            "cook-torrance",
+            "--view",
+            v,
+            "--width",
+            "800",
+            "--height",
+            "600",
+            "--light",
+            "--out",
+            &p.to_string_lossy(),
         ]);
         let text = std::fs::read_to_string(&p).unwrap();
-        let doc = roxmltree::Document::parse(&text)
-            .unwrap_or_else(|e| panic!("{v}.svg is not XML: {e}"));
+        let doc =
+            roxmltree::Document::parse(&text).unwrap_or_else(|e| panic!("{v}.svg is not XML: {e}"));
         let root = doc.root_element();
         assert_eq!(root.tag_name().name(), "svg", "{v}");
-        assert_eq!(root.tag_name().namespace(), Some("http://www.w3.org/2000/svg"));
+        assert_eq!(
+            root.tag_name().namespace(),
+            Some("http://www.w3.org/2000/svg")
+        );
         assert!(root.attribute("viewBox").is_some());
         let count = |tag: &str| doc.descendants().filter(|n| n.has_tag_name(tag)).count();
         assert!(count("polyline") >= 1, "{v}: no curve");
@@ -263,13 +348,26 @@ fn svg_plots_parse_as_xml_and_carry_the_curves() {
             .filter_map(|n| n.text())
             .collect::<Vec<_>>()
             .join("|");
-        assert!(texts.contains("Cook-Torrance"), "{v}: legend missing: {texts}");
+        assert!(
+            texts.contains("Cook-Torrance"),
+            "{v}: legend missing: {texts}"
+        );
     }
     // `--view all --svg` writes one SVG per 2D view besides the PNGs.
     let all = dir.join("all");
     run(&[
-        "render", "--model", "lambert", "--view", "all", "--svg", "--width", "200", "--height",
-        "150", "--out", &all.to_string_lossy(),
+        "render",
+        "--model",
+        "lambert",
+        "--view",
+        "all",
+        "--svg",
+        "--width",
+        "200",
+        "--height",
+        "150",
+        "--out",
+        &all.to_string_lossy(),
     ]);
     for v in ["polar", "cartesian", "albedo", "fresnel"] {
         assert!(all.join(format!("{v}.svg")).exists(), "{v}.svg");
@@ -280,8 +378,16 @@ fn svg_plots_parse_as_xml_and_carry_the_curves() {
 #[test]
 fn slice_csv_has_the_stated_columns() {
     let out = run(&[
-        "slice", "--model", "lambert", "--param", "albedo=0.5", "--theta-i", "30", "--samples",
-        "90", "--csv",
+        "slice",
+        "--model",
+        "lambert",
+        "--param",
+        "albedo=0.5",
+        "--theta-i",
+        "30",
+        "--samples",
+        "90",
+        "--csv",
     ]);
     let text = String::from_utf8(out.stdout).unwrap();
     let mut lines = text.lines();
@@ -301,7 +407,9 @@ fn slice_csv_has_the_stated_columns() {
     }
     assert!(rows[0][0] < -89.0 && rows[90][0] > 89.0);
 
-    let out = run(&["slice", "--model", "ward", "--curve", "theta-h", "--fixed", "10", "--csv"]);
+    let out = run(&[
+        "slice", "--model", "ward", "--curve", "theta-h", "--fixed", "10", "--csv",
+    ]);
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.starts_with("theta_h_deg,f_r,f_g,f_b,f_mean,f_cos_mean\n"));
 
@@ -326,12 +434,23 @@ fn lobe_meshes_for_blender() {
     let ply = dir.join("lobe.ply");
     let scene = dir.join("two.toml");
     run(&[
-        "scene", "new", "--model", "lambert", "--model", "phong", "--out",
+        "scene",
+        "new",
+        "--model",
+        "lambert",
+        "--model",
+        "phong",
+        "--out",
         &scene.to_string_lossy(),
     ]);
     for p in [&obj, &ply] {
         run(&[
-            "render", "--scene", &scene.to_string_lossy(), "--view", "lobe3d", "--out",
+            "render",
+            "--scene",
+            &scene.to_string_lossy(),
+            "--view",
+            "lobe3d",
+            "--out",
             &p.to_string_lossy(),
         ]);
     }

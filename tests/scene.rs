@@ -116,7 +116,10 @@ fn corrupt_files_are_refused_with_a_clear_error() {
     assert!(e.contains("theta_deg") && e.contains("line"), "{e}");
     // Out of range: the key and the range.
     let e = err_of(&good.replace("theta_deg = 61.125", "theta_deg = 95.0"));
-    assert!(e.contains("incident.theta_deg") && e.contains("89.5"), "{e}");
+    assert!(
+        e.contains("incident.theta_deg") && e.contains("89.5"),
+        "{e}"
+    );
     // An unknown model, a bad parameter: the entry and the core's reason.
     let e = err_of(&good.replace("model = \"lambert\"\n", "model = \"lamberd\"\n"));
     assert!(e.contains("brdfs[0]") && e.contains("lamberd"), "{e}");
@@ -127,7 +130,10 @@ fn corrupt_files_are_refused_with_a_clear_error() {
     assert!(e.contains("300") || e.contains("u8"), "{e}");
     // Another program's file, a newer format.
     let e = err_of(&good.replace("format = \"bv-scene\"", "format = \"blender\""));
-    assert!(e.contains("`format`") && e.contains("not a bv scene"), "{e}");
+    assert!(
+        e.contains("`format`") && e.contains("not a bv scene"),
+        "{e}"
+    );
     let e = err_of(&good.replace("version = 1", "version = 99"));
     assert!(e.contains("99") && e.contains("newer"), "{e}");
     // Two BRDFs with one id.
@@ -144,7 +150,11 @@ fn truncated_files_are_refused() {
         .char_indices()
         .filter(|(_, c)| *c == '\n')
         .map(|(i, _)| i + 1)
-        .chain((1..good.len()).step_by(97).filter(|i| good.is_char_boundary(*i)))
+        .chain(
+            (1..good.len())
+                .step_by(97)
+                .filter(|i| good.is_char_boundary(*i)),
+        )
         .filter(|&i| i < good.trim_end().len() - END_MARKER.len())
         .collect();
     assert!(cuts.len() > 50);
@@ -187,7 +197,10 @@ e = 50
     assert_eq!(l.state.brdfs[0].spec.params.float("e").unwrap(), 50.0);
     assert_eq!(l.state.incident.theta_deg, 30.0);
     let w = l.warnings.join("\n");
-    assert!(w.contains("colour_scheme") && w.contains("incident.spin"), "{w}");
+    assert!(
+        w.contains("colour_scheme") && w.contains("incident.spin"),
+        "{w}"
+    );
 }
 
 #[test]
@@ -250,43 +263,75 @@ fn bv_scene_check_print_and_new() {
     let path = tmp("cli.toml");
     let out = Command::new(bin)
         .args([
-            "scene", "new", "--model", "lambert", "-p", "albedo=0.3", "--model", "ward", "-p",
-            "alpha_x=0.1", "--theta-i", "30", "--log", "--out",
+            "scene",
+            "new",
+            "--model",
+            "lambert",
+            "-p",
+            "albedo=0.3",
+            "--model",
+            "ward",
+            "-p",
+            "alpha_x=0.1",
+            "--theta-i",
+            "30",
+            "--log",
+            "--out",
         ])
         .arg(&path)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let l = scene::load(&path).unwrap();
     assert_eq!(l.state.brdfs.len(), 2);
-    assert_eq!(
-        l.state.brdfs[0].spec.params.color("albedo").unwrap().x,
-        0.3
-    );
+    assert_eq!(l.state.brdfs[0].spec.params.color("albedo").unwrap().x, 0.3);
     assert_eq!(l.state.brdfs[1].spec.params.float("alpha_x").unwrap(), 0.1);
     assert!(l.state.display.log);
 
-    let out = Command::new(bin).args(["scene", "check"]).arg(&path).output().unwrap();
+    let out = Command::new(bin)
+        .args(["scene", "check"])
+        .arg(&path)
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("ok") && text.contains("lambert, ward"), "{text}");
+    assert!(
+        text.contains("ok") && text.contains("lambert, ward"),
+        "{text}"
+    );
 
     // Warnings go to stderr; errors fail with the key.
     let text = std::fs::read_to_string(&path)
         .unwrap()
         .replace("[incident]", "[incident]\nwobble = 1");
     std::fs::write(&path, &text).unwrap();
-    let out = Command::new(bin).args(["scene", "check"]).arg(&path).output().unwrap();
+    let out = Command::new(bin)
+        .args(["scene", "check"])
+        .arg(&path)
+        .output()
+        .unwrap();
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("incident.wobble"));
     std::fs::write(&path, text.replace("theta_deg = 30.0", "theta_deg = -4.0")).unwrap();
-    let out = Command::new(bin).args(["scene", "check"]).arg(&path).output().unwrap();
+    let out = Command::new(bin)
+        .args(["scene", "check"])
+        .arg(&path)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("incident.theta_deg"));
 
     // `print` writes a scene that loads back.
     scene::save(&path, &rich_state()).unwrap();
-    let out = Command::new(bin).args(["scene", "print"]).arg(&path).output().unwrap();
+    let out = Command::new(bin)
+        .args(["scene", "print"])
+        .arg(&path)
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let printed = String::from_utf8(out.stdout).unwrap();
     assert_eq!(scene::from_toml(&printed).unwrap().state, rich_state());

@@ -50,11 +50,7 @@ impl Filter {
     pub fn accepts(&self, path: &Path) -> bool {
         path.extension()
             .and_then(OsStr::to_str)
-            .is_some_and(|e| {
-                self.extensions
-                    .iter()
-                    .any(|x| x.eq_ignore_ascii_case(e))
-            })
+            .is_some_and(|e| self.extensions.iter().any(|x| x.eq_ignore_ascii_case(e)))
     }
 
     /// `path` with the first extension added when it has none of them.
@@ -172,8 +168,14 @@ mod tests {
 
     #[test]
     fn extensions_are_added_once() {
-        assert_eq!(SCENE.with_extension(Path::new("a/b")), Path::new("a/b.toml"));
-        assert_eq!(SCENE.with_extension(Path::new("b.TOML")), Path::new("b.TOML"));
+        assert_eq!(
+            SCENE.with_extension(Path::new("a/b")),
+            Path::new("a/b.toml")
+        );
+        assert_eq!(
+            SCENE.with_extension(Path::new("b.TOML")),
+            Path::new("b.TOML")
+        );
         assert_eq!(MESH.with_extension(Path::new("m.ply")), Path::new("m.ply"));
         assert_eq!(MESH.with_extension(Path::new("m")), Path::new("m.obj"));
         assert!(!PNG.accepts(Path::new("x.svg")));

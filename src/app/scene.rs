@@ -277,7 +277,10 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     range("incident.phi_deg", s.incident.phi_deg, -360.0, 360.0, "°")?;
     let c = s.camera;
     if !c.yaw_deg.is_finite() {
-        return bad("camera.yaw_deg", format!("{} is not a finite angle", c.yaw_deg));
+        return bad(
+            "camera.yaw_deg",
+            format!("{} is not a finite angle", c.yaw_deg),
+        );
     }
     range(
         "camera.pitch_deg",
@@ -402,7 +405,10 @@ mod tests {
 
     fn sample() -> AppState {
         let mut s = AppState::default();
-        s.add(ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.2, 0.4, 0.6]})).unwrap());
+        s.add(
+            ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.2, 0.4, 0.6]}))
+                .unwrap(),
+        );
         s.add(ModelSpec::new("cook-torrance").unwrap());
         s.brdfs[0].visible = false;
         s.incident = Incident {

@@ -103,6 +103,7 @@ pub struct ScreenGeometry {
 }
 
 /// The scene/figure part of the viewer's UI state.
+#[derive(Default)]
 pub struct ExportUi {
     files: Files<Task>,
     /// The export dialog is showing.
@@ -119,20 +120,6 @@ pub struct ExportUi {
         eframe::wgpu::Adapter,
     )>,
     svg_views: Option<Vec<&'static str>>,
-}
-
-impl Default for ExportUi {
-    fn default() -> Self {
-        Self {
-            files: Files::default(),
-            dialog_open: false,
-            settings: FigureSettings::default(),
-            scene_path: None,
-            toast: None,
-            gpu: None,
-            svg_views: None,
-        }
-    }
 }
 
 /// Which views have a vector (SVG) form: asked of each view on an empty scene.
@@ -181,15 +168,16 @@ impl ExportUi {
             .scene_path
             .as_ref()
             .and_then(|p| p.file_name())
-            .map_or_else(|| "scene.toml".to_string(), |n| n.to_string_lossy().into_owned());
+            .map_or_else(
+                || "scene.toml".to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
         self.files
             .save(Task::SaveScene, "Save the scene", files::SCENE, &name);
     }
 
     fn svg_ok(&mut self, id: &str) -> bool {
-        self.svg_views
-            .get_or_insert_with(svg_views)
-            .contains(&id)
+        self.svg_views.get_or_insert_with(svg_views).contains(&id)
     }
 
     /// Draws the dialogs and the toast; returns what the user asked for.
@@ -389,7 +377,9 @@ impl ExportUi {
             Format::Svg => {
                 let e = entry.ok_or_else(|| anyhow::anyhow!("SVG needs a 2D plot view"))?;
                 let svg = export::view_svg(state, e, [size.x, size.y], settings.transparent)
-                    .ok_or_else(|| anyhow::anyhow!("{} has no vector form; save it as PNG", e.title))?;
+                    .ok_or_else(|| {
+                        anyhow::anyhow!("{} has no vector form; save it as PNG", e.title)
+                    })?;
                 export::write_file(path, svg.as_bytes())?;
                 Ok(format!("Saved {} as SVG to {}", e.title, path.display()))
             }

@@ -11,9 +11,9 @@ use super::runtime::Runtime;
 use super::scene;
 use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::state::{AppState, Theme};
-use std::path::Path;
 use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
 use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
+use std::path::Path;
 
 /// Keyboard shortcuts, as shown in the help overlay.
 pub const SHORTCUTS: &[(&str, &str)] = &[
@@ -33,7 +33,10 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("T", "switch between dark and light themes"),
     ("Ctrl+O", "open a scene file"),
     ("Ctrl+S", "save the scene (to the file it came from)"),
-    ("Ctrl+Shift+S", "export a figure: a view or the window as PNG / SVG / OBJ"),
+    (
+        "Ctrl+Shift+S",
+        "export a figure: a view or the window as PNG / SVG / OBJ",
+    ),
     ("Ctrl+Q", "quit (the session is saved)"),
 ];
 
@@ -334,7 +337,9 @@ impl Viewer {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
         // Shift+S first: `consume_key` with COMMAND alone would also match it.
-        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S)) {
+        if ctx
+            .input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S))
+        {
             self.export.dialog_open = !self.export.dialog_open;
         } else if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::S)) {
             match self.export.scene_path.clone() {

@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 
 /// Options of `bv render`.
 #[derive(Debug, Clone, clap::Args)]
-#[command(long_about = "Draw a view to a file without opening a window: the viewer's own \
+#[command(
+    long_about = "Draw a view to a file without opening a window: the viewer's own \
     drawing code, rendered offscreen with wgpu (on a machine without a GPU, Mesa's lavapipe: \
     apt install mesa-vulkan-drivers libvulkan1).\n\n\
     The output's extension picks the format: .png (any view), .svg (2D plots: polar, \
@@ -25,7 +26,8 @@ use std::path::{Path, PathBuf};
     Example (every figure of a lecture, one shell loop):\n  \
     for m in lambert phong ward cook-torrance; do\n    \
     bv render --model $m --view all --theta-i 45 --out figs/$m --svg\n  \
-    done")]
+    done"
+)]
 pub struct RenderArgs {
     /// Scene file to draw (TOML: BRDFs, light, camera, display options).
     #[arg(long, value_name = "FILE")]
@@ -42,7 +44,8 @@ pub struct RenderArgs {
     pub params: Vec<String>,
 
     /// The view: lobe3d (or lobe), polar, cartesian, albedo, fresnel, any other
-    /// view of this build (the error for an unknown one lists them), or `all`.
+    /// view of this build (the error for an unknown one lists them), `all`, or
+    /// `window` (the whole viewer window, panels included).
     #[arg(long, value_name = "VIEW")]
     pub view: String,
 
@@ -115,6 +118,7 @@ pub fn view_names() -> String {
         })
         .collect();
     names.push("all".into());
+    names.push("window".into());
     names.join(", ")
 }
 
@@ -240,9 +244,18 @@ impl Progress {
 
 /// Runs `bv render`.
 pub fn run(a: &RenderArgs) -> Result<()> {
-    let views = views_for(&a.view)?;
-    let all = views.len() > 1 || a.view.trim().eq_ignore_ascii_case("all");
-    if a.width == 0 || a.height == 0 || a.width > export::offscreen::MAX_SIDE || a.height > export::offscreen::MAX_SIDE {
+    let window = a.view.trim().eq_ignore_ascii_case("window");
+    let views = if window {
+        Vec::new()
+    } else {
+        views_for(&a.view)?
+    };
+    let all = !window && (views.len() > 1 || a.view.trim().eq_ignore_ascii_case("all"));
+    if a.width == 0
+        || a.height == 0
+        || a.width > export::offscreen::MAX_SIDE
+        || a.height > export::offscreen::MAX_SIDE
+    {
         bail!(
             "--width/--height must be 1..={} pixels",
             export::offscreen::MAX_SIDE
@@ -262,6 +275,14 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         transparent: a.transparent,
     };
 
+    if window {
+        if kind_of(&a.out)? != Kind::Png {
+            bail!("--view window: only PNG (--out FILE.png)");
+        }
+        let mut off = Offscreen::headless()?;
+        let img = export::render_window(&mut off, &state, frame)?;
+        return export::save_png(&img, &a.out);
+    }
     if !all {
         let e = views[0];
         let kind = kind_of(&a.out)?;
@@ -273,7 +294,10 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             Kind::Svg => write_svg(&state, e, frame, &a.out),
             Kind::Obj | Kind::Ply => {
                 if e.id != "lobe" {
-                    bail!("--out {}: meshes come from the lobe view (--view lobe3d)", a.out.display());
+                    bail!(
+                        "--out {}: meshes come from the lobe view (--view lobe3d)",
+                        a.out.display()
+                    );
                 }
                 write_mesh(&state, kind, &a.out)
             }
@@ -320,7 +344,13 @@ pub fn run(a: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-fn write_png(off: &mut Offscreen, state: &AppState, e: &ViewEntry, frame: Frame, path: &Path) -> Result<()> {
+fn write_png(
+    off: &mut Offscreen,
+    state: &AppState,
+    e: &ViewEntry,
+    frame: Frame,
+    path: &Path,
+) -> Result<()> {
     let img = export::render_view(off, state, e, frame)
         .with_context(|| format!("drawing the {} view", e.id))?;
     export::save_png(&img, path)
@@ -337,7 +367,9 @@ fn write_svg(state: &AppState, e: &ViewEntry, frame: Frame, path: &Path) -> Resu
             e.id,
             REGISTRY
                 .iter()
-                .filter(|v| export::view_svg(&AppState::default(), v, [200.0, 150.0], false).is_some())
+                .filter(
+                    |v| export::view_svg(&AppState::default(), v, [200.0, 150.0], false).is_some()
+                )
                 .map(|v| v.id)
                 .collect::<Vec<_>>()
                 .join(", ")
@@ -368,7 +400,10 @@ mod tests {
             Ok(_) => panic!("accepted"),
             Err(e) => e.to_string(),
         };
-        assert!(e.contains("lit-spheer") && e.contains("polar") && e.contains("all"), "{e}");
+        assert!(
+            e.contains("lit-spheer") && e.contains("polar") && e.contains("all"),
+            "{e}"
+        );
         assert_eq!(views_for("lobe3d").unwrap()[0].id, "lobe");
         assert_eq!(views_for("all").unwrap().len(), REGISTRY.len());
     }

@@ -195,15 +195,28 @@ mod tests {
     #[test]
     fn params_follow_their_model() {
         let argv: Vec<String> = [
-            "bv", "scene", "new", "--model", "lambert", "-p", "albedo=0.2", "--model=ward",
-            "--param", "alpha_x=0.1", "--out", "x.toml",
+            "bv",
+            "scene",
+            "new",
+            "--model",
+            "lambert",
+            "-p",
+            "albedo=0.2",
+            "--model=ward",
+            "--param",
+            "alpha_x=0.1",
+            "--out",
+            "x.toml",
         ]
         .iter()
         .map(|s| s.to_string())
         .collect();
         assert_eq!(
             group_params(&argv),
-            vec![vec!["albedo=0.2".to_string()], vec!["alpha_x=0.1".to_string()]]
+            vec![
+                vec!["albedo=0.2".to_string()],
+                vec!["alpha_x=0.1".to_string()]
+            ]
         );
     }
 }

@@ -33,7 +33,8 @@ pub enum Curve {
 
 /// Options of `bv slice`.
 #[derive(Debug, Clone, clap::Args)]
-#[command(long_about = "Print a BRDF slice, the numbers behind the 2D plots.\n\n\
+#[command(
+    long_about = "Print a BRDF slice, the numbers behind the 2D plots.\n\n\
     Columns (--csv adds a header row with these names):\n  \
     theta-o (default): theta_o_deg,f_r,f_g,f_b,f_mean,f_cos_mean\n    \
     theta_o_deg is signed in the plane of incidence, negative on the light's side;\n    \
@@ -42,7 +43,8 @@ pub enum Curve {
     theta-h, theta-d: the same with theta_h_deg / theta_d_deg first (phi_h = 0,\n    \
     phi_d = 90 deg; the other angle is --fixed).\n  \
     albedo: theta_i_deg,rho_r,rho_g,rho_b,rho_mean,std_error_mean (Monte Carlo,\n    \
-    the albedo view's estimator).")]
+    the albedo view's estimator)."
+)]
 pub struct SliceArgs {
     /// The model and its parameters.
     #[command(flatten)]
@@ -53,11 +55,21 @@ pub struct SliceArgs {
     pub curve: Curve,
 
     /// Polar angle of the light, degrees (theta-o; albedo ignores it).
-    #[arg(long = "theta-i", value_name = "DEG", default_value_t = 45.0, allow_negative_numbers = true)]
+    #[arg(
+        long = "theta-i",
+        value_name = "DEG",
+        default_value_t = 45.0,
+        allow_negative_numbers = true
+    )]
     pub theta_i: f64,
 
     /// Azimuth of the light, degrees.
-    #[arg(long = "phi-i", value_name = "DEG", default_value_t = 0.0, allow_negative_numbers = true)]
+    #[arg(
+        long = "phi-i",
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
     pub phi_i: f64,
 
     /// The fixed angle of theta-h (θd) or theta-d (θh) curves, degrees.

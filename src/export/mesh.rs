@@ -74,7 +74,11 @@ fn vertex_color(e: &Exported, k: usize, log: bool) -> [u8; 3] {
     if !e.by_value {
         return e.color;
     }
-    let v = e.mesh.values.get(k).map_or(0.0, |v| (v[0] + v[1] + v[2]) / 3.0);
+    let v = e
+        .mesh
+        .values
+        .get(k)
+        .map_or(0.0, |v| (v[0] + v[1] + v[2]) / 3.0);
     let max = e.mesh.max_value as f32;
     let t = if max <= 0.0 {
         0.0
@@ -95,7 +99,11 @@ fn describe(state: &AppState) -> Vec<String> {
         format!(
             "radius r = {}{}; light at theta_i = {} deg, phi_i = {} deg",
             if d.cosine { "f * cos(theta_o)" } else { "f" },
-            if d.log { " as ln(1 + value)" } else { " (1/sr)" },
+            if d.log {
+                " as ln(1 + value)"
+            } else {
+                " (1/sr)"
+            },
             state.incident.theta_deg,
             state.incident.phi_deg
         ),
@@ -200,7 +208,10 @@ mod tests {
         assert!(meshes[0].by_value && !meshes[1].by_value, "primary first");
         let obj = to_obj(&s, &meshes);
         let nv = obj.lines().filter(|l| l.starts_with("v ")).count();
-        assert_eq!(nv, meshes.iter().map(|m| m.mesh.positions.len()).sum::<usize>());
+        assert_eq!(
+            nv,
+            meshes.iter().map(|m| m.mesh.positions.len()).sum::<usize>()
+        );
         for l in obj.lines().filter(|l| l.starts_with("f ")) {
             for idx in l[2..].split(' ') {
                 let i: usize = idx.split("//").next().unwrap().parse().unwrap();

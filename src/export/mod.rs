@@ -53,11 +53,7 @@ pub fn render_view(
             ui.visuals().panel_fill
         };
         egui::CentralPanel::default()
-            .frame(
-                egui::Frame::NONE
-                    .fill(fill)
-                    .inner_margin(FIGURE_MARGIN),
-            )
+            .frame(egui::Frame::NONE.fill(fill).inner_margin(FIGURE_MARGIN))
             .show(ui, |ui| {
                 let mut ignored = Vec::new();
                 view.ui(ui, &scene, &mut ignored);
@@ -66,13 +62,32 @@ pub fn render_view(
 }
 
 /// Draws the whole viewer window showing `state`.
-pub fn render_window(off: &mut Offscreen, state: &AppState, frame: Frame) -> Result<image::RgbaImage> {
+pub fn render_window(
+    off: &mut Offscreen,
+    state: &AppState,
+    frame: Frame,
+) -> Result<image::RgbaImage> {
+    // The window's albedo view computes in the background; a figure shows
+    // the finished curves, so compute them first (they are cached).
+    {
+        let mut runtime = Runtime::default();
+        runtime.sync(state);
+        let scene = figure_scene(state, &runtime, false);
+        for b in &scene.brdfs {
+            crate::views::albedo::curve_now(&scene, b);
+        }
+    }
     let mut viewer = Viewer::new(state.clone());
     off.render(frame, |ui| viewer.ui(ui))
 }
 
 /// One view of `state` as SVG (`None` if the view has no vector form).
-pub fn view_svg(state: &AppState, entry: &ViewEntry, size: [f32; 2], transparent: bool) -> Option<String> {
+pub fn view_svg(
+    state: &AppState,
+    entry: &ViewEntry,
+    size: [f32; 2],
+    transparent: bool,
+) -> Option<String> {
     let mut runtime = Runtime::default();
     runtime.sync(state);
     let scene = figure_scene(state, &runtime, transparent);

@@ -206,9 +206,9 @@ impl Offscreen {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("bv offscreen"),
             });
-        let user = self
-            .renderer
-            .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
+        let user =
+            self.renderer
+                .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
         let texture = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("bv offscreen target"),
             size: wgpu::Extent3d {
@@ -314,11 +314,15 @@ mod tests {
 
     #[test]
     fn unpremultiply_restores_straight_alpha() {
-        let mut img = image::RgbaImage::from_raw(3, 1, vec![
-            64, 32, 0, 128, //
-            10, 10, 10, 0, //
-            200, 100, 50, 255,
-        ])
+        let mut img = image::RgbaImage::from_raw(
+            3,
+            1,
+            vec![
+                64, 32, 0, 128, //
+                10, 10, 10, 0, //
+                200, 100, 50, 255,
+            ],
+        )
         .unwrap();
         unpremultiply(&mut img);
         assert_eq!(img.get_pixel(0, 0).0, [128, 64, 0, 128]);

@@ -128,7 +128,14 @@ impl Svg {
     }
 
     /// A straight segment.
-    pub fn line(&mut self, a: [f32; 2], b: [f32; 2], color: Color32, width: f32, dash: Option<f32>) {
+    pub fn line(
+        &mut self,
+        a: [f32; 2],
+        b: [f32; 2],
+        color: Color32,
+        width: f32,
+        dash: Option<f32>,
+    ) {
         let _ = writeln!(
             self.body,
             r#"<line x1="{}" y1="{}" x2="{}" y2="{}" {}/>"#,
@@ -165,7 +172,10 @@ impl Svg {
             return;
         }
         let mut pts = String::new();
-        for p in points.iter().filter(|p| p[0].is_finite() && p[1].is_finite()) {
+        for p in points
+            .iter()
+            .filter(|p| p[0].is_finite() && p[1].is_finite())
+        {
             let _ = write!(pts, "{},{} ", n(p[0]), n(p[1]));
         }
         let _ = writeln!(
@@ -201,12 +211,7 @@ impl Svg {
             Baseline::Bottom => 0.0,
         };
         let transform = rotate_deg.map_or_else(String::new, |r| {
-            format!(
-                r#" transform="rotate({} {} {})""#,
-                n(r),
-                n(at[0]),
-                n(at[1])
-            )
+            format!(r#" transform="rotate({} {} {})""#, n(r), n(at[0]), n(at[1]))
         });
         let _ = writeln!(
             self.body,
@@ -295,7 +300,13 @@ mod tests {
     fn polylines_break_at_gaps() {
         let mut s = Svg::new(10.0, 10.0);
         s.polyline(
-            &[[0.0, 0.0], [1.0, 1.0], [f32::NAN, 0.0], [2.0, 2.0], [3.0, 3.0]],
+            &[
+                [0.0, 0.0],
+                [1.0, 1.0],
+                [f32::NAN, 0.0],
+                [2.0, 2.0],
+                [3.0, 3.0],
+            ],
             Color32::RED,
             1.0,
             None,

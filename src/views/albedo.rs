@@ -90,9 +90,9 @@ impl AlbedoData {
 
     /// Whether some channel exceeds 1 by more than its error band somewhere.
     pub fn exceeds_one(&self) -> bool {
-        self.rho.iter().any(|e| {
-            (0..3).any(|c| e.value[c] - BAND_SIGMAS * e.std_error[c] > 1.0 + 1e-9)
-        })
+        self.rho
+            .iter()
+            .any(|e| (0..3).any(|c| e.value[c] - BAND_SIGMAS * e.std_error[c] > 1.0 + 1e-9))
     }
 }
 
@@ -252,7 +252,12 @@ impl AlbedoView {
                         cancel(std::slice::from_ref(old));
                     }
                     self.wanted.insert(b.id, key.clone());
-                    let p = start(&key, b.brdf.clone(), scene.incident.phi_deg.to_radians(), ctx);
+                    let p = start(
+                        &key,
+                        b.brdf.clone(),
+                        scene.incident.phi_deg.to_radians(),
+                        ctx,
+                    );
                     done += p.load(Ordering::Relaxed).min(STEPS);
                     total += STEPS;
                 } else {
@@ -438,12 +443,20 @@ mod tests {
             .unwrap()
             .build()
             .unwrap();
-        let d = AlbedoData::compute(b.as_ref(), 0.0, &AtomicUsize::new(0), &AtomicBool::new(false))
-            .unwrap();
+        let d = AlbedoData::compute(
+            b.as_ref(),
+            0.0,
+            &AtomicUsize::new(0),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
         assert_eq!(d.rho.len(), N_THETA);
         for k in 0..N_THETA {
             let (v, band) = d.mean_and_band(k);
-            assert!((v - 0.6).abs() <= band.max(1e-9) + 1e-3, "{k}: {v} ± {band}");
+            assert!(
+                (v - 0.6).abs() <= band.max(1e-9) + 1e-3,
+                "{k}: {v} ± {band}"
+            );
         }
         assert!((mean_rgb(d.rho_hh.value) - 0.6).abs() < 0.01);
         assert!(!d.exceeds_one());
@@ -453,8 +466,13 @@ mod tests {
     fn cancelled_jobs_give_nothing() {
         let b = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
         assert!(
-            AlbedoData::compute(b.as_ref(), 0.0, &AtomicUsize::new(0), &AtomicBool::new(true))
-                .is_none()
+            AlbedoData::compute(
+                b.as_ref(),
+                0.0,
+                &AtomicUsize::new(0),
+                &AtomicBool::new(true)
+            )
+            .is_none()
         );
     }
 }

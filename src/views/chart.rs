@@ -210,13 +210,7 @@ impl Chart {
         // Grid and ticks.
         for (x, label) in &self.x_ticks {
             let px = sx(*x);
-            svg.line(
-                [px, pmin[1]],
-                [px, pmin[1] + psize[1]],
-                pal.grid,
-                1.0,
-                None,
-            );
+            svg.line([px, pmin[1]], [px, pmin[1] + psize[1]], pal.grid, 1.0, None);
             svg.text(
                 [px, pmin[1] + psize[1] + 4.0],
                 label,
@@ -229,13 +223,7 @@ impl Chart {
         }
         for (y, label) in &self.y_ticks {
             let py = sy(*y);
-            svg.line(
-                [pmin[0], py],
-                [pmin[0] + psize[0], py],
-                pal.grid,
-                1.0,
-                None,
-            );
+            svg.line([pmin[0], py], [pmin[0] + psize[0], py], pal.grid, 1.0, None);
             svg.text(
                 [pmin[0] - 5.0, py],
                 label,
@@ -268,12 +256,11 @@ impl Chart {
 
         svg.begin_clip(pmin, psize);
         for b in &self.bands {
-            let mut pts: Vec<[f32; 2]> = b
-                .xs
-                .iter()
-                .zip(&b.hi)
-                .map(|(x, y)| [sx(*x), sy(*y)])
-                .collect();
+            let mut pts: Vec<[f32; 2]> =
+                b.xs.iter()
+                    .zip(&b.hi)
+                    .map(|(x, y)| [sx(*x), sy(*y)])
+                    .collect();
             pts.extend(b.xs.iter().zip(&b.lo).rev().map(|(x, y)| [sx(*x), sy(*y)]));
             svg.polygon(&pts, b.color);
         }

@@ -70,9 +70,7 @@ pub fn fresnel_of(spec: &ModelSpec) -> FresnelOf {
                 "Schlick, F0 from specular, specular_tint and metallic (Burley 2012)".into(),
             )
         }
-        m => FresnelOf::Absent(format!(
-            "{m}: this model has no Fresnel term"
-        )),
+        m => FresnelOf::Absent(format!("{m}: this model has no Fresnel term")),
     }
 }
 
@@ -109,9 +107,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
         .map(|k| 90.0 * k as f64 / SAMPLES as f64)
         .collect();
     let curve = |f: &dyn Fn(f64) -> f64| -> Vec<[f64; 2]> {
-        xs.iter()
-            .map(|&x| [x, f(x.to_radians().cos())])
-            .collect()
+        xs.iter().map(|&x| [x, f(x.to_radians().cos())]).collect()
     };
     let series = |label: String, color: Color32, points, width, dash| Series {
         label,
@@ -148,7 +144,11 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
             ));
         }
         Fresnel::Dielectric { eta } => {
-            let e = if grey(eta) { eta.x } else { bv_core::mean_rgb(eta) };
+            let e = if grey(eta) {
+                eta.x
+            } else {
+                bv_core::mean_rgb(eta)
+            };
             if grey(eta) {
                 let par = [176, 122, 211];
                 let perp = [118, 183, 178];
