@@ -211,13 +211,13 @@ impl ExportUi {
                     .num_columns(2)
                     .spacing([16.0, 6.0])
                     .show(ui, |ui| {
-                        ui.label("Figure of");
+                        let label = ui.label("Figure of");
                         let current = match &s.target {
                             Target::Window => "Whole window".to_string(),
                             Target::View(id) => crate::views::entry(id)
                                 .map_or_else(|| id.clone(), |e| e.title.to_string()),
                         };
-                        egui::ComboBox::new("bv export target", "view")
+                        egui::ComboBox::new("bv export target", "")
                             .selected_text(current)
                             .show_ui(ui, |ui| {
                                 ui.selectable_value(&mut s.target, Target::Window, "Whole window");
@@ -228,7 +228,9 @@ impl ExportUi {
                                         e.title,
                                     );
                                 }
-                            });
+                            })
+                            .response
+                            .labelled_by(label.id);
                         ui.end_row();
 
                         ui.label("Format");

@@ -396,7 +396,7 @@ impl View for AlbedoView {
             x_range: (0.0, 90.0),
             y_range: (0.0, top),
             x_ticks: chart::angle_ticks(0.0, 90.0),
-            y_ticks: chart::labelled(chart::nice_ticks(0.0, top, 5)),
+            y_ticks: chart::labelled(chart::nice_ticks(0.0, top, 8)),
             ..Default::default()
         };
         c.hlines.push(Marker {

@@ -407,7 +407,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
             .map(|k| (f64::from(k), super::decade_label(k)))
             .collect()
     } else {
-        chart::labelled(chart::nice_ticks(data.bottom, data.top, 5))
+        chart::labelled(chart::nice_ticks(data.bottom, data.top, 8))
     };
     let mut c = Chart {
         x_label: data.x_label.clone(),

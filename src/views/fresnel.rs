@@ -93,7 +93,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
         x_range: (0.0, 90.0),
         y_range: (0.0, 1.05),
         x_ticks: chart::angle_ticks(0.0, 90.0),
-        y_ticks: chart::labelled(chart::nice_ticks(0.0, 1.0, 5)),
+        y_ticks: chart::labelled(chart::nice_ticks(0.0, 1.0, 8)),
         ..Default::default()
     };
     let Some(b) = scene.primary() else {
