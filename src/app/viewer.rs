@@ -232,6 +232,7 @@ impl Viewer {
             });
         }
         self.shortcuts(&ctx, &mut out);
+        dropped_files(&ctx, &self.state, &mut out);
         self.help_window(&ctx);
         for r in self.export.ui(&ctx) {
             self.handle(r, &ctx);
@@ -523,6 +524,50 @@ fn central(
     }
 }
 
+/// Files dropped on the window go to a path parameter (a MERL table): the
+/// selected BRDF's if it has one, otherwise a new BRDF of the first catalogue
+/// model that takes a file.
+fn dropped_files(ctx: &egui::Context, state: &AppState, out: &mut Vec<Command>) {
+    let paths: Vec<String> = ctx.input(|i| {
+        i.raw
+            .dropped_files
+            .iter()
+            .map(|f| f.path().display().to_string())
+            .collect()
+    });
+    for path in paths {
+        out.extend(file_command(state, &path));
+    }
+}
+
+/// The command that loads `path` (see [`dropped_files`]).
+pub fn file_command(state: &AppState, path: &str) -> Option<Command> {
+    let path_param = |model: &str| {
+        bv_core::find(model).ok().and_then(|m| {
+            m.params
+                .iter()
+                .find(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
+        })
+    };
+    let value = bv_core::ParamValue::Text(path.to_string());
+    if let Some(e) = state.selected_entry()
+        && let Some(d) = path_param(&e.spec.model)
+    {
+        return Some(Command::SetParam {
+            brdf: e.id,
+            param: d.id.to_string(),
+            value,
+        });
+    }
+    let info = bv_core::catalogue()
+        .iter()
+        .find(|m| path_param(m.id).is_some())?;
+    let decl = path_param(info.id)?;
+    let mut spec = bv_core::ModelSpec::new(info.id).ok()?;
+    spec.set(decl.id, value).ok()?;
+    Some(Command::AddSpec(spec))
+}
+
 /// Builds the frame's scene from the state and the built evaluators.
 pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool) -> Scene<'a> {
     let brdfs = state
@@ -635,6 +680,33 @@ fn view_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dropped_file_goes_to_a_path_parameter() {
+        let Some(model) = bv_core::catalogue().iter().find(|m| {
+            m.params
+                .iter()
+                .any(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
+        }) else {
+            return; // no model of this build takes a file
+        };
+        // Nothing selected that takes a file: a new BRDF of that model.
+        let mut s = AppState::first_run();
+        match file_command(&s, "/data/gold.binary") {
+            Some(Command::AddSpec(spec)) => {
+                assert_eq!(spec.model, model.id);
+                assert!(spec.to_json().to_string().contains("/data/gold.binary"));
+                Command::AddSpec(spec).apply(&mut s);
+            }
+            other => panic!("{other:?}"),
+        }
+        // Now it is selected: the next file replaces its path.
+        let id = s.selected.unwrap();
+        assert!(matches!(
+            file_command(&s, "/data/red.binary"),
+            Some(Command::SetParam { brdf, .. }) if brdf == id
+        ));
+    }
 
     #[test]
     fn layout_fills_the_area() {

@@ -1,5 +1,5 @@
 //! Lobe meshes for Blender and friends: the surface `r(wo) · wo` the 3D view
-//! draws (`bv_core::lobe::build`, horizon zeroed like the view), as Wavefront
+//! draws (`bv_core::lobe::build`), as Wavefront
 //! OBJ (one object per drawn BRDF, vertex colours as the `v x y z r g b`
 //! extension Blender reads) or ASCII PLY (the primary BRDF, with per-vertex
 //! colour and the raw value). Coordinates are the local shading frame
@@ -50,8 +50,7 @@ pub fn lobe_meshes(state: &AppState) -> Vec<Exported> {
         .brdfs
         .iter()
         .map(|b| {
-            let mut mesh = lobe::build(b.brdf.as_ref(), scene.wi(), &opts);
-            crate::views::lobe3d::zero_horizon(&mut mesh);
+            let mesh = lobe::build(b.brdf.as_ref(), scene.wi(), &opts);
             Exported {
                 label: b.label.clone(),
                 color: [b.color.r(), b.color.g(), b.color.b()],
