@@ -190,6 +190,8 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                     Some(&rs.adapter),
                     rs.target_format,
                 );
+                drop(renderer);
+                crate::views::install_context(&cc.egui_ctx, rs);
             }
             let saved = if load_saved {
                 cc.storage.and_then(|s| s.get_string(STORAGE_KEY))
@@ -207,9 +209,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
             );
             let mut viewer = Viewer::new(state);
             if let Some(rs) = &cc.wgpu_render_state {
-                viewer
-                    .export
-                    .set_gpu(rs.device.clone(), rs.queue.clone(), rs.adapter.clone());
+                viewer.export.set_gpu(rs.clone());
             }
             viewer.export.scene_path = args2.scene.clone();
             let mut app = BvApp {

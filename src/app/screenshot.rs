@@ -114,11 +114,7 @@ pub struct ExportUi {
     pub scene_path: Option<PathBuf>,
     /// The last toast.
     pub toast: Option<Toast>,
-    gpu: Option<(
-        eframe::wgpu::Device,
-        eframe::wgpu::Queue,
-        eframe::wgpu::Adapter,
-    )>,
+    gpu: Option<eframe::egui_wgpu::RenderState>,
     svg_views: Option<Vec<&'static str>>,
 }
 
@@ -133,14 +129,10 @@ fn svg_views() -> Vec<&'static str> {
 }
 
 impl ExportUi {
-    /// Gives figures a GPU device (the window's).
-    pub fn set_gpu(
-        &mut self,
-        device: eframe::wgpu::Device,
-        queue: eframe::wgpu::Queue,
-        adapter: eframe::wgpu::Adapter,
-    ) {
-        self.gpu = Some((device, queue, adapter));
+    /// Gives figures a GPU device (the window's render state; figures get
+    /// a renderer of their own on its device).
+    pub fn set_gpu(&mut self, render_state: eframe::egui_wgpu::RenderState) {
+        self.gpu = Some(render_state);
     }
 
     /// Shows a toast.
@@ -327,7 +319,7 @@ impl ExportUi {
     /// The offscreen renderer on the window's device, or a headless one.
     fn offscreen(&self) -> anyhow::Result<Offscreen> {
         match &self.gpu {
-            Some((d, q, a)) => Ok(Offscreen::new(d.clone(), q.clone(), a.clone())),
+            Some(rs) => Ok(Offscreen::from_render_state(rs)),
             None => Offscreen::headless(),
         }
     }

@@ -25,12 +25,12 @@ pub const MAX_PASSES: usize = 16;
 pub const MAX_SIDE: u32 = 8192;
 
 /// An egui-wgpu renderer of its own on a device (the GUI's, or one opened
-/// headless), with every view's GPU resources installed.
+/// headless), with every view's GPU resources installed. It is held as an
+/// egui-wgpu [`egui_wgpu::RenderState`], like a window's, so that views which
+/// find the render state through their egui context (and register textures
+/// with its renderer) draw offscreen as they do in the window.
 pub struct Offscreen {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
-    adapter: wgpu::Adapter,
-    renderer: egui_wgpu::Renderer,
+    rs: egui_wgpu::RenderState,
 }
 
 /// How an image is drawn.
@@ -79,13 +79,18 @@ impl Offscreen {
             trace: wgpu::Trace::Off,
         }))
         .with_context(|| format!("opening a device on {}", info.name))?;
-        Ok(Self::new(device, queue, adapter))
+        Ok(Self::new(instance, adapter, device, queue))
     }
 
-    /// An offscreen renderer on an existing device (the window's): it shares
-    /// the device and queue but has its own egui textures and view resources,
-    /// so the window's are left alone.
-    pub fn new(device: wgpu::Device, queue: wgpu::Queue, adapter: wgpu::Adapter) -> Self {
+    /// An offscreen renderer on an existing device: it shares the device and
+    /// queue but has its own egui textures and view resources, so a window's
+    /// are left alone.
+    pub fn new(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
         let mut renderer =
             egui_wgpu::Renderer::new(&device, FORMAT, egui_wgpu::RendererOptions::PREDICTABLE);
         crate::views::install_gpu(
@@ -95,21 +100,36 @@ impl Offscreen {
             FORMAT,
         );
         Self {
-            device,
-            queue,
-            adapter,
-            renderer,
+            rs: egui_wgpu::RenderState {
+                available_adapters: vec![adapter.clone()],
+                adapter,
+                instance,
+                device,
+                queue,
+                target_format: FORMAT,
+                renderer: std::sync::Arc::new(eframe::egui::mutex::RwLock::new(renderer)),
+            },
         }
     }
 
-    /// From an egui-wgpu render state (eframe's window).
+    /// On the device of an egui-wgpu render state (eframe's window).
     pub fn from_render_state(rs: &egui_wgpu::RenderState) -> Self {
-        Self::new(rs.device.clone(), rs.queue.clone(), rs.adapter.clone())
+        Self::new(
+            rs.instance.clone(),
+            rs.adapter.clone(),
+            rs.device.clone(),
+            rs.queue.clone(),
+        )
+    }
+
+    /// The render state figures are drawn with.
+    pub fn render_state(&self) -> &egui_wgpu::RenderState {
+        &self.rs
     }
 
     /// One line naming the adapter.
     pub fn describe(&self) -> String {
-        let i = self.adapter.get_info();
+        let i = self.rs.adapter.get_info();
         format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
     }
 
@@ -145,21 +165,24 @@ impl Offscreen {
         });
         let mut input = egui::RawInput {
             screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, frame.size)),
-            max_texture_side: Some(self.device.limits().max_texture_dimension_2d as usize),
+            max_texture_side: Some(self.rs.device.limits().max_texture_dimension_2d as usize),
             ..Default::default()
         };
         if let Some(v) = input.viewports.get_mut(&egui::ViewportId::ROOT) {
             v.native_pixels_per_point = Some(frame.pixels_per_point);
         }
         ctx.set_pixels_per_point(frame.pixels_per_point);
+        crate::views::install_context(&ctx, &self.rs);
 
         let mut output = None;
         for pass in 0..MAX_PASSES {
             let mut out = ctx.run_ui(input.clone(), |u| ui(u));
-            for (id, deltas) in &out.textures_delta.set {
-                for delta in deltas {
-                    self.renderer
-                        .update_texture(&self.device, &self.queue, *id, delta);
+            {
+                let mut r = self.rs.renderer.write();
+                for (id, deltas) in &out.textures_delta.set {
+                    for delta in deltas {
+                        r.update_texture(&self.rs.device, &self.rs.queue, *id, delta);
+                    }
                 }
             }
             let settled = out
@@ -171,14 +194,14 @@ impl Offscreen {
                 break;
             }
             for id in &out.textures_delta.free {
-                self.renderer.free_texture(id);
+                self.rs.renderer.write().free_texture(id);
             }
             out.textures_delta.clear();
         }
         let mut output = output.context("egui produced no frame")?;
         let image = self.paint(&ctx, &output, frame, [w, h]);
         for id in &output.textures_delta.free {
-            self.renderer.free_texture(id);
+            self.rs.renderer.write().free_texture(id);
         }
         output.textures_delta.clear();
         let mut image = image?;
@@ -201,15 +224,13 @@ impl Offscreen {
             pixels_per_point: ppp,
         };
         let jobs = ctx.tessellate(output.shapes.clone(), ppp);
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("bv offscreen"),
-            });
-        let user =
-            self.renderer
-                .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
-        let texture = self.device.create_texture(&wgpu::TextureDescriptor {
+        let (device, queue) = (&self.rs.device, &self.rs.queue);
+        let mut renderer = self.rs.renderer.write();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("bv offscreen"),
+        });
+        let user = renderer.update_buffers(device, queue, &mut encoder, &jobs, &screen);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("bv offscreen target"),
             size: wgpu::Extent3d {
                 width: w,
@@ -240,12 +261,13 @@ impl Offscreen {
                     ..Default::default()
                 })
                 .forget_lifetime();
-            self.renderer.render(&mut pass, &jobs, &screen);
+            renderer.render(&mut pass, &jobs, &screen);
         }
+        drop(renderer);
         let unpadded = w as usize * 4;
         let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
         let padded = unpadded.div_ceil(align) * align;
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("bv offscreen readback"),
             size: (padded * h as usize) as u64,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
@@ -267,14 +289,13 @@ impl Offscreen {
                 depth_or_array_layers: 1,
             },
         );
-        self.queue
-            .submit(user.into_iter().chain(std::iter::once(encoder.finish())));
+        queue.submit(user.into_iter().chain(std::iter::once(encoder.finish())));
         let slice = buffer.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
             let _ = tx.send(r);
         });
-        self.device
+        device
             .poll(wgpu::PollType::wait_indefinitely())
             .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
         rx.recv()

@@ -252,6 +252,11 @@ pub fn decade_label(k: i32) -> String {
     }
 }
 
+/// Gives the views of an egui context what they fetch from it (views that
+/// find egui's render state through the context install it here), for
+/// eframe's window and for offscreen figures alike.
+pub fn install_context(_ctx: &egui::Context, _render_state: &eframe::egui_wgpu::RenderState) {}
+
 /// The background a figure view fills: the panel's colour, or nothing.
 pub fn figure_fill(ui: &Ui, scene: &Scene<'_>) -> Color32 {
     if scene.transparent {
