@@ -11,6 +11,8 @@ use bv_core::{ModelSpec, ParamValue};
 pub enum Command {
     /// Adds a BRDF of catalogue model `0` with its defaults, and selects it.
     AddBrdf(String),
+    /// Adds a BRDF with the given (validated) parameters, and selects it.
+    AddSpec(ModelSpec),
     /// Removes a BRDF.
     RemoveBrdf(u64),
     /// Shows a BRDF's parameters in the panel.
@@ -96,6 +98,9 @@ impl Command {
                 }
                 Err(e) => out.message = Some(e.to_string()),
             },
+            Command::AddSpec(spec) => {
+                state.add(spec);
+            }
             Command::RemoveBrdf(id) => {
                 let pos = state.brdfs.iter().position(|b| b.id == id);
                 if let Some(i) = pos {

@@ -9,10 +9,13 @@
 //!   window once it has drawn and exits.
 
 pub mod command;
+pub mod files;
 pub mod lighting;
 pub mod panel;
 pub mod params_ui;
 pub mod runtime;
+pub mod scene;
+pub mod screenshot;
 pub mod state;
 pub mod viewer;
 
@@ -20,7 +23,6 @@ pub use command::Command;
 pub use state::AppState;
 pub use viewer::Viewer;
 
-use crate::views::lobe_gpu;
 use anyhow::{Context as _, bail};
 use bv_core::{ParamKind, ParamValue};
 use eframe::egui;
@@ -61,6 +63,11 @@ pub struct ViewerArgs {
     /// Start with the light theme.
     #[arg(long)]
     pub light: bool,
+
+    /// Open this scene file (TOML, see `bv scene --help`) instead of the saved
+    /// session.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 /// Parses `WIDTHxHEIGHT`.
@@ -84,7 +91,13 @@ pub fn parse_size(text: &str) -> anyhow::Result<[f32; 2]> {
 
 /// The state the window starts with.
 fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppState> {
-    let mut state = if args.fresh {
+    let mut state = if let Some(path) = &args.scene {
+        let loaded = scene::load(path).with_context(|| format!("opening {}", path.display()))?;
+        for w in &loaded.warnings {
+            eprintln!("bv: {}: {w}", path.display());
+        }
+        loaded.state
+    } else if args.fresh {
         AppState::first_run()
     } else {
         saved
@@ -131,6 +144,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
     for m in &args.models {
         bv_core::find(m)?;
     }
+    if let Some(path) = &args.scene {
+        // Refuse a bad scene before a window opens.
+        scene::load(path).with_context(|| format!("opening {}", path.display()))?;
+    }
     let size = match &args.size {
         Some(s) => parse_size(s)?,
         None => [1280.0, 800.0],
@@ -167,8 +184,15 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         options,
         Box::new(move |cc| {
             if let Some(rs) = &cc.wgpu_render_state {
-                lobe_gpu::install(rs);
-                crate::views::gpu_image::install(&cc.egui_ctx, rs);
+                let mut renderer = rs.renderer.write();
+                crate::views::install_gpu(
+                    &mut renderer.callback_resources,
+                    &rs.device,
+                    Some(&rs.adapter),
+                    rs.target_format,
+                );
+                drop(renderer);
+                crate::views::install_context(&cc.egui_ctx, rs);
             }
             let saved = if load_saved {
                 cc.storage.and_then(|s| s.get_string(STORAGE_KEY))
@@ -184,8 +208,13 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                     format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
                 },
             );
+            let mut viewer = Viewer::new(state);
+            if let Some(rs) = &cc.wgpu_render_state {
+                viewer.export.set_gpu(rs.clone());
+            }
+            viewer.export.scene_path = args2.scene.clone();
             let mut app = BvApp {
-                viewer: Viewer::new(state),
+                viewer,
                 persist,
                 bench: args2.bench_frames.map(|n| Bench::new(n, adapter)),
                 shot: args2.screenshot.clone().map(Shot::new),

@@ -205,7 +205,11 @@ fn value_ui(
                 .unwrap_or_else(|| t.clone());
             ui.horizontal(|ui| {
                 ui.label(decl.label);
-                let r = ui.add(egui::TextEdit::singleline(&mut draft).desired_width(SLIDER_WIDTH));
+                let r = ui.add(
+                    egui::TextEdit::singleline(&mut draft)
+                        .desired_width(SLIDER_WIDTH)
+                        .hint_text("path, or drop a file"),
+                );
                 let r = with_doc(r, decl);
                 if r.lost_focus() {
                     *t = draft.clone();

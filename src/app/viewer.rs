@@ -8,9 +8,12 @@
 use super::command::Command;
 use super::panel;
 use super::runtime::Runtime;
+use super::scene;
+use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::state::{AppState, Theme};
 use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
 use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
+use std::path::Path;
 
 /// Keyboard shortcuts, as shown in the help overlay.
 pub const SHORTCUTS: &[(&str, &str)] = &[
@@ -25,12 +28,15 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "M",
         "maximise the view under the pointer (again to restore)",
     ),
-    (
-        "1 … 9",
-        "maximise the first, second, … view (again to restore)",
-    ),
+    ("1 … 9", "maximise view 1 … 9 (again to restore)"),
     ("Esc", "restore the layout"),
     ("T", "switch between dark and light themes"),
+    ("Ctrl+O", "open a scene file"),
+    ("Ctrl+S", "save the scene (to the file it came from)"),
+    (
+        "Ctrl+Shift+S",
+        "export a figure: a view or the window as PNG / SVG / OBJ",
+    ),
     ("Ctrl+Q", "quit (the session is saved)"),
 ];
 
@@ -61,6 +67,11 @@ pub struct Viewer {
     applied_theme: Option<Theme>,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
+    /// Draw as a figure (a screenshot of the window): views finish slow work
+    /// (renderer builds, environment sampling) before drawing.
+    pub figure: bool,
+    /// Scene files, figure export and toasts.
+    pub export: ExportUi,
 }
 
 impl Viewer {
@@ -75,6 +86,83 @@ impl Viewer {
             help: false,
             applied_theme: None,
             force_interacting: false,
+            figure: false,
+            export: ExportUi::default(),
+        }
+    }
+
+    /// Replaces the whole state (a scene was opened).
+    pub fn replace_state(&mut self, state: AppState) {
+        self.state = state.sanitised();
+        self.pending.clear();
+    }
+
+    /// Opens a scene file; returns its warnings. On error the state is
+    /// unchanged.
+    pub fn open_scene(&mut self, path: &Path) -> Result<Vec<String>, scene::SceneError> {
+        let loaded = scene::load(path)?;
+        // Keep the theme the user chose for the window.
+        let theme = self.state.theme;
+        self.replace_state(AppState {
+            theme,
+            ..loaded.state
+        });
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(loaded.warnings)
+    }
+
+    /// Saves the state as a scene file (atomically).
+    pub fn save_scene(&mut self, path: &Path) -> Result<(), scene::SceneError> {
+        scene::save(path, &self.state)?;
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(())
+    }
+
+    fn handle(&mut self, r: Request, ctx: &egui::Context) {
+        match r {
+            Request::OpenScene(path) => match self.open_scene(&path) {
+                Ok(w) => {
+                    let line = screenshot::warnings_line(&path, &w);
+                    if !w.is_empty() {
+                        self.status = Some(line.clone());
+                    }
+                    self.export.toast(line, false);
+                }
+                Err(e) => {
+                    let msg = format!("Could not open {}: {e}", path.display());
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::SaveScene(path) => match self.save_scene(&path) {
+                Ok(()) => self
+                    .export
+                    .toast(format!("Saved the scene to {}", path.display()), false),
+                Err(e) => {
+                    let msg = format!("Could not save the scene: {e}");
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::Figure(settings, path) => {
+                let geometry = ScreenGeometry {
+                    window: ctx.content_rect().size(),
+                    pixels_per_point: ctx.pixels_per_point(),
+                };
+                let view_size = match &settings.target {
+                    screenshot::Target::View(id) => view_rect(ctx, id).map(|r| r.size()),
+                    screenshot::Target::Window => None,
+                };
+                match self
+                    .export
+                    .export_figure(&self.state, &settings, &path, geometry, view_size)
+                {
+                    Ok(line) => self.export.toast(line, false),
+                    Err(e) => self
+                        .export
+                        .toast(format!("Could not export the figure: {e:#}"), true),
+                }
+            }
         }
     }
 
@@ -146,14 +234,19 @@ impl Viewer {
         self.top_bar(ui, &mut out);
         self.left_panel(ui, &mut out);
         {
-            let scene = build_scene(&self.state, &self.runtime, interacting);
+            let mut scene = build_scene(&self.state, &self.runtime, interacting);
+            scene.figure = self.figure;
             let views = &mut self.views;
             egui::CentralPanel::default().show(ui, |ui| {
                 central(ui, views, &scene, &mut out);
             });
         }
         self.shortcuts(&ctx, &mut out);
+        dropped_files(&ctx, &self.state, &mut out);
         self.help_window(&ctx);
+        for r in self.export.ui(&ctx) {
+            self.handle(r, &ctx);
+        }
         if !out.is_empty() {
             // Repaint only for real changes, so a widget that re-sends the same
             // value cannot keep the app busy.
@@ -171,6 +264,28 @@ impl Viewer {
             ui.horizontal(|ui| {
                 ui.label(RichText::new("bv").strong().size(16.0));
                 ui.weak("BRDF viewer");
+                ui.separator();
+                if ui
+                    .button("Open…")
+                    .on_hover_text("Open a scene file (Ctrl+O)")
+                    .clicked()
+                {
+                    self.export.ask_open_scene();
+                }
+                if ui
+                    .button("Save…")
+                    .on_hover_text("Save the scene as a TOML file (Ctrl+S)")
+                    .clicked()
+                {
+                    self.export.ask_save_scene();
+                }
+                if ui
+                    .button("Export…")
+                    .on_hover_text("A view or the window as PNG, SVG or OBJ (Ctrl+Shift+S)")
+                    .clicked()
+                {
+                    self.export.dialog_open = true;
+                }
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
                         .button("? help")
@@ -231,6 +346,20 @@ impl Viewer {
     fn shortcuts(&mut self, ctx: &egui::Context, out: &mut Vec<Command>) {
         if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        // Shift+S first: `consume_key` with COMMAND alone would also match it.
+        if ctx
+            .input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S))
+        {
+            self.export.dialog_open = !self.export.dialog_open;
+        } else if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::S)) {
+            match self.export.scene_path.clone() {
+                Some(p) => self.handle(Request::SaveScene(p), ctx),
+                None => self.export.ask_save_scene(),
+            }
+        }
+        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::O)) {
+            self.export.ask_open_scene();
         }
         if ctx.egui_wants_keyboard_input() {
             return;
@@ -300,17 +429,18 @@ impl Viewer {
                 | Key::Num7
                 | Key::Num8
                 | Key::Num9 => {
-                    let i = match k {
-                        Key::Num1 => 0,
-                        Key::Num2 => 1,
-                        Key::Num3 => 2,
-                        Key::Num4 => 3,
-                        Key::Num5 => 4,
-                        Key::Num6 => 5,
-                        Key::Num7 => 6,
-                        Key::Num8 => 7,
-                        _ => 8,
-                    };
+                    let keys = [
+                        Key::Num1,
+                        Key::Num2,
+                        Key::Num3,
+                        Key::Num4,
+                        Key::Num5,
+                        Key::Num6,
+                        Key::Num7,
+                        Key::Num8,
+                        Key::Num9,
+                    ];
+                    let i = keys.iter().position(|x| *x == k).unwrap_or(0);
                     if let Some(e) = REGISTRY.get(i) {
                         out.push(Command::ToggleMaximise(e.id.to_string()));
                     }
@@ -370,6 +500,17 @@ impl Viewer {
     }
 }
 
+/// Where view `id` was drawn in the last frame.
+pub fn view_rect(ctx: &egui::Context, id: &str) -> Option<Rect> {
+    ctx.memory(|m| {
+        m.data
+            .get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"))
+    })?
+    .into_iter()
+    .find(|(v, _)| v == id)
+    .map(|(_, r)| r)
+}
+
 /// Lays out the views in the central area.
 fn central(
     ui: &mut Ui,
@@ -391,6 +532,50 @@ fn central(
             view_frame(ui, entry, view.as_mut(), is_max, scene, out);
         });
     }
+}
+
+/// Files dropped on the window go to a path parameter (a MERL table): the
+/// selected BRDF's if it has one, otherwise a new BRDF of the first catalogue
+/// model that takes a file.
+fn dropped_files(ctx: &egui::Context, state: &AppState, out: &mut Vec<Command>) {
+    let paths: Vec<String> = ctx.input(|i| {
+        i.raw
+            .dropped_files
+            .iter()
+            .map(|f| f.path().display().to_string())
+            .collect()
+    });
+    for path in paths {
+        out.extend(file_command(state, &path));
+    }
+}
+
+/// The command that loads `path` (see [`dropped_files`]).
+pub fn file_command(state: &AppState, path: &str) -> Option<Command> {
+    let path_param = |model: &str| {
+        bv_core::find(model).ok().and_then(|m| {
+            m.params
+                .iter()
+                .find(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
+        })
+    };
+    let value = bv_core::ParamValue::Text(path.to_string());
+    if let Some(e) = state.selected_entry()
+        && let Some(d) = path_param(&e.spec.model)
+    {
+        return Some(Command::SetParam {
+            brdf: e.id,
+            param: d.id.to_string(),
+            value,
+        });
+    }
+    let info = bv_core::catalogue()
+        .iter()
+        .find(|m| path_param(m.id).is_some())?;
+    let decl = path_param(info.id)?;
+    let mut spec = bv_core::ModelSpec::new(info.id).ok()?;
+    spec.set(decl.id, value).ok()?;
+    Some(Command::AddSpec(spec))
 }
 
 /// Builds the frame's scene from the state and the built evaluators.
@@ -418,6 +603,8 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
         brdfs,
         incident: state.incident,
         interacting,
+        figure: false,
+        transparent: false,
     }
 }
 
@@ -546,6 +733,33 @@ fn view_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_dropped_file_goes_to_a_path_parameter() {
+        let Some(model) = bv_core::catalogue().iter().find(|m| {
+            m.params
+                .iter()
+                .any(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
+        }) else {
+            return; // no model of this build takes a file
+        };
+        // Nothing selected that takes a file: a new BRDF of that model.
+        let mut s = AppState::first_run();
+        match file_command(&s, "/data/gold.binary") {
+            Some(Command::AddSpec(spec)) => {
+                assert_eq!(spec.model, model.id);
+                assert!(spec.to_json().to_string().contains("/data/gold.binary"));
+                Command::AddSpec(spec).apply(&mut s);
+            }
+            other => panic!("{other:?}"),
+        }
+        // Now it is selected: the next file replaces its path.
+        let id = s.selected.unwrap();
+        assert!(matches!(
+            file_command(&s, "/data/red.binary"),
+            Some(Command::SetParam { brdf, .. }) if brdf == id
+        ));
+    }
 
     #[test]
     fn layout_fills_the_area() {

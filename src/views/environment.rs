@@ -40,6 +40,21 @@ pub const PASS_BUDGET_S: f64 = 0.045;
 /// linear filtering. A GPU renders at full resolution.
 pub const SOFTWARE_SCALE: f32 = 0.5;
 
+/// Largest sample count of a figure on a software renderer (a clean image
+/// at full resolution in well under a minute on lavapipe); a GPU takes the
+/// view's target.
+pub const SOFTWARE_FIGURE_SPP: u32 = 256;
+
+/// Samples per pixel of a figure.
+pub fn figure_spp(target: u32, software: bool) -> u32 {
+    let t = target.clamp(1, MAX_TARGET_SPP);
+    if software {
+        t.min(SOFTWARE_FIGURE_SPP)
+    } else {
+        t
+    }
+}
+
 /// Field of view of the background behind the objects (vertical, degrees).
 const BACKGROUND_FOV_DEG: f64 = 60.0;
 
@@ -229,6 +244,28 @@ impl EnvironmentView {
         }
     }
 
+    /// Loads `map` on this thread if it is not the one in use (figures).
+    fn load_map_now(&mut self, map: &Option<String>) {
+        if self.map_requested.as_ref() == Some(map) && self.loading.is_none() {
+            return;
+        }
+        self.loading = None;
+        self.map_requested = Some(map.clone());
+        let loaded = match map {
+            None => EnvironmentMap::builtin_studio(),
+            Some(p) => EnvironmentMap::load(std::path::Path::new(p)),
+        };
+        match loaded {
+            Ok(m) => self.install_map(map.clone(), &m),
+            Err(e) => {
+                self.map_error = Some(format!(
+                    "{e:#} (showing {})",
+                    self.map_in_use.as_deref().unwrap_or("the studio")
+                ))
+            }
+        }
+    }
+
     fn install_map(&mut self, path: Option<String>, map: &EnvironmentMap) {
         if let Some(r) = self.renderer.ready_mut() {
             match r.set_environment(map) {
@@ -251,19 +288,26 @@ impl EnvironmentView {
         env: &EnvView,
         size: (u32, u32),
         interacting: bool,
+        figure: bool,
+        software: bool,
     ) -> (Option<egui::TextureId>, bool) {
         let Some(rs) = gpu_image::render_state(ui.ctx()) else {
             return (None, false);
         };
         let gpu = gpu_image::gpu_of(&rs);
-        let built = self.renderer.poll(ui.ctx(), move || {
+        let build = move || {
             EnvironmentMap::builtin_studio()
                 .and_then(|map| {
                     let mut lib = gpu_image::library()?;
                     EnvRenderer::new(gpu, &mut lib, &map)
                 })
                 .map_err(|e| format!("cannot build the environment renderer: {e:#}"))
-        });
+        };
+        let built = if figure {
+            self.renderer.now(build).map(|_| Some(()))
+        } else {
+            self.renderer.poll(ui.ctx(), build).map(|r| r.map(|_| ()))
+        };
         match built {
             Ok(Some(_)) => {}
             Ok(None) => return (None, false),
@@ -272,11 +316,56 @@ impl EnvironmentView {
                 return (None, false);
             }
         }
-        self.sync_map(ui.ctx(), &env.map);
+        if figure {
+            self.load_map_now(&env.map);
+        } else {
+            self.sync_map(ui.ctx(), &env.map);
+        }
         let Some(renderer) = self.renderer.ready_mut() else {
             return (None, false);
         };
         renderer.set_object(env.object.to_gpu());
+        if figure {
+            // A figure is drawn in one go: accumulate to the target now.
+            let target = figure_spp(env.target_spp, software);
+            let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
+            let settings = Self::settings(env);
+            let mut texture = None;
+            loop {
+                let done = if renderer.would_restart(&specs, &settings, size.0, size.1) {
+                    0
+                } else {
+                    renderer.samples_per_pixel()
+                };
+                if done >= u64::from(target) {
+                    break;
+                }
+                let pass = (u64::from(target) - done).min(u64::from(MAX_PASS_SPP)) as u32;
+                match renderer.render(&specs, &settings, size.0, size.1, pass) {
+                    Ok(t) => texture = Some(t.clone()),
+                    Err(e) => {
+                        self.render_error = Some(format!("{e:#}"));
+                        return (None, false);
+                    }
+                }
+                if let Err(e) = renderer.gpu().wait() {
+                    self.render_error = Some(format!("{e:#}"));
+                    return (None, false);
+                }
+            }
+            let texture = match texture {
+                Some(t) => t,
+                None => match renderer.display(&settings, size.0, size.1) {
+                    Ok(t) => t.clone(),
+                    Err(e) => {
+                        self.render_error = Some(format!("{e:#}"));
+                        return (None, false);
+                    }
+                },
+            };
+            self.render_error = None;
+            return (Some(self.image.id(&rs, &texture)), false);
+        }
         let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
         let settings = Self::settings(env);
         let restart = renderer.would_restart(&specs, &settings, size.0, size.1);
@@ -439,7 +528,9 @@ impl View for EnvironmentView {
         let response = ui.allocate_rect(rect, Sense::hover());
         self.view_rect = Some(rect);
         let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, 0.0, Color32::BLACK);
+        if !scene.transparent {
+            painter.rect_filled(rect, 0.0, Color32::BLACK);
+        }
         let weak = ui.visuals().weak_text_color();
         let env = &scene.state.lighting.env;
 
@@ -479,11 +570,15 @@ impl View for EnvironmentView {
         let (drawables, mut errors) = gpu_image::drawables(scene, env.side_by_side);
         let rs = gpu_image::render_state(ui.ctx());
         let software = rs.as_ref().is_some_and(gpu_image::is_software);
-        let scale = if software { SOFTWARE_SCALE } else { 1.0 };
+        let scale = if software && !scene.figure {
+            SOFTWARE_SCALE
+        } else {
+            1.0
+        };
         if let Some(rs) = &rs {
             self.image.set_filter(
                 rs,
-                if software {
+                if scale < 1.0 {
                     eframe::wgpu::FilterMode::Linear
                 } else {
                     eframe::wgpu::FilterMode::Nearest
@@ -493,7 +588,15 @@ impl View for EnvironmentView {
         let size = gpu_image::pixel_size(rect, ui.ctx().pixels_per_point() * scale);
         let mut more = false;
         if !drawables.is_empty() {
-            let (id, m) = self.step(ui, &drawables, env, size, scene.interacting);
+            let (id, m) = self.step(
+                ui,
+                &drawables,
+                env,
+                size,
+                scene.interacting,
+                scene.figure,
+                software,
+            );
             more = m;
             if let Some(id) = id {
                 painter.image(
@@ -518,26 +621,28 @@ impl View for EnvironmentView {
             self.pass_spp,
             self.spp_cost,
         );
-        response.on_hover_ui(|ui| {
-            ui.label(format!(
-                "{} samples per pixel (one BRDF and one environment sample each, combined \
+        if !scene.figure {
+            response.on_hover_ui(|ui| {
+                ui.label(format!(
+                    "{} samples per pixel (one BRDF and one environment sample each, combined \
                  with the power heuristic); stops at {}.",
-                self.samples_per_pixel(),
-                env.target_spp
-            ));
-            match (converged, restarted) {
-                (Some(t), _) => ui.label(format!("Reached it {t:.1} s after the last change.")),
-                (None, Some(t)) => ui.label(format!(
-                    "{:.1} s since the last change; {pass} samples per frame ({:.2} ms each).",
-                    t.elapsed().as_secs_f64(),
-                    cost.unwrap_or(0.0) * 1e3
-                )),
-                (None, None) => ui.label(""),
-            };
-            if software {
-                ui.label("Software renderer: accumulated at half the view's resolution.");
-            }
-        });
+                    self.samples_per_pixel(),
+                    env.target_spp
+                ));
+                match (converged, restarted) {
+                    (Some(t), _) => ui.label(format!("Reached it {t:.1} s after the last change.")),
+                    (None, Some(t)) => ui.label(format!(
+                        "{:.1} s since the last change; {pass} samples per frame ({:.2} ms each).",
+                        t.elapsed().as_secs_f64(),
+                        cost.unwrap_or(0.0) * 1e3
+                    )),
+                    (None, None) => ui.label(""),
+                };
+                if software {
+                    ui.label("Software renderer: accumulated at half the view's resolution.");
+                }
+            });
+        }
         if self.renderer.building() {
             painter.text(
                 rect.center(),
@@ -561,28 +666,30 @@ impl View for EnvironmentView {
         } else if self.pass_spp > 1 {
             status.push_str(&format!(" (+{} per frame)", self.pass_spp));
         }
-        gpu_image::plate_text(
-            &painter,
-            rect.left_top() + Vec2::new(6.0, 6.0),
-            Align2::LEFT_TOP,
-            &status,
-            text,
-        );
-        let map_name = match (&self.loading, &self.map_in_use) {
-            (Some(l), _) => format!("loading {} …", l.path),
-            (None, Some(p)) => std::path::Path::new(p)
-                .file_name()
-                .map(|f| f.to_string_lossy().to_string())
-                .unwrap_or_else(|| p.clone()),
-            (None, None) => "studio (built in)".to_string(),
-        };
-        gpu_image::plate_text(
-            &painter,
-            rect.right_top() + Vec2::new(-6.0, 6.0),
-            Align2::RIGHT_TOP,
-            &format!("{map_name} · rot {:.0}°", env.rotation_deg),
-            text,
-        );
+        if !scene.figure {
+            gpu_image::plate_text(
+                &painter,
+                rect.left_top() + Vec2::new(6.0, 6.0),
+                Align2::LEFT_TOP,
+                &status,
+                text,
+            );
+            let map_name = match (&self.loading, &self.map_in_use) {
+                (Some(l), _) => format!("loading {} …", l.path),
+                (None, Some(p)) => std::path::Path::new(p)
+                    .file_name()
+                    .map(|f| f.to_string_lossy().to_string())
+                    .unwrap_or_else(|| p.clone()),
+                (None, None) => "studio (built in)".to_string(),
+            };
+            gpu_image::plate_text(
+                &painter,
+                rect.right_top() + Vec2::new(-6.0, 6.0),
+                Align2::RIGHT_TOP,
+                &format!("{map_name} · rot {:.0}°", env.rotation_deg),
+                text,
+            );
+        }
         let circle = gpu_image::sphere_circle(rect, drawables.len());
         for (k, d) in drawables.iter().enumerate() {
             let (c, r) = circle(k);

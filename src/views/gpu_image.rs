@@ -107,6 +107,30 @@ impl<T: Send + 'static> Deferred<T> {
         }
     }
 
+    /// The value now: built on this thread if not asked for yet (or after a
+    /// failure), waited for if a worker is building it. For figures, which
+    /// are drawn in one go.
+    pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
+        if let Deferred::Building(rx) = self {
+            *self = match rx.recv() {
+                Ok(Ok(t)) => Deferred::Ready(t),
+                Ok(Err(e)) => Deferred::Failed(e),
+                Err(_) => Deferred::Empty,
+            };
+        }
+        if !matches!(self, Deferred::Ready(_)) {
+            *self = match build() {
+                Ok(t) => Deferred::Ready(t),
+                Err(e) => Deferred::Failed(e),
+            };
+        }
+        match self {
+            Deferred::Ready(t) => Ok(t),
+            Deferred::Failed(e) => Err(e.clone()),
+            Deferred::Empty | Deferred::Building(_) => Err("no renderer".into()),
+        }
+    }
+
     /// The built value, if ready.
     pub fn ready(&self) -> Option<&T> {
         match self {

@@ -103,14 +103,21 @@ impl LitSphereView {
         drawables: &[Drawable],
         settings: LitSphereSettings,
         size: (u32, u32),
+        figure: bool,
     ) -> Option<egui::TextureId> {
         let rs = gpu_image::render_state(ui.ctx())?;
         let gpu = gpu_image::gpu_of(&rs);
-        let renderer = match self.renderer.poll(ui.ctx(), move || {
+        let build = move || {
             gpu_image::library()
                 .and_then(|mut lib| LitSphereRenderer::new(gpu, &mut lib))
                 .map_err(|e| format!("cannot build the lit sphere renderer: {e:#}"))
-        }) {
+        };
+        let built = if figure {
+            self.renderer.now(build).map(Some)
+        } else {
+            self.renderer.poll(ui.ctx(), build)
+        };
+        let renderer = match built {
             Ok(Some(r)) => r,
             Ok(None) => return None,
             Err(e) => {
@@ -179,8 +186,10 @@ impl View for LitSphereView {
         self.view_rect = Some(rect);
         let dark = ui.visuals().dark_mode;
         let painter = ui.painter_at(rect);
-        let [r, g, b] = gpu_image::theme_background(dark).map(|c| (c * 255.0).round() as u8);
-        painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
+        if !scene.transparent {
+            let [r, g, b] = gpu_image::theme_background(dark).map(|c| (c * 255.0).round() as u8);
+            painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
+        }
         let weak = ui.visuals().weak_text_color();
         let text = super::strong_text(ui);
 
@@ -201,7 +210,7 @@ impl View for LitSphereView {
         let size = gpu_image::pixel_size(rect, ppp);
         let settings = Self::settings(scene, dark, ppp);
         if !drawables.is_empty()
-            && let Some(id) = self.render(ui, &drawables, settings, size)
+            && let Some(id) = self.render(ui, &drawables, settings, size, scene.figure)
         {
             painter.image(
                 id,
@@ -239,7 +248,7 @@ impl View for LitSphereView {
             );
         }
         self.overlays(ui, rect, scene, &drawables, &errors, dark, text, weak);
-        if let Some(p) = response.hover_pos() {
+        if let Some(p) = response.hover_pos().filter(|_| !scene.figure) {
             self.hover_value(ui, rect, p, scene, &drawables, text);
         }
     }
@@ -289,14 +298,16 @@ impl LitSphereView {
             lit.exposure_ev,
             lit.tone_map.label()
         );
-        painter.text(
-            rect.left_top() + Vec2::new(6.0, 4.0),
-            Align2::LEFT_TOP,
-            status,
-            egui::FontId::proportional(12.0),
-            text,
-        );
-        if rect.height() > 220.0 {
+        if !scene.figure {
+            painter.text(
+                rect.left_top() + Vec2::new(6.0, 4.0),
+                Align2::LEFT_TOP,
+                status,
+                egui::FontId::proportional(12.0),
+                text,
+            );
+        }
+        if rect.height() > 220.0 && !scene.figure {
             painter.text(
                 rect.left_bottom() + Vec2::new(6.0, -5.0),
                 Align2::LEFT_BOTTOM,

@@ -131,9 +131,7 @@ impl Lobe3dView {
                     RadiusScale::Linear
                 },
             };
-            let mut mesh = lobe::build(b.brdf.as_ref(), wi, &opts);
-            zero_horizon(&mut mesh);
-            let mesh = Arc::new(mesh);
+            let mesh = Arc::new(lobe::build(b.brdf.as_ref(), wi, &opts));
             let revision = self.next_revision;
             self.next_revision += 1;
             self.rebuilds += 1;
@@ -244,43 +242,6 @@ impl Lobe3dView {
         });
         self.last_frame = Some(frame.clone());
         frame
-    }
-}
-
-/// Sets the horizon ring of a hemisphere mesh to 0. The mesh builder places it
-/// at θ = π/2 with cos θ = 6e-17 rather than 0, and a model with a 1/cos θo
-/// factor (Ward) then returns thousands there, which would swamp the lobe and
-/// its colour scale; by SPEC §1 a reflection model is 0 in the surface.
-fn zero_horizon(mesh: &mut LobeMesh) {
-    if mesh.full_sphere || mesh.n_phi == 0 {
-        return;
-    }
-    let start = mesh.n_theta * mesh.n_phi;
-    let end = (start + mesh.n_phi)
-        .min(mesh.positions.len())
-        .min(mesh.values.len());
-    if start >= end {
-        return;
-    }
-    let mut touched = false;
-    for k in start..end {
-        if mesh.values[k] != [0.0; 3] {
-            mesh.values[k] = [0.0; 3];
-            mesh.positions[k] = [0.0; 3];
-            touched = true;
-        }
-    }
-    if touched {
-        mesh.max_value = mesh
-            .values
-            .iter()
-            .map(|v| f64::from(v[0] + v[1] + v[2]) / 3.0)
-            .fold(0.0, f64::max);
-        mesh.max_radius = mesh
-            .positions
-            .iter()
-            .map(|p| f64::from(Vec3::from_array(*p).length()))
-            .fold(0.0, f64::max);
     }
 }
 
@@ -554,7 +515,10 @@ impl View for Lobe3dView {
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         self.view_rect = Some(rect);
         let dark = ui.visuals().dark_mode;
-        let bg = background(dark);
+        let mut bg = background(dark);
+        if scene.transparent {
+            bg = [0.0; 4];
+        }
         let frame = self.frame(scene, rect.size(), bg, dark);
         ui.painter().add(
             LobeCallback {
@@ -766,20 +730,24 @@ impl Lobe3dView {
             )
         };
         let weak = ui.visuals().weak_text_color();
+        // Figures have no pointer: the scale line takes the hint's place.
+        let lift = if scene.figure { -6.0 } else { -24.0 };
         painter.text(
-            rect.left_bottom() + Vec2::new(8.0, -24.0),
+            rect.left_bottom() + Vec2::new(8.0, lift),
             Align2::LEFT_BOTTOM,
             scale_text,
             small.clone(),
             text,
         );
-        painter.text(
-            rect.left_bottom() + Vec2::new(8.0, -6.0),
-            Align2::LEFT_BOTTOM,
-            "drag: orbit · scroll: zoom · shift+drag: move light · double-click: reset",
-            small.clone(),
-            weak,
-        );
+        if !scene.figure {
+            painter.text(
+                rect.left_bottom() + Vec2::new(8.0, -6.0),
+                Align2::LEFT_BOTTOM,
+                "drag: orbit · scroll: zoom · shift+drag: move light · double-click: reset",
+                small.clone(),
+                weak,
+            );
+        }
         if scene.brdfs.is_empty() {
             painter.text(
                 rect.center(),
@@ -839,20 +807,6 @@ fn away_from(origin: Option<Pos2>, p: Pos2) -> Align2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_horizon_ring_is_zeroed() {
-        let b = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
-        let mut m = lobe::build(b.as_ref(), glam::DVec3::Z, &LobeOptions::default());
-        let k = m.n_theta * m.n_phi;
-        m.values[k] = [1e3; 3];
-        m.positions[k] = [1e3, 0.0, 0.0];
-        m.max_value = 1e3;
-        zero_horizon(&mut m);
-        assert_eq!(m.values[k], [0.0; 3]);
-        assert!((m.max_value - 0.5 / std::f64::consts::PI).abs() < 1e-6);
-        assert!((m.max_radius - 0.5 / std::f64::consts::PI).abs() < 1e-6);
-    }
 
     #[test]
     fn ground_disc_is_a_fan() {

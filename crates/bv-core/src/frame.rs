@@ -14,10 +14,26 @@ pub const TANGENT: DVec3 = DVec3::X;
 /// The bitangent (*v* direction).
 pub const BITANGENT: DVec3 = DVec3::Y;
 
-/// Unit direction from polar angle `theta` and azimuth `phi` (radians).
+/// `(sin θ, cos θ)`, exact at the horizon θ = π/2 and at θ = π. `cos(π/2)` in
+/// floating point is 6e-17, not 0: a direction meant to lie in the surface would
+/// then be just above it, where a model with a 1/cos θ factor (Ward, Phong)
+/// returns thousands instead of the 0 of SPEC §1.
+#[inline]
+pub fn sin_cos_theta(theta: f64) -> (f64, f64) {
+    if theta == FRAC_PI_2 {
+        (1.0, 0.0)
+    } else if theta == PI {
+        (0.0, -1.0)
+    } else {
+        theta.sin_cos()
+    }
+}
+
+/// Unit direction from polar angle `theta` and azimuth `phi` (radians); exactly
+/// in the surface for θ = π/2 (see [`sin_cos_theta`]).
 #[inline]
 pub fn from_spherical(theta: f64, phi: f64) -> DVec3 {
-    let (st, ct) = theta.sin_cos();
+    let (st, ct) = sin_cos_theta(theta);
     let (sp, cp) = phi.sin_cos();
     DVec3::new(st * cp, st * sp, ct)
 }
@@ -211,6 +227,12 @@ mod tests {
             let (t2, p2) = to_spherical(w);
             assert!((t - t2).abs() < 1e-12 && (p - p2).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn horizon_is_exactly_in_the_surface() {
+        assert_eq!(from_spherical(FRAC_PI_2, 0.3).z, 0.0);
+        assert_eq!(from_spherical(PI, 0.3), DVec3::new(0.0, 0.0, -1.0));
     }
 
     #[test]

@@ -107,7 +107,7 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
 
     let theta_max = if full { PI } else { FRAC_PI_2 };
     let ring: Vec<(f64, f64)> = (0..rows)
-        .map(|i| (theta_max * i as f64 / n_theta as f64).sin_cos())
+        .map(|i| frame::sin_cos_theta(theta_max * i as f64 / n_theta as f64))
         .collect();
     let column: Vec<(f64, f64)> = (0..n_phi)
         .map(|j| (2.0 * PI * j as f64 / n_phi as f64).sin_cos())
@@ -317,6 +317,17 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_horizon_ring_is_in_the_surface() {
+        // Ward divides by √cos θo: a horizon ring a hair above the surface would
+        // be thousands of 1/sr; in the surface it is 0 (SPEC §1).
+        let b = crate::ModelSpec::new("ward").unwrap().build().unwrap();
+        let m = build(b.as_ref(), DVec3::Z, &LobeOptions::default());
+        let k = m.n_theta * m.n_phi;
+        assert!(m.values[k..].iter().all(|v| *v == [0.0; 3]));
+        assert!(m.max_value < 10.0, "{}", m.max_value);
     }
 
     #[test]
