@@ -67,6 +67,17 @@ struct Shown {
     samples: u64,
 }
 
+/// How a frame is drawn.
+#[derive(Debug, Clone, Copy)]
+struct Mode {
+    /// A pointer button is held: one sample per frame.
+    interacting: bool,
+    /// A figure: everything now.
+    figure: bool,
+    /// On a software renderer.
+    software: bool,
+}
+
 /// A map being loaded on a worker thread.
 struct Loading {
     path: String,
@@ -287,10 +298,13 @@ impl EnvironmentView {
         drawables: &[Drawable],
         env: &EnvView,
         size: (u32, u32),
-        interacting: bool,
-        figure: bool,
-        software: bool,
+        mode: Mode,
     ) -> (Option<egui::TextureId>, bool) {
+        let Mode {
+            interacting,
+            figure,
+            software,
+        } = mode;
         let Some(rs) = gpu_image::render_state(ui.ctx()) else {
             return (None, false);
         };
@@ -588,15 +602,12 @@ impl View for EnvironmentView {
         let size = gpu_image::pixel_size(rect, ui.ctx().pixels_per_point() * scale);
         let mut more = false;
         if !drawables.is_empty() {
-            let (id, m) = self.step(
-                ui,
-                &drawables,
-                env,
-                size,
-                scene.interacting,
-                scene.figure,
+            let mode = Mode {
+                interacting: scene.interacting,
+                figure: scene.figure,
                 software,
-            );
+            };
+            let (id, m) = self.step(ui, &drawables, env, size, mode);
             more = m;
             if let Some(id) = id {
                 painter.image(
