@@ -561,16 +561,27 @@ fn environment_progression_images() {
     let mut lib = bv::gpu::shaders::ShaderLibrary::new().unwrap();
     let studio = EnvironmentMap::builtin_studio().unwrap();
     let mut env = EnvRenderer::new(gpu.clone(), &mut lib, &studio).unwrap();
-    let specs = [
-        ModelSpec::new("cook-torrance").unwrap(),
-        ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.8, 0.45, 0.2]})).unwrap(),
-    ];
+    // BV_SPECS="ward={\"alpha_x\":0.05};mirror={}" picks the models.
+    let specs: Vec<ModelSpec> = match std::env::var("BV_SPECS") {
+        Ok(list) => list
+            .split(';')
+            .map(|item| {
+                let (m, p) = item.split_once('=').unwrap_or((item, "{}"));
+                ModelSpec::from_json(m, &serde_json::from_str(p).unwrap()).unwrap()
+            })
+            .collect(),
+        Err(_) => vec![
+            ModelSpec::new("cook-torrance").unwrap(),
+            ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.8, 0.45, 0.2]}))
+                .unwrap(),
+        ],
+    };
     let object = match std::env::var("BV_OBJECT").as_deref() {
         Ok("torus") => bv::gpu::env::Object::Torus,
         _ => bv::gpu::env::Object::Sphere,
     };
     env.set_object(object);
-    let (w, h) = (360, 180);
+    let (w, h) = (180 * specs.len() as u32, 180);
     let t0 = std::time::Instant::now();
     for spp in [4u32, 16, 64, 256] {
         let img = env

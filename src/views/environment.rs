@@ -18,6 +18,7 @@ use super::gpu_image::{self, Deferred, Drawable, GpuImage};
 use super::lit_sphere::{arrangement_control, exposure_control, tone_control};
 use super::{Scene, View};
 use crate::app::command::Command;
+use crate::app::files::{Files, Filter};
 use crate::app::lighting::{EnvObject, EnvView, MAX_TARGET_SPP};
 use crate::gpu::{EnvRenderer, EnvSettings, EnvironmentMap};
 use bv_core::ModelSpec;
@@ -67,6 +68,12 @@ struct Shown {
     samples: u64,
 }
 
+/// Environment maps the view opens.
+pub const ENVIRONMENT_FILES: Filter = Filter {
+    name: "environment map (.hdr, .exr)",
+    extensions: &["hdr", "exr"],
+};
+
 /// How a frame is drawn.
 #[derive(Debug, Clone, Copy)]
 struct Mode {
@@ -104,6 +111,7 @@ pub struct EnvironmentView {
     /// Seconds from the last restart to the target sample count.
     converged_after: Option<f64>,
     path_edit: Option<String>,
+    files: Files<()>,
     messages: Vec<String>,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
@@ -133,6 +141,7 @@ impl EnvironmentView {
             restarted_at: None,
             converged_after: None,
             path_edit: None,
+            files: Files::default(),
             messages: Vec::new(),
             view_rect: None,
         }
@@ -458,9 +467,7 @@ impl EnvironmentView {
 
 /// Whether `path` names a map the view can load (by its extension).
 pub fn is_environment_file(path: &std::path::Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("hdr") || e.eq_ignore_ascii_case("exr"))
+    ENVIRONMENT_FILES.accepts(path)
 }
 
 impl View for EnvironmentView {
@@ -520,6 +527,18 @@ impl View for EnvironmentView {
         if !r.has_focus() && next.map.clone().unwrap_or_default() != *edit {
             // Follow changes made elsewhere (a drop, the studio button).
             *edit = next.map.clone().unwrap_or_default();
+        }
+        if ui
+            .small_button("open…")
+            .on_hover_text("Choose a .hdr or .exr environment map")
+            .clicked()
+        {
+            self.files
+                .open((), "Open an environment map", ENVIRONMENT_FILES);
+        }
+        if let Some(((), path)) = self.files.show(ui.ctx()) {
+            next.map = Some(path.display().to_string());
+            self.path_edit = None;
         }
         if ui
             .small_button("studio")

@@ -307,7 +307,9 @@ impl LitSphereView {
                 text,
             );
         }
-        if rect.height() > 220.0 && !scene.figure {
+        // The hint only where it clears the spheres' labels.
+        let below = rect.max.y - (circle(0).0.y + circle(0).1);
+        if below > 44.0 && !scene.figure {
             painter.text(
                 rect.left_bottom() + Vec2::new(6.0, -5.0),
                 Align2::LEFT_BOTTOM,
