@@ -9,6 +9,8 @@
 //!   window once it has drawn and exits.
 
 pub mod command;
+pub mod loader;
+pub mod measured_ui;
 pub mod panel;
 pub mod params_ui;
 pub mod runtime;
@@ -60,6 +62,11 @@ pub struct ViewerArgs {
     /// Start with the light theme.
     #[arg(long)]
     pub light: bool,
+
+    /// Open a measured BRDF (a MERL `.binary` file) as one more BRDF, read in
+    /// the background with a progress bar (repeat for several).
+    #[arg(long = "open", value_name = "FILE")]
+    pub open: Vec<PathBuf>,
 }
 
 /// Parses `WIDTHxHEIGHT`.
@@ -182,8 +189,15 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                     format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
                 },
             );
+            let mut viewer = Viewer::new(state);
+            for f in &args2.open {
+                viewer.push(Command::OpenFile {
+                    path: f.display().to_string(),
+                    into: None,
+                });
+            }
             let mut app = BvApp {
-                viewer: Viewer::new(state),
+                viewer,
                 persist,
                 bench: args2.bench_frames.map(|n| Bench::new(n, adapter)),
                 shot: args2.screenshot.clone().map(Shot::new),

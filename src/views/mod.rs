@@ -4,13 +4,16 @@
 //! [`Command`]s. A view is added by writing its module and one line in
 //! [`REGISTRY`].
 
+pub mod background;
 pub mod camera;
 pub mod cartesian;
 pub mod colormap;
 pub mod curves;
+pub mod image_slice;
 pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
+pub mod sh_overlay;
 
 use crate::app::command::Command;
 use crate::app::state::{AppState, Incident};
@@ -114,6 +117,11 @@ pub const REGISTRY: &[ViewEntry] = &[
         id: "cartesian",
         title: "f versus angle",
         make: || Box::new(cartesian::CartesianView::default()),
+    },
+    ViewEntry {
+        id: "slice",
+        title: "Image slice (θh × θd)",
+        make: || Box::new(image_slice::ImageSliceView::default()),
     },
 ];
 
