@@ -146,9 +146,9 @@ impl Loader {
             let outcome = match self.jobs[i].rx.try_recv() {
                 Ok(r) => Some(r),
                 Err(mpsc::TryRecvError::Empty) => None,
-                Err(mpsc::TryRecvError::Disconnected) => {
-                    Some(Err("the reading thread stopped without an answer".to_string()))
-                }
+                Err(mpsc::TryRecvError::Disconnected) => Some(Err(
+                    "the reading thread stopped without an answer".to_string(),
+                )),
             };
             match outcome {
                 Some(result) => {
@@ -228,10 +228,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("bv-loader-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let good = dir.join("l.binary");
-        let lambert = bv_core::ModelSpec::new("lambert")
-            .unwrap()
-            .build()
-            .unwrap();
+        let lambert = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
         tabulate(lambert.as_ref(), MerlDims::new(4, 4, 8).unwrap())
             .unwrap()
             .write(&good)
@@ -252,7 +249,10 @@ mod tests {
         l.start(bad, LoadTarget::New);
         let done = wait_done(&mut l);
         let err = done[0].result.as_ref().unwrap_err();
-        assert!(err.contains("bad.binary") && err.contains("too short"), "{err}");
+        assert!(
+            err.contains("bad.binary") && err.contains("too short"),
+            "{err}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

@@ -83,7 +83,10 @@ pub fn error_window(ctx: &egui::Context, errors: &[LoadError]) -> bool {
             ui.add_space(4.0);
             ui.weak("Nothing was changed: the BRDFs already loaded are as they were.");
             if errors.len() > 1 {
-                ui.weak(format!("({} more files could not be opened)", errors.len() - 1));
+                ui.weak(format!(
+                    "({} more files could not be opened)",
+                    errors.len() - 1
+                ));
             }
             ui.add_space(6.0);
             if ui.button("OK").clicked() {
@@ -154,9 +157,7 @@ pub fn measured_section(
 
     // Comparison with another BRDF (e.g. the analytic model it was tabulated from).
     let choice_id = egui::Id::unique(("bv compare with", e.id));
-    let mut other: Option<u64> = ui
-        .data(|m| m.get_temp::<Option<u64>>(choice_id))
-        .flatten();
+    let mut other: Option<u64> = ui.data(|m| m.get_temp::<Option<u64>>(choice_id)).flatten();
     if other.is_some_and(|o| state.entry(o).is_none()) {
         other = None;
     }
@@ -213,14 +214,15 @@ pub fn measured_section(
                 ),
                 Err(err) => err.clone(),
             };
-            ui.label(RichText::new(text).strong()).on_hover_text(format!(
-                "At θi = {:.1}°, φi = {:.1}°, on the channel mean of {}; {COMPARE_RINGS} \
+            ui.label(RichText::new(text).strong())
+                .on_hover_text(format!(
+                    "At θi = {:.1}°, φi = {:.1}°, on the channel mean of {}; {COMPARE_RINGS} \
                  Gauss–Legendre rings × {} azimuths",
-                d.key.incident.0,
-                d.key.incident.1,
-                crate::views::value_label(d.key.cosine),
-                2 * COMPARE_RINGS
-            ));
+                    d.key.incident.0,
+                    d.key.incident.1,
+                    crate::views::value_label(d.key.cosine),
+                    2 * COMPARE_RINGS
+                ));
         }
         None => {
             ui.weak("relative L2 difference: computing…");

@@ -112,11 +112,9 @@ impl Viewer {
                     ));
                     let value = bv_core::ParamValue::Text(text);
                     let cmd = match done.target {
-                        LoadTarget::Into { brdf, param } => Command::SetParam {
-                            brdf,
-                            param,
-                            value,
-                        },
+                        LoadTarget::Into { brdf, param } => {
+                            Command::SetParam { brdf, param, value }
+                        }
                         LoadTarget::New => {
                             let mut spec = match bv_core::ModelSpec::new("merl") {
                                 Ok(s) => s,

@@ -88,9 +88,8 @@ where
         let mut g = self.lock();
         g.clock += 1;
         let now = g.clock;
-        g.slots.retain(|_, s| {
-            s.running.is_some() || now.saturating_sub(s.last_use) < FORGET_AFTER
-        });
+        g.slots
+            .retain(|_, s| s.running.is_some() || now.saturating_sub(s.last_use) < FORGET_AFTER);
         let s = g.slots.entry(slot).or_insert_with(|| Slot {
             running: None,
             waiting: None,
@@ -154,7 +153,13 @@ where
         }
     }
 
-    fn spawn(self: &Arc<Self>, slot: u64, key: K, job: Job<V>, notify: Arc<dyn Fn() + Send + Sync>) {
+    fn spawn(
+        self: &Arc<Self>,
+        slot: u64,
+        key: K,
+        job: Job<V>,
+        notify: Arc<dyn Fn() + Send + Sync>,
+    ) {
         let me = self.clone();
         let run = move || {
             let t0 = Instant::now();

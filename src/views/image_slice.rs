@@ -86,7 +86,12 @@ impl SliceData {
 
     /// The luminance below which a fraction `q` of the valid pixels lie.
     pub fn luminance_quantile(&self, q: f64) -> f64 {
-        let mut v: Vec<f64> = self.values.iter().flatten().map(|v| luminance(*v)).collect();
+        let mut v: Vec<f64> = self
+            .values
+            .iter()
+            .flatten()
+            .map(|v| luminance(*v))
+            .collect();
         if v.is_empty() {
             return 0.0;
         }
@@ -160,7 +165,12 @@ pub fn compute(brdf: &dyn Brdf, phi_d: f64, sqrt_axis: bool, n: usize) -> SliceD
 }
 
 /// The colour of one pixel under the display settings.
-pub fn display_color(v: Option<[f32; 3]>, s: &SliceSettings, hatch: (Color32, Color32), odd: bool) -> Color32 {
+pub fn display_color(
+    v: Option<[f32; 3]>,
+    s: &SliceSettings,
+    hatch: (Color32, Color32),
+    odd: bool,
+) -> Color32 {
     let Some(c) = v else {
         return if odd { hatch.0 } else { hatch.1 };
     };
@@ -187,7 +197,10 @@ pub fn to_image(d: &SliceData, s: &SliceSettings, dark: bool) -> ColorImage {
     let hatch = if dark {
         (Color32::from_rgb(38, 44, 58), Color32::from_rgb(52, 60, 78))
     } else {
-        (Color32::from_rgb(200, 206, 220), Color32::from_rgb(222, 227, 238))
+        (
+            Color32::from_rgb(200, 206, 220),
+            Color32::from_rgb(222, 227, 238),
+        )
     };
     let mut pixels = Vec::with_capacity(d.width * d.height);
     for row in 0..d.height {
@@ -456,7 +469,12 @@ impl View for ImageSliceView {
                 Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
                 Color32::WHITE,
             );
-            painter.rect_stroke(*rect, 0.0, Stroke::new(1.0, grid), egui::StrokeKind::Outside);
+            painter.rect_stroke(
+                *rect,
+                0.0,
+                Stroke::new(1.0, grid),
+                egui::StrokeKind::Outside,
+            );
             painter.text(
                 rect.left_top() - Vec2::new(0.0, 3.0),
                 Align2::LEFT_BOTTOM,
@@ -502,7 +520,11 @@ impl View for ImageSliceView {
             painter.text(
                 Pos2::new(rect.center().x, rect.max.y + 19.0),
                 Align2::CENTER_TOP,
-                if s.sqrt_theta_h { "θh (√ axis)" } else { "θh" },
+                if s.sqrt_theta_h {
+                    "θh (√ axis)"
+                } else {
+                    "θh"
+                },
                 small.clone(),
                 weak,
             );
@@ -538,7 +560,13 @@ impl View for ImageSliceView {
                 theta_d_deg: td.to_degrees(),
                 values: shown
                     .iter()
-                    .map(|b| (b.label.clone(), b.color, value_at(b.brdf.as_ref(), th, td, pd)))
+                    .map(|b| {
+                        (
+                            b.label.clone(),
+                            b.color,
+                            value_at(b.brdf.as_ref(), th, td, pd),
+                        )
+                    })
                     .collect(),
             });
         }
@@ -573,11 +601,13 @@ impl View for ImageSliceView {
                     ui.weak("f in 1/sr");
                 }
                 None => {
-                    ui.weak(format!(
-                        "hover an image to read f · hatched: a direction below the horizon · \
-                         φh = 0 · {:.0} ms per slice",
-                        secs * 1e3
-                    ));
+                    ui.weak("hover to read f · hatched: below the horizon · φh = 0")
+                        .on_hover_text(format!(
+                            "{} × {} evaluations per slice; the last took {:.0} ms",
+                            self.cache.values().next().map_or(0, |c| c.data.width),
+                            self.cache.values().next().map_or(0, |c| c.data.height),
+                            secs * 1e3
+                        ));
                 }
             }
         });

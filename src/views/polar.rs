@@ -127,11 +127,7 @@ impl View for PolarView {
                     [rad * s.x.sin(), rad * s.x.cos()]
                 })
                 .collect();
-            Some((
-                format!("{} SH L = {}", b.label, r.lobe.order),
-                b.color,
-                pts,
-            ))
+            Some((format!("{} SH L = {}", b.label, r.lobe.order), b.color, pts))
         });
         self.sh_curve = sh.as_ref().map(|s| s.2.clone());
         let rmax = curves

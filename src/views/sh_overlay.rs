@@ -269,10 +269,7 @@ mod tests {
 
     #[test]
     fn lambert_projects_with_a_small_error_and_the_mesh_follows() {
-        let b = bv_core::ModelSpec::new("lambert")
-            .unwrap()
-            .build()
-            .unwrap();
+        let b = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
         let key = ShKey {
             revision: 1,
             incident: (30.0, 0.0),
