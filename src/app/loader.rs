@@ -200,14 +200,6 @@ pub fn progress_text(read: u64, total: u64) -> String {
     format!("{:.1} / {:.1} MB", read as f64 / 1e6, total as f64 / 1e6)
 }
 
-/// Whether a path names a MERL table by its extension (what the file dialog
-/// lists; a dropped file of another kind is still tried and refused with the
-/// reader's message).
-pub fn is_binary(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("binary"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -260,8 +252,6 @@ mod tests {
     fn texts() {
         assert_eq!(progress_text(0, 0), "opening…");
         assert_eq!(progress_text(12_300_000, 34_992_012), "12.3 / 35.0 MB");
-        assert!(is_binary(Path::new("/x/gold.BINARY")));
-        assert!(!is_binary(Path::new("/x/gold.bin")));
         assert_eq!(file_name(Path::new("/x/gold.binary")), "gold.binary");
     }
 }

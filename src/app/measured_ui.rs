@@ -1,10 +1,11 @@
 //! The GUI of measured tables (issue 5, items 6 and 7): the "Load MERL…"
-//! file dialog, the progress of background reads, the error dialog of a
+//! button (its dialog is [`super::files`]), the progress of background reads, the error dialog of a
 //! refused file, and the panel section of a `merl` BRDF (its table, the
 //! reader's warnings, and the relative L2 difference to another loaded BRDF,
 //! e.g. the analytic model a table was tabulated from).
 
 use super::command::Command;
+use super::files::Filter;
 use super::loader::{self, LoadError, Loader};
 use super::runtime::Runtime;
 use super::state::{AppState, BrdfEntry};
@@ -12,33 +13,13 @@ use crate::views::background::{self, Done};
 use crate::views::sh_overlay::percent;
 use bv_core::Brdf;
 use eframe::egui::{self, RichText, Role, Ui, WidgetInfo};
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// The file dialog for `.binary` tables, starting in `dir` (egui_file; the
-/// app's `files.rs` wrapper replaces this once it exists).
-pub fn open_dialog(dir: Option<PathBuf>) -> egui_file::FileDialog {
-    let mut d = egui_file::FileDialog::open_file()
-        .title("Load a MERL table (.binary)")
-        .show_files_filter(Box::new(loader::is_binary))
-        .show_new_folder(false)
-        .show_rename(false)
-        .default_size([560.0, 420.0]);
-    if let Some(dir) = dir {
-        d = d.initial_path(dir);
-    }
-    d.open();
-    d
-}
-
-/// Shows the dialog; returns the chosen file once, and whether it is still open.
-pub fn poll_dialog(d: &mut egui_file::FileDialog, ctx: &egui::Context) -> (Option<PathBuf>, bool) {
-    d.show(ctx);
-    if d.selected() {
-        return (d.path().map(Path::to_path_buf), false);
-    }
-    (None, d.visible())
-}
+/// What the "Load MERL…" dialog lists.
+pub const MERL_FILES: Filter = Filter {
+    name: "MERL table (.binary)",
+    extensions: &["binary"],
+};
 
 /// Progress bars of the reads in flight (nothing when idle).
 pub fn progress_ui(ui: &mut Ui, loader: &Loader) {

@@ -9,11 +9,14 @@
 //!   window once it has drawn and exits.
 
 pub mod command;
+pub mod files;
 pub mod loader;
 pub mod measured_ui;
 pub mod panel;
 pub mod params_ui;
 pub mod runtime;
+pub mod scene;
+pub mod screenshot;
 pub mod state;
 pub mod viewer;
 
@@ -21,7 +24,6 @@ pub use command::Command;
 pub use state::AppState;
 pub use viewer::Viewer;
 
-use crate::views::lobe_gpu;
 use anyhow::{Context as _, bail};
 use bv_core::{ParamKind, ParamValue};
 use eframe::egui;
@@ -67,6 +69,11 @@ pub struct ViewerArgs {
     /// the background with a progress bar (repeat for several).
     #[arg(long = "open", value_name = "FILE")]
     pub open: Vec<PathBuf>,
+
+    /// Open this scene file (TOML, see `bv scene --help`) instead of the saved
+    /// session.
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
 }
 
 /// Parses `WIDTHxHEIGHT`.
@@ -90,7 +97,13 @@ pub fn parse_size(text: &str) -> anyhow::Result<[f32; 2]> {
 
 /// The state the window starts with.
 fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppState> {
-    let mut state = if args.fresh {
+    let mut state = if let Some(path) = &args.scene {
+        let loaded = scene::load(path).with_context(|| format!("opening {}", path.display()))?;
+        for w in &loaded.warnings {
+            eprintln!("bv: {}: {w}", path.display());
+        }
+        loaded.state
+    } else if args.fresh {
         AppState::first_run()
     } else {
         saved
@@ -137,6 +150,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
     for m in &args.models {
         bv_core::find(m)?;
     }
+    if let Some(path) = &args.scene {
+        // Refuse a bad scene before a window opens.
+        scene::load(path).with_context(|| format!("opening {}", path.display()))?;
+    }
     let size = match &args.size {
         Some(s) => parse_size(s)?,
         None => [1280.0, 800.0],
@@ -173,7 +190,15 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         options,
         Box::new(move |cc| {
             if let Some(rs) = &cc.wgpu_render_state {
-                lobe_gpu::install(rs);
+                let mut renderer = rs.renderer.write();
+                crate::views::install_gpu(
+                    &mut renderer.callback_resources,
+                    &rs.device,
+                    Some(&rs.adapter),
+                    rs.target_format,
+                );
+                drop(renderer);
+                crate::views::install_context(&cc.egui_ctx, rs);
             }
             let saved = if load_saved {
                 cc.storage.and_then(|s| s.get_string(STORAGE_KEY))
@@ -196,6 +221,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                     into: None,
                 });
             }
+            if let Some(rs) = &cc.wgpu_render_state {
+                viewer.export.set_gpu(rs.clone());
+            }
+            viewer.export.scene_path = args2.scene.clone();
             let mut app = BvApp {
                 viewer,
                 persist,

@@ -6,13 +6,17 @@
 //! shortcuts, then apply the commands.
 
 use super::command::Command;
+use super::files::Files;
 use super::loader::{self, LoadError, LoadTarget, Loader};
 use super::measured_ui;
 use super::panel;
 use super::runtime::Runtime;
+use super::scene;
+use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::state::{AppState, Theme};
 use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
 use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
+use std::path::Path;
 
 /// Keyboard shortcuts, as shown in the help overlay.
 pub const SHORTCUTS: &[(&str, &str)] = &[
@@ -27,9 +31,15 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
         "M",
         "maximise the view under the pointer (again to restore)",
     ),
-    ("1, 2, 3", "maximise view 1, 2, 3 (again to restore)"),
+    ("1 … 9", "maximise view 1 … 9 (again to restore)"),
     ("Esc", "restore the layout"),
     ("T", "switch between dark and light themes"),
+    ("Ctrl+O", "open a scene file"),
+    ("Ctrl+S", "save the scene (to the file it came from)"),
+    (
+        "Ctrl+Shift+S",
+        "export a figure: a view or the window as PNG / SVG / OBJ",
+    ),
     ("Ctrl+Q", "quit (the session is saved)"),
 ];
 
@@ -56,9 +66,11 @@ pub struct Viewer {
     loader: Loader,
     load_errors: Vec<LoadError>,
     last_load: Option<String>,
-    dialog: Option<egui_file::FileDialog>,
+    files: Files<()>,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
+    /// Scene files, figure export and toasts.
+    pub export: ExportUi,
 }
 
 impl Viewer {
@@ -75,8 +87,84 @@ impl Viewer {
             loader: Loader::default(),
             load_errors: Vec::new(),
             last_load: None,
-            dialog: None,
+            files: Files::default(),
             force_interacting: false,
+            export: ExportUi::default(),
+        }
+    }
+
+    /// Replaces the whole state (a scene was opened).
+    pub fn replace_state(&mut self, state: AppState) {
+        self.state = state.sanitised();
+        self.pending.clear();
+    }
+
+    /// Opens a scene file; returns its warnings. On error the state is
+    /// unchanged.
+    pub fn open_scene(&mut self, path: &Path) -> Result<Vec<String>, scene::SceneError> {
+        let loaded = scene::load(path)?;
+        // Keep the theme the user chose for the window.
+        let theme = self.state.theme;
+        self.replace_state(AppState {
+            theme,
+            ..loaded.state
+        });
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(loaded.warnings)
+    }
+
+    /// Saves the state as a scene file (atomically).
+    pub fn save_scene(&mut self, path: &Path) -> Result<(), scene::SceneError> {
+        scene::save(path, &self.state)?;
+        self.export.scene_path = Some(path.to_path_buf());
+        Ok(())
+    }
+
+    fn handle(&mut self, r: Request, ctx: &egui::Context) {
+        match r {
+            Request::OpenScene(path) => match self.open_scene(&path) {
+                Ok(w) => {
+                    let line = screenshot::warnings_line(&path, &w);
+                    if !w.is_empty() {
+                        self.status = Some(line.clone());
+                    }
+                    self.export.toast(line, false);
+                }
+                Err(e) => {
+                    let msg = format!("Could not open {}: {e}", path.display());
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::SaveScene(path) => match self.save_scene(&path) {
+                Ok(()) => self
+                    .export
+                    .toast(format!("Saved the scene to {}", path.display()), false),
+                Err(e) => {
+                    let msg = format!("Could not save the scene: {e}");
+                    self.status = Some(msg.clone());
+                    self.export.toast(msg, true);
+                }
+            },
+            Request::Figure(settings, path) => {
+                let geometry = ScreenGeometry {
+                    window: ctx.content_rect().size(),
+                    pixels_per_point: ctx.pixels_per_point(),
+                };
+                let view_size = match &settings.target {
+                    screenshot::Target::View(id) => view_rect(ctx, id).map(|r| r.size()),
+                    screenshot::Target::Window => None,
+                };
+                match self
+                    .export
+                    .export_figure(&self.state, &settings, &path, geometry, view_size)
+                {
+                    Ok(line) => self.export.toast(line, false),
+                    Err(e) => self
+                        .export
+                        .toast(format!("Could not export the figure: {e:#}"), true),
+                }
+            }
         }
     }
 
@@ -93,7 +181,7 @@ impl Viewer {
 
     /// Whether the file dialog is open.
     pub fn dialog_open(&self) -> bool {
-        self.dialog.is_some()
+        self.files.is_open()
     }
 
     /// Applies the reads that have finished: a valid table becomes a BRDF (or
@@ -198,16 +286,9 @@ impl Viewer {
             if let Some((path, target)) = r.open {
                 self.loader.start(path.into(), target);
             }
-            if r.open_dialog && self.dialog.is_none() {
-                let dir = self
-                    .state
-                    .brdfs
-                    .iter()
-                    .rev()
-                    .filter_map(|b| b.spec.params.text("path").ok())
-                    .find(|p| !p.is_empty())
-                    .and_then(|p| std::path::Path::new(p).parent().map(|d| d.to_path_buf()));
-                self.dialog = Some(measured_ui::open_dialog(dir));
+            if r.open_dialog && !self.files.is_open() {
+                self.files
+                    .open((), "Load a MERL table (.binary)", measured_ui::MERL_FILES);
             }
         }
     }
@@ -244,21 +325,18 @@ impl Viewer {
         self.shortcuts(&ctx, &mut out);
         dropped_files(&ctx, &self.state, &self.runtime, &mut out);
         self.help_window(&ctx);
-        if let Some(d) = &mut self.dialog {
-            let (chosen, open) = measured_ui::poll_dialog(d, &ctx);
-            if let Some(path) = chosen {
-                out.push(Command::OpenFile {
-                    path: path.display().to_string(),
-                    into: None,
-                });
-            }
-            if !open {
-                self.dialog = None;
-            }
+        if let Some(((), path)) = self.files.show(&ctx) {
+            out.push(Command::OpenFile {
+                path: path.display().to_string(),
+                into: None,
+            });
         }
         if measured_ui::error_window(&ctx, &self.load_errors) {
             self.load_errors.remove(0);
             ctx.request_repaint();
+        }
+        for r in self.export.ui(&ctx) {
+            self.handle(r, &ctx);
         }
         if !out.is_empty() {
             // Repaint only for real changes, so a widget that re-sends the same
@@ -277,6 +355,28 @@ impl Viewer {
             ui.horizontal(|ui| {
                 ui.label(RichText::new("bv").strong().size(16.0));
                 ui.weak("BRDF viewer");
+                ui.separator();
+                if ui
+                    .button("Open…")
+                    .on_hover_text("Open a scene file (Ctrl+O)")
+                    .clicked()
+                {
+                    self.export.ask_open_scene();
+                }
+                if ui
+                    .button("Save…")
+                    .on_hover_text("Save the scene as a TOML file (Ctrl+S)")
+                    .clicked()
+                {
+                    self.export.ask_save_scene();
+                }
+                if ui
+                    .button("Export…")
+                    .on_hover_text("A view or the window as PNG, SVG or OBJ (Ctrl+Shift+S)")
+                    .clicked()
+                {
+                    self.export.dialog_open = true;
+                }
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
                         .button("? help")
@@ -348,6 +448,20 @@ impl Viewer {
         if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
+        // Shift+S first: `consume_key` with COMMAND alone would also match it.
+        if ctx
+            .input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S))
+        {
+            self.export.dialog_open = !self.export.dialog_open;
+        } else if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::S)) {
+            match self.export.scene_path.clone() {
+                Some(p) => self.handle(Request::SaveScene(p), ctx),
+                None => self.export.ask_save_scene(),
+            }
+        }
+        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::O)) {
+            self.export.ask_open_scene();
+        }
         if ctx.egui_wants_keyboard_input() {
             return;
         }
@@ -366,6 +480,12 @@ impl Viewer {
                 Key::Num1,
                 Key::Num2,
                 Key::Num3,
+                Key::Num4,
+                Key::Num5,
+                Key::Num6,
+                Key::Num7,
+                Key::Num8,
+                Key::Num9,
                 Key::Escape,
                 Key::T,
             ];
@@ -401,12 +521,27 @@ impl Viewer {
                         out.push(Command::ToggleMaximise(id.to_string()));
                     }
                 }
-                Key::Num1 | Key::Num2 | Key::Num3 => {
-                    let i = match k {
-                        Key::Num1 => 0,
-                        Key::Num2 => 1,
-                        _ => 2,
-                    };
+                Key::Num1
+                | Key::Num2
+                | Key::Num3
+                | Key::Num4
+                | Key::Num5
+                | Key::Num6
+                | Key::Num7
+                | Key::Num8
+                | Key::Num9 => {
+                    let keys = [
+                        Key::Num1,
+                        Key::Num2,
+                        Key::Num3,
+                        Key::Num4,
+                        Key::Num5,
+                        Key::Num6,
+                        Key::Num7,
+                        Key::Num8,
+                        Key::Num9,
+                    ];
+                    let i = keys.iter().position(|x| *x == k).unwrap_or(0);
                     if let Some(e) = REGISTRY.get(i) {
                         out.push(Command::ToggleMaximise(e.id.to_string()));
                     }
@@ -464,6 +599,17 @@ impl Viewer {
             self.help = false;
         }
     }
+}
+
+/// Where view `id` was drawn in the last frame.
+pub fn view_rect(ctx: &egui::Context, id: &str) -> Option<Rect> {
+    ctx.memory(|m| {
+        m.data
+            .get_temp::<Vec<(String, Rect)>>(egui::Id::unique("bv view rects"))
+    })?
+    .into_iter()
+    .find(|(v, _)| v == id)
+    .map(|(_, r)| r)
 }
 
 /// Lays out the views in the central area.
@@ -549,6 +695,8 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
         brdfs,
         incident: state.incident,
         interacting,
+        figure: false,
+        transparent: false,
     }
 }
 

@@ -6,7 +6,10 @@
 //! - [`eval`]: JSON Lines queries on stdin, one answer per line on stdout;
 //! - [`models`]: the model catalogue with every parameter's range and default;
 //! - [`check`]: the properties of SPEC §3 for one parameter set;
-//! - [`bench`]: batch evaluation speed.
+//! - [`bench`]: batch evaluation speed;
+//! - [`render`]: figures without a window (PNG, SVG, OBJ/PLY);
+//! - [`slice`]: the plotted curves as numbers (CSV);
+//! - [`scene`]: check, print and create scene files.
 //!
 //! Errors are reported as `bv: <message>` on stderr with a non-zero exit
 //! status; nothing a user types makes the program panic.
@@ -18,6 +21,9 @@ pub mod info;
 pub mod models;
 pub mod output;
 pub mod params;
+pub mod render;
+pub mod scene;
+pub mod slice;
 pub mod tabulate;
 
 use clap::{Parser, Subcommand};
@@ -62,6 +68,12 @@ pub enum Command {
     Tabulate(tabulate::TabulateArgs),
     /// Describe a MERL .binary file: dimensions, ranges, ρhd, reciprocity.
     Info(info::InfoArgs),
+    /// Draw a view to PNG (SVG for 2D plots, OBJ/PLY for the lobe) without a window.
+    Render(render::RenderArgs),
+    /// Print a BRDF slice (the numbers behind the 2D plots), e.g. as CSV.
+    Slice(slice::SliceArgs),
+    /// Check, print or create scene files.
+    Scene(scene::SceneArgs),
 }
 
 /// Entry point of the binary.
@@ -75,6 +87,12 @@ pub fn main() -> ExitCode {
         Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Tabulate(a)) => tabulate::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Render(a)) => render::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Slice(a)) => slice::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Scene(a)) => {
+            let argv: Vec<String> = std::env::args().collect();
+            scene::run(a, &argv).map(|()| ExitCode::SUCCESS)
+        }
     };
     match result {
         Ok(code) => code,

@@ -3,6 +3,7 @@
 //! (Rusinkiewicz angles with φh = 0 and φd = 90°). Every drawn BRDF in its
 //! colour, a legend, a log toggle and the exact values under the pointer.
 
+use super::chart::{self, Chart, Marker, Palette, Series};
 use super::curves::{self, HalfDiffAxis};
 use super::polar::{Readout, readout_ui};
 use super::{Scene, View};
@@ -79,40 +80,14 @@ impl View for CartesianView {
             scene.incident.theta_deg.to_radians(),
             scene.incident.phi_deg.to_radians(),
         );
-        let eval = |b: &super::SceneBrdf| -> Vec<curves::Sample> {
-            match p.axis {
-                CartesianAxis::ThetaO => {
-                    let n = if b.brdf.transmits() {
-                        2 * SAMPLES
-                    } else {
-                        SAMPLES
-                    };
-                    curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
-                }
-                CartesianAxis::ThetaH => curves::half_diff_slice(
-                    b.brdf.as_ref(),
-                    HalfDiffAxis::ThetaH,
-                    p.fixed_theta_d_deg.to_radians(),
-                    SAMPLES / 2,
-                    d.cosine,
-                ),
-                CartesianAxis::ThetaD => curves::half_diff_slice(
-                    b.brdf.as_ref(),
-                    HalfDiffAxis::ThetaD,
-                    p.fixed_theta_h_deg.to_radians(),
-                    SAMPLES / 2,
-                    d.cosine,
-                ),
-            }
-        };
-        let data: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
-            scene.brdfs.iter().map(|b| (b, eval(b))).collect();
-        let vmax = data
-            .iter()
-            .flat_map(|(_, s)| s.iter())
-            .map(|s| s.value)
-            .fold(0.0, f64::max);
-        let floor = curves::log_floor(vmax);
+        let Data {
+            curves: data,
+            floor,
+            bottom,
+            top,
+            x_label,
+            y_label,
+        } = Data::compute(scene);
         let log = d.log;
         let y_of = move |v: f64| {
             if log {
@@ -125,24 +100,8 @@ impl View for CartesianView {
         let axis = p.axis;
         let x_name = axis_name(axis);
 
-        let readout_h = 22.0;
+        let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
-        let x_label = match axis {
-            CartesianAxis::ThetaO => "θo (°), negative on the light's side".to_string(),
-            CartesianAxis::ThetaH => format!("θh (°), θd = {:.1}°, φd = 90°", p.fixed_theta_d_deg),
-            CartesianAxis::ThetaD => format!("θd (°), θh = {:.1}°, φd = 90°", p.fixed_theta_h_deg),
-        };
-        let y_label = if log {
-            format!("{value_name} (1/sr, log scale)")
-        } else {
-            format!("{value_name} (1/sr)")
-        };
-        // Headroom above the largest value for the legend and markers.
-        let (bottom, top) = if log {
-            (floor.log10(), y_of(vmax.max(1e-30)) + 0.4)
-        } else {
-            (0.0, vmax.max(1e-6) * 1.3)
-        };
         let mut plot = Plot::new(super::view_id("cartesian"))
             .width(size.x.max(50.0))
             .height(size.y.max(50.0))
@@ -324,10 +283,180 @@ impl View for CartesianView {
                 });
             }
         }
-        readout_ui(ui, self.readout.as_ref(), d.cosine);
+        if !scene.figure {
+            readout_ui(ui, self.readout.as_ref(), d.cosine);
+        }
     }
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
+        Some(chart(scene, dark).to_svg(size, Palette::new(dark, scene.transparent)))
+    }
+}
+
+/// The curves of one frame and the axes they need (shared by the plot and
+/// its SVG).
+struct Data<'s> {
+    curves: Vec<(&'s super::SceneBrdf, Vec<curves::Sample>)>,
+    floor: f64,
+    bottom: f64,
+    top: f64,
+    x_label: String,
+    y_label: String,
+}
+
+impl<'s> Data<'s> {
+    fn compute(scene: &'s Scene<'_>) -> Self {
+        let d = scene.state.display;
+        let p = scene.state.plots;
+        let (theta_i, phi_i) = (
+            scene.incident.theta_deg.to_radians(),
+            scene.incident.phi_deg.to_radians(),
+        );
+        let eval = |b: &super::SceneBrdf| -> Vec<curves::Sample> {
+            match p.axis {
+                CartesianAxis::ThetaO => {
+                    let n = if b.brdf.transmits() {
+                        2 * SAMPLES
+                    } else {
+                        SAMPLES
+                    };
+                    curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+                }
+                CartesianAxis::ThetaH => curves::half_diff_slice(
+                    b.brdf.as_ref(),
+                    HalfDiffAxis::ThetaH,
+                    p.fixed_theta_d_deg.to_radians(),
+                    SAMPLES / 2,
+                    d.cosine,
+                ),
+                CartesianAxis::ThetaD => curves::half_diff_slice(
+                    b.brdf.as_ref(),
+                    HalfDiffAxis::ThetaD,
+                    p.fixed_theta_h_deg.to_radians(),
+                    SAMPLES / 2,
+                    d.cosine,
+                ),
+            }
+        };
+        let curves: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
+            scene.brdfs.iter().map(|b| (b, eval(b))).collect();
+        let vmax = curves
+            .iter()
+            .flat_map(|(_, s)| s.iter())
+            .map(|s| s.value)
+            .fold(0.0, f64::max);
+        let floor = curves::log_floor(vmax);
+        let value_name = super::value_label(d.cosine);
+        let x_label = match p.axis {
+            CartesianAxis::ThetaO => "θo (°), negative on the light's side".to_string(),
+            CartesianAxis::ThetaH => format!("θh (°), θd = {:.1}°, φd = 90°", p.fixed_theta_d_deg),
+            CartesianAxis::ThetaD => format!("θd (°), θh = {:.1}°, φd = 90°", p.fixed_theta_h_deg),
+        };
+        let y_label = if d.log {
+            format!("{value_name} (1/sr, log scale)")
+        } else {
+            format!("{value_name} (1/sr)")
+        };
+        // Headroom above the largest value for the legend and markers.
+        let (bottom, top) = if d.log {
+            (
+                floor.log10(),
+                curves::log_ordinate(vmax.max(1e-30), floor) + 0.4,
+            )
+        } else {
+            (0.0, vmax.max(1e-6) * 1.3)
+        };
+        Self {
+            curves,
+            floor,
+            bottom,
+            top,
+            x_label,
+            y_label,
+        }
+    }
+}
+
+/// The plot as a [`Chart`] (for SVG export).
+pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
+    let data = Data::compute(scene);
+    let d = scene.state.display;
+    let p = scene.state.plots;
+    let theta_i = scene.incident.theta_deg.to_radians();
+    let phi_i = scene.incident.phi_deg.to_radians();
+    let y_of = |v: f64| {
+        if d.log {
+            curves::log_ordinate(v, data.floor)
+        } else {
+            v
+        }
+    };
+    let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
+    let x_range = match p.axis {
+        CartesianAxis::ThetaO if transmits => (-180.0, 180.0),
+        CartesianAxis::ThetaO => (-90.0, 90.0),
+        _ => (0.0, 90.0),
+    };
+    let y_ticks = if d.log {
+        let (a, b) = (data.bottom.ceil() as i32, data.top.floor() as i32);
+        (a..=b)
+            .map(|k| (f64::from(k), super::decade_label(k)))
+            .collect()
+    } else {
+        chart::labelled(chart::nice_ticks(data.bottom, data.top, 8))
+    };
+    let mut c = Chart {
+        x_label: data.x_label.clone(),
+        y_label: data.y_label.clone(),
+        x_range,
+        y_range: (data.bottom, data.top),
+        x_ticks: chart::angle_ticks(x_range.0, x_range.1),
+        y_ticks,
+        ..Default::default()
+    };
+    if p.axis == CartesianAxis::ThetaO {
+        c.vlines.push(Marker {
+            at: curves::incident_signed_angle(theta_i).to_degrees(),
+            color: super::light_color(dark),
+            dashed: false,
+            label: "ωi".into(),
+        });
+        c.vlines.push(Marker {
+            at: theta_i.to_degrees(),
+            color: super::mirror_color(dark),
+            dashed: true,
+            label: "ωr".into(),
+        });
+        for (b, _) in &data.curves {
+            for dl in b.brdf.deltas(scene.wi()) {
+                let along = -(dl.direction.x * phi_i.cos() + dl.direction.y * phi_i.sin());
+                let a = along.atan2(dl.direction.z).to_degrees();
+                c.vlines.push(Marker {
+                    at: a,
+                    color: b.color,
+                    dashed: true,
+                    label: format!("δ {:.3}", bv_core::mean_rgb(dl.weight)),
+                });
+            }
+        }
+    }
+    let mut order: Vec<&(&super::SceneBrdf, Vec<curves::Sample>)> = data.curves.iter().collect();
+    order.sort_by_key(|(b, _)| b.selected);
+    for (b, samples) in order {
+        c.series.push(Series {
+            label: b.label.clone(),
+            color: b.color,
+            points: samples
+                .iter()
+                .map(|s| [s.x.to_degrees(), y_of(s.value)])
+                .collect(),
+            width: if b.selected { 2.5 } else { 1.8 },
+            dash: None,
+        });
+    }
+    c
 }

@@ -440,7 +440,7 @@ impl View for ImageSliceView {
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
-        let readout_h = 22.0;
+        let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let area = ui.available_rect_before_wrap();
         let area = Rect::from_min_max(area.min, area.max - Vec2::new(0.0, readout_h));
         if area.width() < 40.0 || area.height() < 40.0 {
@@ -482,12 +482,21 @@ impl View for ImageSliceView {
                 FontId::proportional(12.5),
                 b.color,
             );
-            // Axes: θh along the bottom, θd up the left side, every 15°.
+            // Axes: θh along the bottom, θd up the left side, ticks every
+            // 15°, labels as dense as the tile allows.
+            let label_step = if rect.width() >= 320.0 {
+                15
+            } else if rect.width() >= 150.0 {
+                30
+            } else {
+                90
+            };
             for deg in (0..=90).step_by(15) {
                 let t = f64::from(deg).to_radians();
                 let x = rect.min.x + u_of_theta_h(t, s.sqrt_theta_h) as f32 * rect.width();
                 let y = rect.max.y - (f64::from(deg) / 90.0) as f32 * rect.height();
                 let major = deg % 30 == 0;
+                let labelled = deg % label_step == 0;
                 let len = if major { 5.0 } else { 3.0 };
                 painter.line_segment(
                     [Pos2::new(x, rect.max.y), Pos2::new(x, rect.max.y + len)],
@@ -497,8 +506,7 @@ impl View for ImageSliceView {
                     [Pos2::new(rect.min.x - len, y), Pos2::new(rect.min.x, y)],
                     Stroke::new(1.0, text),
                 );
-                // On the √ axis the first ticks crowd: label 0, 15 and every 30.
-                if major || !s.sqrt_theta_h || deg == 15 {
+                if labelled {
                     painter.text(
                         Pos2::new(x, rect.max.y + 6.0),
                         Align2::CENTER_TOP,
@@ -507,7 +515,7 @@ impl View for ImageSliceView {
                         text,
                     );
                 }
-                if major {
+                if labelled {
                     painter.text(
                         Pos2::new(rect.min.x - 7.0, y),
                         Align2::RIGHT_CENTER,
@@ -548,6 +556,9 @@ impl View for ImageSliceView {
 
         // Exact values under the pointer.
         self.readout = None;
+        if scene.figure {
+            return;
+        }
         if let Some(p) = response.hover_pos()
             && let Some((_, r)) = self.image_rects.iter().find(|(_, r)| r.contains(p))
         {

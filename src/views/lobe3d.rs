@@ -576,7 +576,10 @@ impl View for Lobe3dView {
         let response = ui.allocate_rect(rect, Sense::click_and_drag());
         self.view_rect = Some(rect);
         let dark = ui.visuals().dark_mode;
-        let bg = background(dark);
+        let mut bg = background(dark);
+        if scene.transparent {
+            bg = [0.0; 4];
+        }
         self.set_sh(sh_overlay::request(ui.ctx(), scene));
         let frame = self.frame(scene, rect.size(), bg, dark);
         ui.painter().add(
@@ -789,20 +792,24 @@ impl Lobe3dView {
             )
         };
         let weak = ui.visuals().weak_text_color();
+        // Figures have no pointer: the scale line takes the hint's place.
+        let lift = if scene.figure { -6.0 } else { -24.0 };
         painter.text(
-            rect.left_bottom() + Vec2::new(8.0, -24.0),
+            rect.left_bottom() + Vec2::new(8.0, lift),
             Align2::LEFT_BOTTOM,
             scale_text,
             small.clone(),
             text,
         );
-        painter.text(
-            rect.left_bottom() + Vec2::new(8.0, -6.0),
-            Align2::LEFT_BOTTOM,
-            "drag: orbit · scroll: zoom · shift+drag: move light · double-click: reset",
-            small.clone(),
-            weak,
-        );
+        if !scene.figure {
+            painter.text(
+                rect.left_bottom() + Vec2::new(8.0, -6.0),
+                Align2::LEFT_BOTTOM,
+                "drag: orbit · scroll: zoom · shift+drag: move light · double-click: reset",
+                small.clone(),
+                weak,
+            );
+        }
         if scene.brdfs.is_empty() {
             painter.text(
                 rect.center(),

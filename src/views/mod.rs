@@ -1,14 +1,19 @@
 //! The viewer's views: the 3D polar lobe, the polar plot of the plane of
-//! incidence and the Cartesian plot. Each is a struct with its own `ui()`; they
-//! read one [`Scene`] per frame and ask for changes by pushing
-//! [`Command`]s. A view is added by writing its module and one line in
-//! [`REGISTRY`].
+//! incidence, the Cartesian plot, the directional albedo, the Fresnel
+//! curves and the image slice in half/difference angles. Each is a struct with its own `ui()`; they read one [`Scene`] per
+//! frame and ask for changes by pushing [`Command`]s. A view is added by
+//! writing its module and one line in [`REGISTRY`]; the window, screenshots
+//! and `bv render` all go through the registry. A view with its own wgpu
+//! pipeline also adds one line to [`install_gpu`].
 
+pub mod albedo;
 pub mod background;
 pub mod camera;
 pub mod cartesian;
+pub mod chart;
 pub mod colormap;
 pub mod curves;
+pub mod fresnel;
 pub mod image_slice;
 pub mod lobe3d;
 pub mod lobe_gpu;
@@ -60,6 +65,13 @@ pub struct Scene<'a> {
     /// A pointer button is held somewhere (a slider or the light is being
     /// dragged): views may trade resolution for speed.
     pub interacting: bool,
+    /// Drawn as a figure (screenshot, `bv render`): no hover hints or
+    /// readouts, and slow results (albedo curves) computed before drawing
+    /// rather than in the background.
+    pub figure: bool,
+    /// Figure with a transparent background: views leave their own
+    /// backgrounds unfilled.
+    pub transparent: bool,
 }
 
 impl Scene<'_> {
@@ -88,6 +100,13 @@ pub trait View: Any {
 
     /// For tests and drivers that need the concrete view.
     fn as_any(&self) -> &dyn Any;
+
+    /// The view as an SVG document of `size` points (2D plots only; `None`
+    /// for views that have no vector form). Same data, colours and labels as
+    /// [`View::ui`] draws.
+    fn svg(&mut self, _scene: &Scene<'_>, _size: [f32; 2], _dark: bool) -> Option<String> {
+        None
+    }
 }
 
 /// A registered view.
@@ -119,15 +138,52 @@ pub const REGISTRY: &[ViewEntry] = &[
         make: || Box::new(cartesian::CartesianView::default()),
     },
     ViewEntry {
+        id: "albedo",
+        title: "Directional albedo ρhd(θi)",
+        make: || Box::new(albedo::AlbedoView::default()),
+    },
+    ViewEntry {
+        id: "fresnel",
+        title: "Fresnel reflectance",
+        make: || Box::new(fresnel::FresnelView::default()),
+    },
+    ViewEntry {
         id: "slice",
         title: "Image slice (θh × θd)",
         make: || Box::new(image_slice::ImageSliceView::default()),
     },
 ];
 
+/// Other names a view answers to on the command line (`bv render --view
+/// lobe3d`).
+pub const ALIASES: &[(&str, &str)] = &[("lobe3d", "lobe"), ("3d", "lobe")];
+
 /// The registry entry with id `id`.
 pub fn entry(id: &str) -> Option<&'static ViewEntry> {
     REGISTRY.iter().find(|v| v.id == id)
+}
+
+/// The registry entry with id or alias `name` (case-insensitive).
+pub fn find_view(name: &str) -> Option<&'static ViewEntry> {
+    let name = name.trim().to_ascii_lowercase();
+    let id = ALIASES
+        .iter()
+        .find(|(a, _)| *a == name)
+        .map_or(name.as_str(), |(_, id)| id);
+    entry(id)
+}
+
+/// Installs the GPU resources of every view with its own pipeline into a
+/// renderer's paint-callback resources (eframe's window, an offscreen
+/// renderer, a test harness). `target_format` is the format of the pass the
+/// views paint into.
+pub fn install_gpu(
+    resources: &mut eframe::egui_wgpu::CallbackResources,
+    device: &eframe::wgpu::Device,
+    adapter: Option<&eframe::wgpu::Adapter>,
+    target_format: eframe::wgpu::TextureFormat,
+) {
+    lobe_gpu::install_into(resources, device, adapter, target_format);
 }
 
 /// The label of the value the views show.
@@ -147,6 +203,15 @@ pub fn srgb_f32(c: Color32) -> [f32; 3] {
 /// A text colour that reads on the current background.
 pub fn strong_text(ui: &Ui) -> Color32 {
     ui.visuals().strong_text_color()
+}
+
+/// The strong text colour of a theme, where no `Ui` is at hand (SVG).
+pub fn strong_text_color(dark: bool) -> Color32 {
+    if dark {
+        Color32::from_gray(230)
+    } else {
+        Color32::from_gray(20)
+    }
 }
 
 /// Marker colour of the light (ωi) in every view.
@@ -195,6 +260,20 @@ pub fn decade_label(k: i32) -> String {
     }
 }
 
+/// Gives the views of an egui context what they fetch from it (views that
+/// find egui's render state through the context install it here), for
+/// eframe's window and for offscreen figures alike.
+pub fn install_context(_ctx: &egui::Context, _render_state: &eframe::egui_wgpu::RenderState) {}
+
+/// The background a figure view fills: the panel's colour, or nothing.
+pub fn figure_fill(ui: &Ui, scene: &Scene<'_>) -> Color32 {
+    if scene.transparent {
+        Color32::TRANSPARENT
+    } else {
+        ui.visuals().panel_fill
+    }
+}
+
 /// Shared by plots: the toggles for log and cosine.
 pub fn display_toggles(ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
     let d = scene.state.display;
@@ -222,6 +301,8 @@ mod tests {
         ids.dedup();
         assert_eq!(ids.len(), REGISTRY.len());
         assert!(entry("lobe").is_some());
+        assert_eq!(find_view("LOBE3D").map(|e| e.id), Some("lobe"));
+        assert!(find_view("nope").is_none());
     }
 
     #[test]

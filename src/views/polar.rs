@@ -94,27 +94,7 @@ impl View for PolarView {
             scene.incident.phi_deg.to_radians(),
         );
         let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
-
-        // Curves and the largest radius.
-        let curves: Vec<(String, Color32, bool, Vec<[f64; 2]>)> = scene
-            .brdfs
-            .iter()
-            .map(|b| {
-                let n = if b.brdf.transmits() {
-                    2 * SAMPLES
-                } else {
-                    SAMPLES
-                };
-                let pts = curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
-                    .iter()
-                    .map(|s| {
-                        let r = radius(s.value, d.log);
-                        [r * s.x.sin(), r * s.x.cos()]
-                    })
-                    .collect();
-                (b.label.clone(), b.color, b.selected, pts)
-            })
-            .collect();
+        let (curves, outer) = polar_curves(scene);
         // The SH reconstruction of the selected lobe, dashed (issue 5, item 6).
         let sh = sh_overlay::request(ui.ctx(), scene).and_then(|done| {
             let r = done.value.as_ref().ok()?;
@@ -130,18 +110,12 @@ impl View for PolarView {
             Some((format!("{} SH L = {}", b.label, r.lobe.order), b.color, pts))
         });
         self.sh_curve = sh.as_ref().map(|s| s.2.clone());
-        let rmax = curves
-            .iter()
-            .flat_map(|c| c.3.iter())
-            .map(|p| p[0].hypot(p[1]))
-            .fold(0.0, f64::max);
-        let outer = curves::nice_ceil(if rmax > 0.0 { rmax } else { radius(1.0, d.log) });
 
         let grid = super::grid_color(dark);
         let text_col = super::strong_text(ui);
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);
-        let readout_h = 22.0;
+        let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         let value_name = super::value_label(d.cosine);
         let log = d.log;
@@ -175,16 +149,8 @@ impl View for PolarView {
         let brdfs = &scene.brdfs;
         let response = plot.show(ui, |pui| {
             // Rings with the value they stand for, and spokes every 15°.
-            for k in 1..=4 {
-                // On the log scale the rings stand at round values of f.
-                let r = if log {
-                    radius(
-                        curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2),
-                        log,
-                    )
-                } else {
-                    outer * k as f64 / 4.0
-                };
+            // On the log scale the rings stand at round values of f.
+            for (r, _) in rings(outer, log) {
                 let n = 4 * span as usize;
                 let pts: Vec<[f64; 2]> = (0..=n)
                     .map(|j| {
@@ -360,12 +326,230 @@ impl View for PolarView {
                 });
             }
         }
-        readout_ui(ui, self.readout.as_ref(), d.cosine);
+        if !scene.figure {
+            readout_ui(ui, self.readout.as_ref(), d.cosine);
+        }
     }
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
+
+    fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
+        Some(polar_svg(scene, size, dark))
+    }
+}
+
+/// One curve of the polar plot: label, colour, selected, points (x, y) in
+/// plot coordinates (radius along the outgoing direction).
+type PolarCurve = (String, Color32, bool, Vec<[f64; 2]>);
+
+/// The curves and the outer ring's radius.
+fn polar_curves(scene: &Scene<'_>) -> (Vec<PolarCurve>, f64) {
+    let d = scene.state.display;
+    let (theta_i, phi_i) = (
+        scene.incident.theta_deg.to_radians(),
+        scene.incident.phi_deg.to_radians(),
+    );
+    let curves: Vec<PolarCurve> = scene
+        .brdfs
+        .iter()
+        .map(|b| {
+            let n = if b.brdf.transmits() {
+                2 * SAMPLES
+            } else {
+                SAMPLES
+            };
+            let pts = curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+                .iter()
+                .map(|s| {
+                    let r = radius(s.value, d.log);
+                    [r * s.x.sin(), r * s.x.cos()]
+                })
+                .collect();
+            (b.label.clone(), b.color, b.selected, pts)
+        })
+        .collect();
+    let rmax = curves
+        .iter()
+        .flat_map(|c| c.3.iter())
+        .map(|p| p[0].hypot(p[1]))
+        .fold(0.0, f64::max);
+    let outer = curves::nice_ceil(if rmax > 0.0 { rmax } else { radius(1.0, d.log) });
+    (curves, outer)
+}
+
+/// The ring radii (plot units) and the values they stand for.
+fn rings(outer: f64, log: bool) -> Vec<(f64, f64)> {
+    (1..=4)
+        .map(|k| {
+            let r = if log {
+                radius(
+                    curves::round_significant(value_at(outer * k as f64 / 4.0, log), 2),
+                    log,
+                )
+            } else {
+                outer * k as f64 / 4.0
+            };
+            (r, value_at(r, log))
+        })
+        .collect()
+}
+
+/// The polar plot as SVG: the same rings, spokes, markers and curves.
+pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
+    use super::chart::{Palette, Series, legend};
+    use crate::export::svg::{Anchor, Baseline, Svg};
+    let d = scene.state.display;
+    let pal = Palette::new(dark, scene.transparent);
+    let (curves, outer) = polar_curves(scene);
+    let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
+    let theta_i = scene.incident.theta_deg.to_radians();
+    let phi_i = scene.incident.phi_deg.to_radians();
+    let [w, h] = [size[0].max(120.0), size[1].max(90.0)];
+    let mut svg = Svg::new(w, h);
+    if let Some(bg) = pal.background {
+        svg.rect([0.0, 0.0], [w, h], Some(bg), None);
+    }
+    // Data extents (plot units) and a uniform scale that fits them.
+    let (x0, x1) = (-1.3 * outer, 1.3 * outer);
+    let (y0, y1) = if transmits {
+        (-1.3 * outer, 1.3 * outer)
+    } else {
+        (-0.15 * outer, 1.3 * outer)
+    };
+    let k = ((w - 20.0) as f64 / (x1 - x0)).min((h - 20.0) as f64 / (y1 - y0));
+    let cx = w as f64 * 0.5 - (x0 + x1) * 0.5 * k;
+    let cy = h as f64 * 0.5 + (y0 + y1) * 0.5 * k;
+    let at = |p: [f64; 2]| [(cx + p[0] * k) as f32, (cy - p[1] * k) as f32];
+    let text_col = pal.text.gamma_multiply(0.8);
+    let span: i32 = if transmits { 180 } else { 90 };
+    for (r, v) in rings(outer, d.log) {
+        let n = 4 * span as usize;
+        let pts: Vec<[f32; 2]> = (0..=n)
+            .map(|j| {
+                let a = (-(span as f64) + 2.0 * span as f64 * j as f64 / n as f64).to_radians();
+                at([r * a.sin(), r * a.cos()])
+            })
+            .collect();
+        svg.polyline(&pts, pal.grid, 1.0, None);
+        svg.text(
+            at([r, -outer * 0.015]),
+            &curves::fmt_tick(v),
+            10.5,
+            text_col,
+            Anchor::Middle,
+            Baseline::Top,
+            None,
+        );
+    }
+    for deg in (-span..=span).step_by(15) {
+        let a = f64::from(deg).to_radians();
+        svg.line(
+            at([0.0, 0.0]),
+            at([outer * a.sin(), outer * a.cos()]),
+            pal.grid,
+            1.0,
+            None,
+        );
+        if deg % 30 == 0 {
+            let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
+            svg.text(
+                at([outer * 1.09 * a.sin(), outer * 1.09 * a.cos() + lift]),
+                &format!("{}°", deg.abs()),
+                10.5,
+                text_col,
+                Anchor::Middle,
+                Baseline::Middle,
+                None,
+            );
+        }
+    }
+    svg.line(
+        at([-outer * 1.15, 0.0]),
+        at([outer * 1.15, 0.0]),
+        pal.text.gamma_multiply(0.7),
+        1.5,
+        None,
+    );
+    let light = super::light_color(dark);
+    let mirror = super::mirror_color(dark);
+    let li = curves::incident_signed_angle(theta_i);
+    let lp = [outer * 1.2 * li.sin(), outer * 1.2 * li.cos()];
+    svg.line(at(lp), at([0.0, 0.0]), light, 2.5, None);
+    svg.text(
+        at([lp[0] * 1.06, lp[1] * 1.06 + outer * 0.04]),
+        "ωi",
+        14.0,
+        light,
+        Anchor::Middle,
+        Baseline::Middle,
+        None,
+    );
+    let mp = [outer * 1.12 * theta_i.sin(), outer * 1.12 * theta_i.cos()];
+    svg.line(at([0.0, 0.0]), at(mp), mirror, 1.5, Some(6.0));
+    svg.text(
+        at([mp[0] * 1.08, mp[1] * 1.08]),
+        "ωr",
+        14.0,
+        mirror,
+        Anchor::Middle,
+        Baseline::Middle,
+        None,
+    );
+    let mut order: Vec<&PolarCurve> = curves.iter().collect();
+    order.sort_by_key(|c| c.2);
+    let mut series = Vec::new();
+    for (label, color, selected, pts) in order {
+        let width = if *selected { 2.5 } else { 1.8 };
+        let p: Vec<[f32; 2]> = pts.iter().map(|p| at(*p)).collect();
+        svg.polyline(&p, *color, width, None);
+        series.push(Series {
+            label: label.clone(),
+            color: *color,
+            points: Vec::new(),
+            width,
+            dash: None,
+        });
+    }
+    for b in &scene.brdfs {
+        for dl in b.brdf.deltas(scene.wi()) {
+            let dir = dl.direction;
+            let plane_n = glam::DVec3::new(-phi_i.sin(), phi_i.cos(), 0.0);
+            if dir.dot(plane_n).abs() > 1e-6 {
+                continue;
+            }
+            let along = -(dir.x * phi_i.cos() + dir.y * phi_i.sin());
+            let a = along.atan2(dir.z);
+            let wgt = bv_core::mean_rgb(dl.weight);
+            let tip = [outer * wgt * a.sin(), outer * wgt * a.cos()];
+            svg.line(at([0.0, 0.0]), at(tip), b.color, 2.0, None);
+            svg.text(
+                at([tip[0] * 1.05, tip[1] * 1.05]),
+                &format!("δ {wgt:.3}"),
+                10.5,
+                b.color,
+                Anchor::Middle,
+                Baseline::Middle,
+                None,
+            );
+        }
+    }
+    svg.text(
+        [10.0, h - 8.0],
+        &format!(
+            "radius: {} (1/sr){}",
+            super::value_label(d.cosine),
+            if d.log { ", ln(1 + value)" } else { "" }
+        ),
+        11.0,
+        pal.weak,
+        Anchor::Start,
+        Baseline::Bottom,
+        None,
+    );
+    legend(&mut svg, &series, [w - 4.0, 4.0], pal);
+    svg.finish()
 }
 
 #[cfg(test)]

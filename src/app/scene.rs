@@ -1,0 +1,453 @@
+//! Scene files (issue 6): the viewer's [`AppState`] as TOML, for slides,
+//! papers and `bv render --scene`.
+//!
+//! A scene file is the same serialisable state eframe persists between runs
+//! (one type, [`AppState`]), written as TOML with two header keys:
+//!
+//! ```toml
+//! format = "bv-scene"
+//! generator = "bv 0.1.0"
+//! version = 1
+//! …
+//! [incident]
+//! theta_deg = 45.0
+//! …
+//! [[brdfs]]
+//! id = 1
+//! color = [78, 151, 234]
+//! visible = true
+//! [brdfs.spec]
+//! model = "cook-torrance"
+//! [brdfs.spec.params]
+//! alpha_x = 0.2
+//! …
+//! # end of bv scene
+//! ```
+//!
+//! Loading is strict where the persisted session is lenient: a value of the
+//! wrong type, an out-of-range angle, a BRDF whose model is unknown or whose
+//! parameters do not validate (the core's one declaration checks them, through
+//! `ModelSpec::from_json`) is an error naming the key and the reason; an unknown
+//! key is a warning (the rest still loads). A file that bv wrote carries
+//! `generator` and ends with [`END_MARKER`]; if the marker is missing the file
+//! was cut short, and loading it is refused rather than silently filling the
+//! lost tail with defaults. Saving writes a temporary file beside the target,
+//! syncs it and renames it over the target, so a crash or a full disk leaves
+//! the old scene intact.
+
+use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
+use serde::Deserialize;
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The value of the `format` key.
+pub const FORMAT: &str = "bv-scene";
+
+/// The last line of every scene bv writes; its absence in a file that names
+/// bv as its `generator` means the file was truncated.
+pub const END_MARKER: &str = "# end of bv scene";
+
+/// The usual file extension (without the dot).
+pub const EXTENSION: &str = "toml";
+
+/// Why a scene could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// The text is not valid TOML, or a value has the wrong type.
+    #[error("not a valid scene file: {0}")]
+    Syntax(String),
+    /// A key has a value bv refuses.
+    #[error("bad value for `{key}`: {reason}")]
+    BadValue {
+        /// Dotted path of the key (`incident.theta_deg`, `brdfs[2].spec`).
+        key: String,
+        /// Why it is refused.
+        reason: String,
+    },
+    /// The file was cut short.
+    #[error(
+        "the file is truncated: it names bv as its generator but does not end with the line \
+         `{END_MARKER}` that bv writes last (was the save interrupted, or the file copied \
+         incompletely?)"
+    )]
+    Truncated,
+    /// The file comes from a newer bv.
+    #[error(
+        "scene format version {found} is newer than this bv reads (up to {STATE_VERSION}); \
+         update bv"
+    )]
+    TooNew {
+        /// The version in the file.
+        found: i64,
+    },
+}
+
+/// A loaded scene and what was odd about it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loaded {
+    /// The state (sanitised, ready for the viewer).
+    pub state: AppState,
+    /// Keys that were ignored and other non-fatal remarks, one line each.
+    pub warnings: Vec<String>,
+}
+
+/// The scene as TOML text (what [`save`] writes).
+pub fn to_toml(state: &AppState) -> Result<String, SceneError> {
+    let mut state = state.clone();
+    state.version = STATE_VERSION;
+    let body = toml::to_string(&state).map_err(|e| SceneError::Syntax(e.to_string()))?;
+    let mut out = String::new();
+    out.push_str(
+        "# bv scene: BRDFs (model, parameters, colour, visibility), light, camera,\n\
+         # display options and layout. Open with `bv --scene FILE`, render with\n\
+         # `bv render --scene FILE --view …`, check with `bv scene check FILE`.\n",
+    );
+    let _ = writeln!(out, "format = \"{FORMAT}\"");
+    let _ = writeln!(out, "generator = \"bv {}\"", env!("CARGO_PKG_VERSION"));
+    out.push_str(&body);
+    if !out.ends_with('\n') {
+        out.push('\n');
+    }
+    out.push('\n');
+    out.push_str(END_MARKER);
+    out.push('\n');
+    Ok(out)
+}
+
+/// The header keys, read before the state itself.
+#[derive(Debug, Default, Deserialize)]
+struct Header {
+    format: Option<toml::Value>,
+    generator: Option<toml::Value>,
+    version: Option<toml::Value>,
+}
+
+/// Parses scene text (strictly; see the module docs).
+pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
+    let text = text.trim_start_matches('\u{feff}');
+    let mut warnings = Vec::new();
+    let table: toml::Table =
+        toml::from_str(text).map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
+    let header: Header = toml::Table::try_into(table.clone())
+        .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
+
+    match &header.format {
+        Some(toml::Value::String(f)) if f == FORMAT => {}
+        Some(other) => {
+            return Err(SceneError::BadValue {
+                key: "format".into(),
+                reason: format!("expected \"{FORMAT}\", found {other} (not a bv scene file)"),
+            });
+        }
+        None => warnings.push(format!(
+            "no `format = \"{FORMAT}\"` line; reading the file as a bv scene anyway"
+        )),
+    }
+    match &header.version {
+        Some(toml::Value::Integer(v)) if *v > i64::from(STATE_VERSION) => {
+            return Err(SceneError::TooNew { found: *v });
+        }
+        Some(toml::Value::Integer(v)) if *v >= 1 => {}
+        Some(other) => {
+            return Err(SceneError::BadValue {
+                key: "version".into(),
+                reason: format!("expected a format version 1..={STATE_VERSION}, found {other}"),
+            });
+        }
+        // Required, so that a file cut short before bv's header is refused
+        // rather than read as an empty scene.
+        None => {
+            return Err(SceneError::BadValue {
+                key: "version".into(),
+                reason: format!(
+                    "missing: a scene file starts with `format = \"{FORMAT}\"` and \
+                     `version = {STATE_VERSION}` (an empty or truncated file?)"
+                ),
+            });
+        }
+    }
+    if header.generator.is_some() && !ends_with_marker(text) {
+        return Err(SceneError::Truncated);
+    }
+
+    // BRDF entries one by one, so that an error names the entry (the
+    // persisted session drops bad entries instead; a scene refuses them).
+    if let Some(items) = table.get("brdfs") {
+        let Some(items) = items.as_array() else {
+            return Err(SceneError::BadValue {
+                key: "brdfs".into(),
+                reason: "expected an array of tables ([[brdfs]])".into(),
+            });
+        };
+        let mut ids = std::collections::HashSet::new();
+        for (i, item) in items.iter().enumerate() {
+            let key = format!("brdfs[{i}]");
+            let json = serde_json::to_value(item).map_err(|e| SceneError::BadValue {
+                key: key.clone(),
+                reason: e.to_string(),
+            })?;
+            let mut unknown = Vec::new();
+            let entry: BrdfEntry = serde_ignored::deserialize(json.clone(), |p| {
+                unknown.push(p.to_string());
+            })
+            .map_err(|e: serde_json::Error| {
+                let model = json
+                    .get("spec")
+                    .and_then(|s| s.get("model"))
+                    .and_then(|m| m.as_str())
+                    .map(|m| format!(" (model `{m}`)"))
+                    .unwrap_or_default();
+                SceneError::BadValue {
+                    key: format!("{key}{model}"),
+                    reason: e.to_string(),
+                }
+            })?;
+            for u in unknown {
+                warnings.push(format!("unknown key `{key}.{u}` ignored"));
+            }
+            if !ids.insert(entry.id) {
+                return Err(SceneError::BadValue {
+                    key: format!("{key}.id"),
+                    reason: format!("id {} is used by an earlier BRDF", entry.id),
+                });
+            }
+        }
+    }
+
+    // The whole state, noting every key serde ignores.
+    let mut ignored = Vec::new();
+    let de = toml::Deserializer::parse(text)
+        .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
+    let state: AppState = serde_ignored::deserialize(de, |path| ignored.push(path.to_string()))
+        .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
+    for key in ignored {
+        if key == "format" || key == "generator" {
+            continue;
+        }
+        warnings.push(format!("unknown key `{key}` ignored"));
+    }
+
+    validate(&state, &mut warnings)?;
+    Ok(Loaded {
+        state: state.sanitised(),
+        warnings,
+    })
+}
+
+fn ends_with_marker(text: &str) -> bool {
+    text.lines()
+        .rev()
+        .map(str::trim)
+        .find(|l| !l.is_empty())
+        .is_some_and(|l| l == END_MARKER)
+}
+
+/// Range checks the persisted session would silently clamp, but a scene file
+/// refuses: a figure must show what the file says.
+fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> {
+    let bad = |key: &str, reason: String| {
+        Err(SceneError::BadValue {
+            key: key.to_string(),
+            reason,
+        })
+    };
+    let range = |key: &str, x: f64, lo: f64, hi: f64, unit: &str| {
+        if x.is_finite() && (lo..=hi).contains(&x) {
+            Ok(())
+        } else {
+            bad(key, format!("{x} is outside {lo}..={hi}{unit}"))
+        }
+    };
+    range(
+        "incident.theta_deg",
+        s.incident.theta_deg,
+        0.0,
+        Incident::MAX_THETA_DEG,
+        "°",
+    )?;
+    range("incident.phi_deg", s.incident.phi_deg, -360.0, 360.0, "°")?;
+    let c = s.camera;
+    if !c.yaw_deg.is_finite() {
+        return bad(
+            "camera.yaw_deg",
+            format!("{} is not a finite angle", c.yaw_deg),
+        );
+    }
+    range(
+        "camera.pitch_deg",
+        f64::from(c.pitch_deg),
+        f64::from(Camera::PITCH_RANGE.0),
+        f64::from(Camera::PITCH_RANGE.1),
+        "°",
+    )?;
+    range(
+        "camera.distance",
+        f64::from(c.distance),
+        f64::from(Camera::DISTANCE_RANGE.0),
+        f64::from(Camera::DISTANCE_RANGE.1),
+        "",
+    )?;
+    if !(c.fixed_scale.is_finite() && c.fixed_scale > 0.0) {
+        return bad(
+            "camera.fixed_scale",
+            format!("{} is not a positive number", c.fixed_scale),
+        );
+    }
+    range(
+        "plots.fixed_theta_d_deg",
+        s.plots.fixed_theta_d_deg,
+        0.0,
+        89.5,
+        "°",
+    )?;
+    range(
+        "plots.fixed_theta_h_deg",
+        s.plots.fixed_theta_h_deg,
+        0.0,
+        89.5,
+        "°",
+    )?;
+    if let Some(v) = &s.maximised
+        && crate::views::entry(v).is_none()
+    {
+        warnings.push(format!(
+            "`maximised = \"{v}\"`: no such view in this bv (views: {}); showing all views",
+            crate::views::REGISTRY
+                .iter()
+                .map(|e| e.id)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    for (key, id) in [("selected", s.selected), ("solo", s.solo)] {
+        if let Some(id) = id
+            && s.entry(id).is_none()
+        {
+            warnings.push(format!("`{key} = {id}`: no BRDF has that id; ignored"));
+        }
+    }
+    Ok(())
+}
+
+/// Reads a scene file.
+pub fn load(path: &Path) -> Result<Loaded, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        SceneError::Syntax(format!(
+            "the file is not UTF-8 text (invalid byte at offset {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    from_toml(&text)
+}
+
+/// Writes a scene file atomically (see [`write_atomic`]).
+pub fn save(path: &Path, state: &AppState) -> Result<(), SceneError> {
+    let text = to_toml(state)?;
+    write_atomic(path, |f| f.write_all(text.as_bytes()))
+}
+
+/// Writes `path` through a temporary file in the same directory, synced and
+/// then renamed over `path` (rename is atomic within a file system), so that
+/// readers see either the old file or the whole new one. If `write` fails,
+/// the temporary file is removed and `path` is untouched.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+) -> Result<(), SceneError> {
+    let io = |source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "scene".to_string());
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        write(&mut f)?;
+        f.sync_all()?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(io(e));
+    }
+    // Make the rename itself durable where the platform allows.
+    if let Ok(d) = std::fs::File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bv_core::ModelSpec;
+
+    fn sample() -> AppState {
+        let mut s = AppState::default();
+        s.add(
+            ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.2, 0.4, 0.6]}))
+                .unwrap(),
+        );
+        s.add(ModelSpec::new("cook-torrance").unwrap());
+        s.brdfs[0].visible = false;
+        s.incident = Incident {
+            theta_deg: 33.25,
+            phi_deg: -20.0,
+        };
+        s.camera.yaw_deg = 12.5;
+        s.display.log = true;
+        s.maximised = Some("polar".into());
+        s.sanitised()
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let s = sample();
+        let text = to_toml(&s).unwrap();
+        let back = from_toml(&text).unwrap();
+        assert_eq!(back.warnings, Vec::<String>::new());
+        assert_eq!(back.state, s);
+    }
+
+    #[test]
+    fn unknown_keys_warn_and_the_rest_loads() {
+        let text = to_toml(&sample())
+            .unwrap()
+            .replace("[incident]", "[incident]\nshininess = 3");
+        let back = from_toml(&text).unwrap();
+        assert_eq!(back.warnings.len(), 1, "{:?}", back.warnings);
+        assert!(back.warnings[0].contains("incident.shininess"));
+        assert_eq!(back.state, sample());
+    }
+
+    #[test]
+    fn bad_values_name_the_key() {
+        let text = to_toml(&sample()).unwrap();
+        let e = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 120.0")).unwrap_err();
+        assert!(e.to_string().contains("incident.theta_deg"), "{e}");
+        let e = from_toml(&text.replace("albedo = [", "albedo = [7.0, ")).unwrap_err();
+        let m = e.to_string();
+        assert!(m.contains("brdfs[0]") && m.contains("albedo"), "{m}");
+    }
+}

@@ -1,0 +1,417 @@
+//! `bv render`: figures without a window (issue 6). Any view of the registry
+//! drawn offscreen by the viewer's own code (wgpu; lavapipe on a server) to
+//! PNG, the 2D plots to SVG, the lobe to OBJ/PLY; `--view all` writes one file
+//! per view into a folder, with a progress bar on stderr.
+
+use super::params::spec_from_cli;
+use crate::app::scene;
+use crate::app::state::{AppState, Incident, Theme};
+use crate::export::{self, Frame, Offscreen};
+use crate::views::{ALIASES, REGISTRY, ViewEntry};
+use anyhow::{Context as _, Result, bail};
+use eframe::egui::Vec2;
+use std::io::{IsTerminal, Write as _};
+use std::path::{Path, PathBuf};
+
+/// Options of `bv render`.
+#[derive(Debug, Clone, clap::Args)]
+#[command(
+    long_about = "Draw a view to a file without opening a window: the viewer's own \
+    drawing code, rendered offscreen with wgpu (on a machine without a GPU, Mesa's lavapipe: \
+    apt install mesa-vulkan-drivers libvulkan1).\n\n\
+    The output's extension picks the format: .png (any view), .svg (2D plots: polar, \
+    cartesian, albedo, fresnel), .obj or .ply (the lobe's mesh, for Blender). With --view all, \
+    --out is a folder and gets one <view>.png per view (and <view>.svg for the 2D plots with \
+    --svg).\n\n\
+    Example (every figure of a lecture, one shell loop):\n  \
+    for m in lambert phong ward cook-torrance; do\n    \
+    bv render --model $m --view all --theta-i 45 --out figs/$m --svg\n  \
+    done"
+)]
+pub struct RenderArgs {
+    /// Scene file to draw (TOML: BRDFs, light, camera, display options).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+
+    /// Draw this model (replaces the scene's BRDFs; default: the scene's, or
+    /// the first model of the catalogue).
+    #[arg(short, long, value_name = "ID")]
+    pub model: Option<String>,
+
+    /// A parameter of --model, repeatable: `--param alpha=0.3`, a colour as
+    /// `--param kd=0.2,0.5,0.8`.
+    #[arg(short, long = "param", value_name = "NAME=VALUE")]
+    pub params: Vec<String>,
+
+    /// The view: lobe3d (or lobe), polar, cartesian, albedo, fresnel, any other
+    /// view of this build (the error for an unknown one lists them), `all`, or
+    /// `window` (the whole viewer window, panels included).
+    #[arg(long, value_name = "VIEW")]
+    pub view: String,
+
+    /// Polar angle of the light, degrees (0..89.5).
+    #[arg(long = "theta-i", value_name = "DEG", allow_negative_numbers = true)]
+    pub theta_i: Option<f64>,
+
+    /// Azimuth of the light, degrees.
+    #[arg(long = "phi-i", value_name = "DEG", allow_negative_numbers = true)]
+    pub phi_i: Option<f64>,
+
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 1600)]
+    pub width: u32,
+
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 1200)]
+    pub height: u32,
+
+    /// Pixels per point: the size of text and lines (default: width / 800,
+    /// between 1 and 4, so a 1600-pixel figure reads like the 800-point view
+    /// on a 2× screen).
+    #[arg(long, value_name = "S")]
+    pub scale: Option<f32>,
+
+    /// Transparent background (PNG and SVG).
+    #[arg(long)]
+    pub transparent: bool,
+
+    /// Light theme (dark text on white: slides, print).
+    #[arg(long, conflicts_with = "dark")]
+    pub light: bool,
+
+    /// Dark theme.
+    #[arg(long)]
+    pub dark: bool,
+
+    /// Logarithmic scale.
+    #[arg(long)]
+    pub log: bool,
+
+    /// Show f · cos θo.
+    #[arg(long)]
+    pub cosine: bool,
+
+    /// With --view all: also write SVG for the 2D plots.
+    #[arg(long)]
+    pub svg: bool,
+
+    /// Output file (or folder with --view all).
+    #[arg(short, long, value_name = "PATH")]
+    pub out: PathBuf,
+}
+
+/// The list of view names for messages.
+pub fn view_names() -> String {
+    let mut names: Vec<String> = REGISTRY
+        .iter()
+        .map(|e| {
+            let aliases: Vec<&str> = ALIASES
+                .iter()
+                .filter(|(_, id)| *id == e.id)
+                .map(|(a, _)| *a)
+                .collect();
+            if aliases.is_empty() {
+                e.id.to_string()
+            } else {
+                format!("{} (or {})", e.id, aliases.join(", "))
+            }
+        })
+        .collect();
+    names.push("all".into());
+    names.push("window".into());
+    names.join(", ")
+}
+
+/// The views `name` stands for.
+pub fn views_for(name: &str) -> Result<Vec<&'static ViewEntry>> {
+    if name.trim().eq_ignore_ascii_case("all") {
+        return Ok(REGISTRY.iter().collect());
+    }
+    match crate::views::find_view(name) {
+        Some(e) => Ok(vec![e]),
+        None => bail!(
+            "--view {name}: no such view in this build; available: {}",
+            view_names()
+        ),
+    }
+}
+
+/// The state to draw: the scene (or defaults), with the command line's
+/// changes on top.
+pub fn state_for(a: &RenderArgs) -> Result<AppState> {
+    let mut state = match &a.scene {
+        Some(p) => {
+            let loaded = scene::load(p).with_context(|| format!("--scene {}", p.display()))?;
+            for w in &loaded.warnings {
+                eprintln!("bv render: {}: {w}", p.display());
+            }
+            loaded.state
+        }
+        None if a.model.is_none() => AppState::first_run(),
+        None => AppState::default(),
+    };
+    if let Some(m) = &a.model {
+        let spec = spec_from_cli(m, &a.params)?;
+        state.brdfs.clear();
+        state.solo = None;
+        state.add(spec);
+    } else if !a.params.is_empty() {
+        bail!("--param needs --model");
+    }
+    let mut inc = state.incident;
+    if let Some(t) = a.theta_i {
+        if !(t.is_finite() && (0.0..=Incident::MAX_THETA_DEG).contains(&t)) {
+            bail!(
+                "--theta-i {t}: out of range 0..={}°",
+                Incident::MAX_THETA_DEG
+            );
+        }
+        inc.theta_deg = t;
+    }
+    if let Some(p) = a.phi_i {
+        if !p.is_finite() {
+            bail!("--phi-i {p}: not a finite angle");
+        }
+        inc.phi_deg = p;
+    }
+    state.incident = inc.clamped();
+    if a.light {
+        state.theme = Theme::Light;
+    }
+    if a.dark {
+        state.theme = Theme::Dark;
+    }
+    state.display.log |= a.log;
+    state.display.cosine |= a.cosine;
+    state.maximised = None;
+    Ok(state.sanitised())
+}
+
+/// The output kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Png,
+    Svg,
+    Obj,
+    Ply,
+}
+
+fn kind_of(path: &Path) -> Result<Kind> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    Ok(match ext.as_deref() {
+        Some("png") => Kind::Png,
+        Some("svg") => Kind::Svg,
+        Some("obj") => Kind::Obj,
+        Some("ply") => Kind::Ply,
+        _ => bail!(
+            "--out {}: the extension picks the format: .png, .svg (2D plots), .obj or .ply (lobe mesh)",
+            path.display()
+        ),
+    })
+}
+
+/// A progress bar on stderr (a line per step when stderr is not a terminal).
+struct Progress {
+    total: usize,
+    tty: bool,
+}
+
+impl Progress {
+    fn step(&self, done: usize, what: &str) {
+        let mut err = std::io::stderr().lock();
+        if self.tty {
+            let width = 24;
+            let filled = width * done / self.total.max(1);
+            let _ = write!(
+                err,
+                "\r\x1b[2Kbv render [{}{}] {done}/{} {what}",
+                "#".repeat(filled),
+                ".".repeat(width - filled),
+                self.total
+            );
+            if done == self.total {
+                let _ = writeln!(err);
+            }
+        } else {
+            let _ = writeln!(err, "bv render: [{done}/{}] {what}", self.total);
+        }
+        let _ = err.flush();
+    }
+}
+
+/// Runs `bv render`.
+pub fn run(a: &RenderArgs) -> Result<()> {
+    let window = a.view.trim().eq_ignore_ascii_case("window");
+    let views = if window {
+        Vec::new()
+    } else {
+        views_for(&a.view)?
+    };
+    let all = !window && (views.len() > 1 || a.view.trim().eq_ignore_ascii_case("all"));
+    if a.width == 0
+        || a.height == 0
+        || a.width > export::offscreen::MAX_SIDE
+        || a.height > export::offscreen::MAX_SIDE
+    {
+        bail!(
+            "--width/--height must be 1..={} pixels",
+            export::offscreen::MAX_SIDE
+        );
+    }
+    let scale = a
+        .scale
+        .unwrap_or_else(|| (a.width as f32 / 800.0).clamp(1.0, 4.0));
+    if !(scale.is_finite() && (0.25..=8.0).contains(&scale)) {
+        bail!("--scale {scale}: expected 0.25..=8");
+    }
+    let state = state_for(a)?;
+    let frame = Frame {
+        size: Vec2::new(a.width as f32 / scale, a.height as f32 / scale),
+        pixels_per_point: scale,
+        dark: export::is_dark(&state),
+        transparent: a.transparent,
+    };
+
+    if window {
+        if kind_of(&a.out)? != Kind::Png {
+            bail!("--view window: only PNG (--out FILE.png)");
+        }
+        let mut off = Offscreen::headless()?;
+        let img = export::render_window(&mut off, &state, frame)?;
+        return export::save_png(&img, &a.out);
+    }
+    if !all {
+        let e = views[0];
+        let kind = kind_of(&a.out)?;
+        return match kind {
+            Kind::Png => {
+                let mut off = Offscreen::headless()?;
+                write_png(&mut off, &state, e, frame, &a.out)
+            }
+            Kind::Svg => write_svg(&state, e, frame, &a.out),
+            Kind::Obj | Kind::Ply => {
+                if e.id != "lobe" {
+                    bail!(
+                        "--out {}: meshes come from the lobe view (--view lobe3d)",
+                        a.out.display()
+                    );
+                }
+                write_mesh(&state, kind, &a.out)
+            }
+        };
+    }
+
+    // --view all: a folder of PNGs (and SVGs).
+    if a.out.extension().is_some_and(|e| e == "png" || e == "svg") {
+        bail!(
+            "--view all writes one file per view: --out must be a folder, not {}",
+            a.out.display()
+        );
+    }
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("cannot create the folder {}", a.out.display()))?;
+    let svg_views: Vec<&ViewEntry> = if a.svg {
+        views
+            .iter()
+            .copied()
+            .filter(|e| export::view_svg(&AppState::default(), e, [200.0, 150.0], false).is_some())
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let progress = Progress {
+        total: views.len() + svg_views.len(),
+        tty: std::io::stderr().is_terminal(),
+    };
+    let mut off = Offscreen::headless()?;
+    let mut done = 0;
+    progress.step(done, "starting");
+    for e in &views {
+        let path = a.out.join(format!("{}.png", e.id));
+        write_png(&mut off, &state, e, frame, &path)?;
+        done += 1;
+        progress.step(done, &path.display().to_string());
+    }
+    for e in &svg_views {
+        let path = a.out.join(format!("{}.svg", e.id));
+        write_svg(&state, e, frame, &path)?;
+        done += 1;
+        progress.step(done, &path.display().to_string());
+    }
+    Ok(())
+}
+
+fn write_png(
+    off: &mut Offscreen,
+    state: &AppState,
+    e: &ViewEntry,
+    frame: Frame,
+    path: &Path,
+) -> Result<()> {
+    let img = export::render_view(off, state, e, frame)
+        .with_context(|| format!("drawing the {} view", e.id))?;
+    export::save_png(&img, path)
+}
+
+fn write_svg(state: &AppState, e: &ViewEntry, frame: Frame, path: &Path) -> Result<()> {
+    let size = [
+        frame.size.x - 2.0 * export::FIGURE_MARGIN,
+        frame.size.y - 2.0 * export::FIGURE_MARGIN,
+    ];
+    let Some(svg) = export::view_svg(state, e, size, frame.transparent) else {
+        bail!(
+            "the {} view has no vector form; write a .png (SVG: {})",
+            e.id,
+            REGISTRY
+                .iter()
+                .filter(
+                    |v| export::view_svg(&AppState::default(), v, [200.0, 150.0], false).is_some()
+                )
+                .map(|v| v.id)
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    };
+    export::write_file(path, svg.as_bytes())
+}
+
+fn write_mesh(state: &AppState, kind: Kind, path: &Path) -> Result<()> {
+    let meshes = export::mesh::lobe_meshes(state);
+    let Some(first) = meshes.first() else {
+        bail!("no BRDF is drawn: nothing to export");
+    };
+    let text = match kind {
+        Kind::Ply => export::mesh::to_ply(state, first),
+        _ => export::mesh::to_obj(state, &meshes),
+    };
+    export::write_file(path, text.as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_views_list_the_available_ones() {
+        let e = match views_for("lit-spheer") {
+            Ok(_) => panic!("accepted"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("lit-spheer") && e.contains("polar") && e.contains("all"),
+            "{e}"
+        );
+        assert_eq!(views_for("lobe3d").unwrap()[0].id, "lobe");
+        assert_eq!(views_for("all").unwrap().len(), REGISTRY.len());
+    }
+
+    #[test]
+    fn extensions_pick_the_format() {
+        assert_eq!(kind_of(Path::new("a.PNG")).unwrap(), Kind::Png);
+        assert_eq!(kind_of(Path::new("a.ply")).unwrap(), Kind::Ply);
+        assert!(kind_of(Path::new("a.jpg")).is_err());
+    }
+}

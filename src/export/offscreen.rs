@@ -1,0 +1,364 @@
+//! Drawing an egui UI into an image without a window: the same UI code the
+//! viewer runs, laid out by a fresh egui context, painted by egui-wgpu into an
+//! offscreen `Rgba8Unorm` texture and read back. Views with their own wgpu
+//! pipelines (the lobe) render inside it through their paint callbacks, whose
+//! resources [`crate::views::install_gpu`] puts into this renderer.
+//!
+//! Pixels per point are set on the context, so a 2× or 4× image is laid out
+//! and rasterised at that resolution (text, lines and the lobe's own target),
+//! never upscaled.
+
+use anyhow::{Context as _, Result, anyhow, bail};
+use eframe::egui::{self, Vec2};
+use eframe::egui_wgpu::{self, ScreenDescriptor};
+use eframe::wgpu;
+
+/// Colour format of the offscreen image (gamma-encoded, what egui-wgpu blends in).
+pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// Most egui passes run before painting: a layout settles in two or three, and
+/// a view that keeps asking for repaints (progressive rendering) is painted as
+/// it stands after this many.
+pub const MAX_PASSES: usize = 16;
+
+/// Largest image side accepted (wgpu's default texture limit).
+pub const MAX_SIDE: u32 = 8192;
+
+/// An egui-wgpu renderer of its own on a device (the GUI's, or one opened
+/// headless), with every view's GPU resources installed. It is held as an
+/// egui-wgpu [`egui_wgpu::RenderState`], like a window's, so that views which
+/// find the render state through their egui context (and register textures
+/// with its renderer) draw offscreen as they do in the window.
+pub struct Offscreen {
+    rs: egui_wgpu::RenderState,
+}
+
+/// How an image is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// Size in points (the layout size).
+    pub size: Vec2,
+    /// Pixels per point (1, 2, 4 … × the screen's).
+    pub pixels_per_point: f32,
+    /// Dark or light visuals.
+    pub dark: bool,
+    /// Leave the background transparent (panels and plot areas unfilled).
+    pub transparent: bool,
+}
+
+impl Frame {
+    /// The image size in pixels.
+    pub fn pixels(&self) -> [u32; 2] {
+        [
+            (self.size.x * self.pixels_per_point).round().max(1.0) as u32,
+            (self.size.y * self.pixels_per_point).round().max(1.0) as u32,
+        ]
+    }
+}
+
+impl Offscreen {
+    /// Opens a device headless: the first adapter wgpu finds, preferring a
+    /// real GPU (lavapipe on a server without one).
+    pub fn headless() -> Result<Self> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            ..Default::default()
+        }))
+        .map_err(|e| anyhow!(crate::app::no_gpu_message(&e.to_string())))?;
+        let info = adapter.get_info();
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("bv offscreen"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .with_context(|| format!("opening a device on {}", info.name))?;
+        Ok(Self::new(instance, adapter, device, queue))
+    }
+
+    /// An offscreen renderer on an existing device: it shares the device and
+    /// queue but has its own egui textures and view resources, so a window's
+    /// are left alone.
+    pub fn new(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> Self {
+        let mut renderer =
+            egui_wgpu::Renderer::new(&device, FORMAT, egui_wgpu::RendererOptions::PREDICTABLE);
+        crate::views::install_gpu(
+            &mut renderer.callback_resources,
+            &device,
+            Some(&adapter),
+            FORMAT,
+        );
+        Self {
+            rs: egui_wgpu::RenderState {
+                available_adapters: vec![adapter.clone()],
+                adapter,
+                instance,
+                device,
+                queue,
+                target_format: FORMAT,
+                renderer: std::sync::Arc::new(eframe::egui::mutex::RwLock::new(renderer)),
+            },
+        }
+    }
+
+    /// On the device of an egui-wgpu render state (eframe's window).
+    pub fn from_render_state(rs: &egui_wgpu::RenderState) -> Self {
+        Self::new(
+            rs.instance.clone(),
+            rs.adapter.clone(),
+            rs.device.clone(),
+            rs.queue.clone(),
+        )
+    }
+
+    /// The render state figures are drawn with.
+    pub fn render_state(&self) -> &egui_wgpu::RenderState {
+        &self.rs
+    }
+
+    /// One line naming the adapter.
+    pub fn describe(&self) -> String {
+        let i = self.rs.adapter.get_info();
+        format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+    }
+
+    /// Runs `ui` in a fresh egui context of `frame.size` points until it
+    /// settles (at most [`MAX_PASSES`] passes), paints the last pass and reads
+    /// it back. With `transparent`, the image is un-premultiplied so that PNG
+    /// viewers show the right colours over any background.
+    pub fn render(
+        &mut self,
+        frame: Frame,
+        mut ui: impl FnMut(&mut egui::Ui),
+    ) -> Result<image::RgbaImage> {
+        let [w, h] = frame.pixels();
+        if w > MAX_SIDE || h > MAX_SIDE {
+            bail!("image of {w}×{h} pixels is larger than {MAX_SIDE} on a side");
+        }
+        let ctx = egui::Context::default();
+        ctx.set_theme(if frame.dark {
+            egui::Theme::Dark
+        } else {
+            egui::Theme::Light
+        });
+        ctx.all_styles_mut(|style| {
+            style.animation_time = 0.0;
+            style.visuals.text_cursor.blink = false;
+            if frame.transparent {
+                let v = &mut style.visuals;
+                v.panel_fill = egui::Color32::TRANSPARENT;
+                v.window_fill = egui::Color32::TRANSPARENT;
+                v.extreme_bg_color = egui::Color32::TRANSPARENT;
+                v.faint_bg_color = egui::Color32::TRANSPARENT;
+            }
+        });
+        let mut input = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, frame.size)),
+            max_texture_side: Some(self.rs.device.limits().max_texture_dimension_2d as usize),
+            ..Default::default()
+        };
+        if let Some(v) = input.viewports.get_mut(&egui::ViewportId::ROOT) {
+            v.native_pixels_per_point = Some(frame.pixels_per_point);
+        }
+        ctx.set_pixels_per_point(frame.pixels_per_point);
+        crate::views::install_context(&ctx, &self.rs);
+
+        let mut output = None;
+        for pass in 0..MAX_PASSES {
+            let mut out = ctx.run_ui(input.clone(), |u| ui(u));
+            {
+                let mut r = self.rs.renderer.write();
+                for (id, deltas) in &out.textures_delta.set {
+                    for delta in deltas {
+                        r.update_texture(&self.rs.device, &self.rs.queue, *id, delta);
+                    }
+                }
+            }
+            let settled = out
+                .viewport_output
+                .get(&egui::ViewportId::ROOT)
+                .is_none_or(|v| v.repaint_delay > std::time::Duration::ZERO);
+            if settled || pass + 1 == MAX_PASSES {
+                output = Some(out);
+                break;
+            }
+            for id in &out.textures_delta.free {
+                self.rs.renderer.write().free_texture(id);
+            }
+            out.textures_delta.clear();
+        }
+        let mut output = output.context("egui produced no frame")?;
+        let image = self.paint(&ctx, &output, frame, [w, h]);
+        for id in &output.textures_delta.free {
+            self.rs.renderer.write().free_texture(id);
+        }
+        output.textures_delta.clear();
+        let mut image = image?;
+        if frame.transparent {
+            unpremultiply(&mut image);
+        }
+        Ok(image)
+    }
+
+    fn paint(
+        &mut self,
+        ctx: &egui::Context,
+        output: &egui::FullOutput,
+        frame: Frame,
+        [w, h]: [u32; 2],
+    ) -> Result<image::RgbaImage> {
+        let ppp = frame.pixels_per_point;
+        let screen = ScreenDescriptor {
+            size_in_pixels: [w, h],
+            pixels_per_point: ppp,
+        };
+        let jobs = ctx.tessellate(output.shapes.clone(), ppp);
+        let (device, queue) = (&self.rs.device, &self.rs.queue);
+        let mut renderer = self.rs.renderer.write();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("bv offscreen"),
+        });
+        let user = renderer.update_buffers(device, queue, &mut encoder, &jobs, &screen);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("bv offscreen target"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        {
+            let mut pass = encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("bv offscreen egui"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &view,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            store: wgpu::StoreOp::Store,
+                        },
+                        depth_slice: None,
+                    })],
+                    ..Default::default()
+                })
+                .forget_lifetime();
+            renderer.render(&mut pass, &jobs, &screen);
+        }
+        drop(renderer);
+        let unpadded = w as usize * 4;
+        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
+        let padded = unpadded.div_ceil(align) * align;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("bv offscreen readback"),
+            size: (padded * h as usize) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded as u32),
+                    rows_per_image: None,
+                },
+            },
+            wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit(user.into_iter().chain(std::iter::once(encoder.finish())));
+        let slice = buffer.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+        rx.recv()
+            .context("the GPU dropped the readback")?
+            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| anyhow!("GPU readback failed: {e:?}"))?;
+        let mut pixels = Vec::with_capacity(unpadded * h as usize);
+        for row in data.chunks_exact(padded) {
+            pixels.extend_from_slice(&row[..unpadded]);
+        }
+        drop(data);
+        buffer.unmap();
+        texture.destroy();
+        image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
+    }
+}
+
+/// egui blends with premultiplied alpha; PNG stores straight alpha.
+pub fn unpremultiply(img: &mut image::RgbaImage) {
+    for p in img.pixels_mut() {
+        let a = p.0[3];
+        if a == 0 {
+            p.0 = [0, 0, 0, 0];
+        } else if a < 255 {
+            for c in &mut p.0[..3] {
+                *c = ((u32::from(*c) * 255 + u32::from(a) / 2) / u32::from(a)).min(255) as u8;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unpremultiply_restores_straight_alpha() {
+        let mut img = image::RgbaImage::from_raw(
+            3,
+            1,
+            vec![
+                64, 32, 0, 128, //
+                10, 10, 10, 0, //
+                200, 100, 50, 255,
+            ],
+        )
+        .unwrap();
+        unpremultiply(&mut img);
+        assert_eq!(img.get_pixel(0, 0).0, [128, 64, 0, 128]);
+        assert_eq!(img.get_pixel(1, 0).0, [0, 0, 0, 0]);
+        assert_eq!(img.get_pixel(2, 0).0, [200, 100, 50, 255]);
+    }
+
+    #[test]
+    fn pixel_size_follows_the_scale() {
+        let f = Frame {
+            size: Vec2::new(400.0, 300.0),
+            pixels_per_point: 2.0,
+            dark: true,
+            transparent: false,
+        };
+        assert_eq!(f.pixels(), [800, 600]);
+    }
+}

@@ -1,0 +1,478 @@
+//! The directional albedo view: `ρhd(θi) = ∫ f cos θo dωo` (plus the weights
+//! of delta lobes) against θi for every drawn BRDF, with its Monte Carlo error
+//! band, the energy-conservation line ρ = 1 and the current θi; the legend
+//! gives each BRDF's bihemispherical albedo ρhh (SPEC §3). The numbers are
+//! `bv_core::analysis::albedo`'s, the same estimator `bv check` reports.
+//!
+//! A curve costs [`N_THETA`] × [`SAMPLES`] evaluations plus [`RHH_SAMPLES`] for
+//! ρhh, so it is computed on a background thread and cached process-wide by
+//! (model, parameters, φi): a slider drag shows the last finished curve and a
+//! progress bar, and starts no work until the pointer is released. Figures
+//! (screenshots, `bv render`) compute it before drawing.
+
+use super::chart::{self, Band, Chart, Marker, Palette, Series};
+use super::{Scene, SceneBrdf, View};
+use crate::app::command::Command;
+use bv_core::analysis::albedo::{Estimate, rho_hd, rho_hh, theta_grid};
+use bv_core::analysis::directions::stream_seed;
+use bv_core::{Brdf, mean_rgb};
+use eframe::egui::{self, Ui};
+use egui_plot::{Corner, FilledArea, HLine, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+use rayon::prelude::*;
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, LazyLock, Mutex};
+
+/// θi samples: 0°, 2°, …, 88° (90° is left out: no light arrives there).
+pub const N_THETA: usize = 45;
+/// Evaluations per θi.
+pub const SAMPLES: usize = 4096;
+/// Evaluations for ρhh.
+pub const RHH_SAMPLES: usize = 32768;
+/// Seed of the estimates (fixed: the same BRDF always gives the same curve).
+pub const SEED: u64 = 0x0062_7661_6c62;
+/// Half-width of the error band in standard errors (±3σ covers the true value
+/// with about 99 % probability for these 16-replica estimates).
+pub const BAND_SIGMAS: f64 = 3.0;
+
+/// One finished curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlbedoData {
+    /// θi in degrees.
+    pub theta_deg: Vec<f64>,
+    /// ρhd at each θi.
+    pub rho: Vec<Estimate>,
+    /// ρhh.
+    pub rho_hh: Estimate,
+}
+
+impl AlbedoData {
+    /// Computes the curve of `brdf` for light at azimuth `phi_i` (radians),
+    /// counting finished steps in `progress` ([`STEPS`] in all); `None` when
+    /// `cancel` was raised.
+    pub fn compute(
+        brdf: &dyn Brdf,
+        phi_i: f64,
+        progress: &AtomicUsize,
+        cancel: &AtomicBool,
+    ) -> Option<Self> {
+        let thetas = theta_grid(N_THETA);
+        let rho: Option<Vec<Estimate>> = thetas
+            .par_iter()
+            .enumerate()
+            .map(|(k, &t)| {
+                if cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
+                let e = rho_hd(brdf, t, phi_i, SAMPLES, stream_seed(SEED, k as u64));
+                progress.fetch_add(1, Ordering::Relaxed);
+                Some(e)
+            })
+            .collect();
+        let rho = rho?;
+        if cancel.load(Ordering::Relaxed) {
+            return None;
+        }
+        let rho_hh = rho_hh(brdf, RHH_SAMPLES, SEED);
+        progress.fetch_add(1, Ordering::Relaxed);
+        Some(Self {
+            theta_deg: thetas.iter().map(|t| t.to_degrees()).collect(),
+            rho,
+            rho_hh,
+        })
+    }
+
+    /// The plotted value (channel mean) and its band half-width at sample `k`.
+    pub fn mean_and_band(&self, k: usize) -> (f64, f64) {
+        let e = &self.rho[k];
+        (mean_rgb(e.value), BAND_SIGMAS * mean_rgb(e.std_error))
+    }
+
+    /// Whether some channel exceeds 1 by more than its error band somewhere.
+    pub fn exceeds_one(&self) -> bool {
+        self.rho
+            .iter()
+            .any(|e| (0..3).any(|c| e.value[c] - BAND_SIGMAS * e.std_error[c] > 1.0 + 1e-9))
+    }
+}
+
+/// Steps of a computation (one per θi, one for ρhh).
+pub const STEPS: usize = N_THETA + 1;
+
+/// Cache key: the spec as JSON and φi.
+type Key = (String, u64);
+
+struct Job {
+    progress: Arc<AtomicUsize>,
+    cancel: Arc<AtomicBool>,
+}
+
+#[derive(Default)]
+struct Cache {
+    done: HashMap<Key, Arc<AlbedoData>>,
+    running: HashMap<Key, Job>,
+}
+
+/// Finished curves and running jobs of the whole process (shared by the
+/// window's view and the views of offscreen figures).
+static CACHE: LazyLock<Mutex<Cache>> = LazyLock::new(Mutex::default);
+
+/// Most finished curves kept.
+const CACHE_LIMIT: usize = 64;
+
+fn key_of(scene: &Scene<'_>, b: &SceneBrdf) -> Option<Key> {
+    let e = scene.state.entry(b.id)?;
+    Some((
+        e.spec.to_json().to_string(),
+        scene.incident.phi_deg.to_bits(),
+    ))
+}
+
+fn cached(key: &Key) -> Option<Arc<AlbedoData>> {
+    CACHE.lock().ok()?.done.get(key).cloned()
+}
+
+fn store(key: Key, data: Arc<AlbedoData>) {
+    if let Ok(mut c) = CACHE.lock() {
+        if c.done.len() >= CACHE_LIMIT {
+            c.done.clear();
+        }
+        c.done.insert(key.clone(), data);
+        c.running.remove(&key);
+    }
+}
+
+/// Starts computing `key` in the background unless it is running; returns its
+/// progress counter.
+fn start(key: &Key, brdf: Arc<dyn Brdf>, phi_i: f64, ctx: &egui::Context) -> Arc<AtomicUsize> {
+    let Ok(mut c) = CACHE.lock() else {
+        return Arc::new(AtomicUsize::new(0));
+    };
+    if let Some(j) = c.running.get(key) {
+        return j.progress.clone();
+    }
+    let progress = Arc::new(AtomicUsize::new(0));
+    let cancel = Arc::new(AtomicBool::new(false));
+    c.running.insert(
+        key.clone(),
+        Job {
+            progress: progress.clone(),
+            cancel: cancel.clone(),
+        },
+    );
+    let (p, k, ctx) = (progress.clone(), key.clone(), ctx.clone());
+    let spawned = std::thread::Builder::new()
+        .name("bv albedo".into())
+        .spawn(move || {
+            match AlbedoData::compute(brdf.as_ref(), phi_i, &p, &cancel) {
+                Some(d) => store(k, Arc::new(d)),
+                None => {
+                    if let Ok(mut c) = CACHE.lock() {
+                        c.running.remove(&k);
+                    }
+                }
+            }
+            ctx.request_repaint();
+        });
+    if spawned.is_err() {
+        c.running.remove(key);
+    }
+    progress
+}
+
+/// Cancels the running jobs of `keys`.
+fn cancel(keys: &[Key]) {
+    if let Ok(c) = CACHE.lock() {
+        for k in keys {
+            if let Some(j) = c.running.get(k) {
+                j.cancel.store(true, Ordering::Relaxed);
+            }
+        }
+    }
+}
+
+/// The curve of `b`, computed now (blocking) if it is not cached.
+pub fn curve_now(scene: &Scene<'_>, b: &SceneBrdf) -> Option<Arc<AlbedoData>> {
+    let key = key_of(scene, b)?;
+    if let Some(d) = cached(&key) {
+        return Some(d);
+    }
+    let d = Arc::new(AlbedoData::compute(
+        b.brdf.as_ref(),
+        scene.incident.phi_deg.to_radians(),
+        &AtomicUsize::new(0),
+        &AtomicBool::new(false),
+    )?);
+    store(key, d.clone());
+    Some(d)
+}
+
+/// The albedo view.
+#[derive(Default)]
+pub struct AlbedoView {
+    /// Last finished curve per BRDF id (shown, marked stale, while its new
+    /// curve is computed).
+    latest: HashMap<u64, (Key, Arc<AlbedoData>)>,
+    /// The key each BRDF is being computed for.
+    wanted: HashMap<u64, Key>,
+    /// Progress of the running computations, (done, total) steps, in the last
+    /// frame (for tests and the progress bar).
+    pub progress: Option<(usize, usize)>,
+}
+
+/// One BRDF's curve in a frame.
+struct Shown {
+    brdf: SceneBrdf,
+    data: Arc<AlbedoData>,
+    stale: bool,
+}
+
+impl AlbedoView {
+    /// Brings the curves up to date and returns what to draw.
+    fn update(&mut self, scene: &Scene<'_>, ctx: Option<&egui::Context>) -> Vec<Shown> {
+        let mut shown = Vec::new();
+        let mut done = 0;
+        let mut total = 0;
+        for b in &scene.brdfs {
+            let Some(key) = key_of(scene, b) else {
+                continue;
+            };
+            if let Some(d) = cached(&key) {
+                self.latest.insert(b.id, (key.clone(), d));
+            } else if scene.figure || ctx.is_none() {
+                if let Some(d) = curve_now(scene, b) {
+                    self.latest.insert(b.id, (key.clone(), d));
+                }
+            } else if let Some(ctx) = ctx {
+                if !scene.interacting {
+                    // A new key for this BRDF: the old job is of no more use.
+                    if let Some(old) = self.wanted.get(&b.id)
+                        && *old != key
+                    {
+                        cancel(std::slice::from_ref(old));
+                    }
+                    self.wanted.insert(b.id, key.clone());
+                    let p = start(
+                        &key,
+                        b.brdf.clone(),
+                        scene.incident.phi_deg.to_radians(),
+                        ctx,
+                    );
+                    done += p.load(Ordering::Relaxed).min(STEPS);
+                    total += STEPS;
+                } else {
+                    total += STEPS;
+                }
+            }
+            if let Some((k, d)) = self.latest.get(&b.id) {
+                shown.push(Shown {
+                    brdf: b.clone(),
+                    data: d.clone(),
+                    stale: *k != key,
+                });
+            }
+        }
+        self.latest
+            .retain(|id, _| scene.brdfs.iter().any(|b| b.id == *id));
+        self.progress = (total > 0).then_some((done, total));
+        if total > 0
+            && let Some(ctx) = ctx
+        {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+        shown
+    }
+}
+
+fn legend_label(s: &Shown) -> String {
+    let hh = &s.data.rho_hh;
+    let mut l = format!(
+        "{}: ρhh = {:.3} ± {:.3}",
+        s.brdf.label,
+        mean_rgb(hh.value),
+        BAND_SIGMAS * mean_rgb(hh.std_error)
+    );
+    if s.data.exceeds_one() {
+        l.push_str(" (ρhd > 1!)");
+    }
+    if s.stale {
+        l.push_str(" (updating)");
+    }
+    l
+}
+
+fn y_top(shown: &[Shown]) -> f64 {
+    let m = shown
+        .iter()
+        .flat_map(|s| (0..s.data.rho.len()).map(|k| s.data.mean_and_band(k)))
+        .map(|(v, b)| v + b)
+        .fold(0.0, f64::max);
+    (m * 1.08).max(1.1)
+}
+
+const Y_LABEL: &str = "ρhd (mean of r, g, b)";
+const X_LABEL: &str = "θi (°)";
+
+impl View for AlbedoView {
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+        let dark = ui.visuals().dark_mode;
+        let shown = self.update(scene, (!scene.figure).then(|| ui.ctx()));
+        if let Some((done, total)) = self.progress
+            && !scene.figure
+        {
+            ui.add(
+                egui::ProgressBar::new(done as f32 / total.max(1) as f32)
+                    .desired_height(12.0)
+                    .text(format!("computing ρhd: {done}/{total} steps")),
+            );
+        }
+        let top = y_top(&shown);
+        let size = ui.available_size();
+        let light = super::light_color(dark);
+        let plot = Plot::new(super::view_id("albedo"))
+            .width(size.x.max(50.0))
+            .height(size.y.max(50.0))
+            .legend(Legend::default().position(Corner::RightBottom))
+            .x_axis_label(X_LABEL)
+            .y_axis_label(Y_LABEL)
+            .y_axis_min_width(36.0)
+            .include_x(0.0)
+            .include_x(90.0)
+            .include_y(0.0)
+            .include_y(top)
+            .allow_scroll(false)
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        let theta_i = scene.incident.theta_deg;
+        plot.show(ui, |pui| {
+            pui.hline(
+                HLine::new("", 1.0)
+                    .color(super::mirror_color(dark))
+                    .style(LineStyle::Dashed { length: 6.0 })
+                    .width(1.2)
+                    .allow_hover(false),
+            );
+            pui.vline(
+                VLine::new("", theta_i)
+                    .color(light)
+                    .width(1.5)
+                    .allow_hover(false),
+            );
+            for s in &shown {
+                let n = s.data.rho.len();
+                let (mut lo, mut hi) = (Vec::with_capacity(n), Vec::with_capacity(n));
+                for k in 0..n {
+                    let (v, b) = s.data.mean_and_band(k);
+                    lo.push(v - b);
+                    hi.push(v + b);
+                }
+                pui.add(
+                    FilledArea::new("", &s.data.theta_deg, &lo, &hi)
+                        .fill_color(s.brdf.color.gamma_multiply(0.3)),
+                );
+                let pts: Vec<[f64; 2]> = (0..n)
+                    .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
+                    .collect();
+                let mut line = Line::new(legend_label(s), PlotPoints::from(pts))
+                    .color(s.brdf.color)
+                    .width(if s.brdf.selected { 2.5 } else { 1.8 });
+                if s.stale {
+                    line = line.style(LineStyle::Dashed { length: 8.0 });
+                }
+                pui.line(line);
+            }
+        });
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
+        let shown = self.update(scene, None);
+        let top = y_top(&shown);
+        let mut c = Chart {
+            x_label: X_LABEL.into(),
+            y_label: Y_LABEL.into(),
+            x_range: (0.0, 90.0),
+            y_range: (0.0, top),
+            x_ticks: chart::angle_ticks(0.0, 90.0),
+            y_ticks: chart::labelled(chart::nice_ticks(0.0, top, 8)),
+            ..Default::default()
+        };
+        c.hlines.push(Marker {
+            at: 1.0,
+            color: super::mirror_color(dark),
+            dashed: true,
+            label: "ρ = 1".into(),
+        });
+        c.vlines.push(Marker {
+            at: scene.incident.theta_deg,
+            color: super::light_color(dark),
+            dashed: false,
+            label: "θi".into(),
+        });
+        for s in &shown {
+            let n = s.data.rho.len();
+            let mb: Vec<(f64, f64)> = (0..n).map(|k| s.data.mean_and_band(k)).collect();
+            c.bands.push(Band {
+                color: s.brdf.color.gamma_multiply(0.3),
+                xs: s.data.theta_deg.clone(),
+                lo: mb.iter().map(|(v, b)| v - b).collect(),
+                hi: mb.iter().map(|(v, b)| v + b).collect(),
+            });
+            c.series.push(Series {
+                label: legend_label(s),
+                color: s.brdf.color,
+                points: (0..n).map(|k| [s.data.theta_deg[k], mb[k].0]).collect(),
+                width: if s.brdf.selected { 2.5 } else { 1.8 },
+                dash: None,
+            });
+        }
+        Some(c.to_svg(size, Palette::new(dark, scene.transparent)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lambert_albedo_is_flat_at_its_albedo() {
+        // ρhd of a Lambertian surface is its albedo at every θi (∫ a/π cos dω = a).
+        let b = bv_core::ModelSpec::from_json("lambert", &serde_json::json!({"albedo": 0.6}))
+            .unwrap()
+            .build()
+            .unwrap();
+        let d = AlbedoData::compute(
+            b.as_ref(),
+            0.0,
+            &AtomicUsize::new(0),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        assert_eq!(d.rho.len(), N_THETA);
+        for k in 0..N_THETA {
+            let (v, band) = d.mean_and_band(k);
+            assert!(
+                (v - 0.6).abs() <= band.max(1e-9) + 1e-3,
+                "{k}: {v} ± {band}"
+            );
+        }
+        assert!((mean_rgb(d.rho_hh.value) - 0.6).abs() < 0.01);
+        assert!(!d.exceeds_one());
+    }
+
+    #[test]
+    fn cancelled_jobs_give_nothing() {
+        let b = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
+        assert!(
+            AlbedoData::compute(
+                b.as_ref(),
+                0.0,
+                &AtomicUsize::new(0),
+                &AtomicBool::new(true)
+            )
+            .is_none()
+        );
+    }
+}
