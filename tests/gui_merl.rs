@@ -78,7 +78,10 @@ fn drop_file(h: &mut Harness<'_, Viewer>, path: &Path) {
     h.input_mut()
         .dropped_files
         .push(Arc::new(Dropped(path.to_path_buf())));
-    h.run();
+    // One frame takes the drop and starts the read; while it runs the window
+    // keeps repainting (the progress bar), so wait rather than `run`.
+    h.step();
+    assert!(h.state().loader().busy(), "the read started");
     assert!(h.state_mut().wait_for_loads(Duration::from_secs(60)));
     h.run();
 }
@@ -170,7 +173,7 @@ fn a_bad_file_shows_the_reader_message_and_keeps_everything() {
         path: bad.display().to_string(),
         into: Some(id),
     });
-    h.run();
+    h.step();
     assert!(h.state_mut().wait_for_loads(Duration::from_secs(60)));
     h.run();
     assert_eq!(h.state().state(), &before, "the table keeps its file");
@@ -207,6 +210,8 @@ fn the_load_button_opens_a_file_dialog() {
 fn the_image_slice_follows_phi_d() {
     let mut state = AppState::default();
     state.add(cook_torrance());
+    // Maximised: in the default layout the view may be too small to draw.
+    state.maximised = Some("slice".into());
     let mut h = viewer(state);
     let id = h.state().state().brdfs[0].id;
     let slice = |h: &Harness<'_, Viewer>| {

@@ -31,6 +31,9 @@ pub const IDLE_RESOLUTION: usize = 256;
 /// Slice resolution while something is dragged.
 pub const DRAG_RESOLUTION: usize = 128;
 
+/// Smallest image side (points) worth drawing with its axes.
+const MIN_TILE: f32 = 56.0;
+
 /// Display settings of the view.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SliceSettings {
@@ -447,10 +450,22 @@ impl View for ImageSliceView {
             return;
         }
         let response = ui.allocate_rect(area, Sense::hover());
-        self.update(scene);
         let dark = ui.visuals().dark_mode;
         let shown: Vec<super::SceneBrdf> = self.shown(scene).into_iter().cloned().collect();
         let rects = tiles(area, shown.len());
+        if rects.first().is_some_and(|r| r.width() < MIN_TILE) {
+            ui.painter_at(area).text(
+                area.center(),
+                Align2::CENTER_CENTER,
+                "too small for the slices: maximise this view",
+                FontId::proportional(12.5),
+                ui.visuals().weak_text_color(),
+            );
+            self.image_rects.clear();
+            self.readout = None;
+            return;
+        }
+        self.update(scene);
         let painter = ui.painter_at(area);
         let text = super::strong_text(ui);
         let weak = ui.visuals().weak_text_color();
