@@ -551,9 +551,10 @@ impl View for ImageSliceView {
                 small.clone(),
                 weak,
             );
+            // The θd title sits above its axis, clear of the tick labels.
             painter.text(
-                Pos2::new(rect.min.x - 26.0, rect.center().y),
-                Align2::CENTER_CENTER,
+                Pos2::new(rect.min.x - 7.0, rect.min.y - 8.0),
+                Align2::RIGHT_BOTTOM,
                 "θd",
                 small.clone(),
                 weak,

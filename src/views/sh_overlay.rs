@@ -257,7 +257,7 @@ pub fn error_label(ui: &mut Ui, scene: &Scene<'_>, done: Option<&ShDone>) {
     };
     let current = key_for(scene).is_some_and(|(_, k)| k == done.key);
     let text = summary(done, current);
-    let r = ui.label(egui::RichText::new(&text).small());
+    let r = ui.label(&text);
     if let Ok(res) = &done.value {
         r.on_hover_text(format!(
             "‖ĝ − g‖ / ‖g‖ over the {} of {} ({} quadrature rings); projected in {:.0} ms",
