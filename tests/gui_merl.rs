@@ -426,3 +426,77 @@ fn snapshot_image_slice() {
         .count();
     assert!(differ > 1000, "{differ} pixels changed");
 }
+
+/// Timings for the record (not a pass/fail test; machines are noisy):
+/// `cargo test --release --test gui_merl timings -- --ignored --nocapture`.
+/// A public-size table read through the GUI's background loader, a 256 × 256
+/// image slice of the analytic model and of its table, and the SH projection
+/// at L = 16 of both.
+#[test]
+#[ignore]
+fn timings() {
+    use bv::app::loader::{LoadTarget, Loader};
+    use std::time::Instant;
+    let dir = temp_dir("timings");
+    let path = dir.join("ct.binary");
+    let ct = ModelSpec::from_json("cook-torrance", &serde_json::json!({"alpha": 0.2})).unwrap();
+    write_table(&ct, [90, 90, 180], &path);
+    let mut loader = Loader::default();
+    let t0 = Instant::now();
+    loader.start(path.clone(), LoadTarget::New);
+    let mut last = (0, 0);
+    let mut updates = 0;
+    while loader.busy() {
+        if let Some(j) = loader.jobs().first()
+            && j.progress() != last
+        {
+            updates += 1;
+            last = j.progress();
+        }
+        if !loader.poll().is_empty() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    println!(
+        "load 35 MB through the loader: {:.0} ms ({updates} progress values seen, polling every ms)",
+        t0.elapsed().as_secs_f64() * 1e3
+    );
+    let analytic = ct.build().unwrap();
+    let merl = ModelSpec::from_json("merl", &serde_json::json!({"path": path.to_str().unwrap()}))
+        .unwrap()
+        .build()
+        .unwrap();
+    for (name, b) in [("cook-torrance", &analytic), ("merl table", &merl)] {
+        let mut best = f64::INFINITY;
+        for _ in 0..5 {
+            let d = bv::views::image_slice::compute(
+                b.as_ref(),
+                std::f64::consts::FRAC_PI_2,
+                false,
+                256,
+            );
+            best = best.min(d.seconds);
+        }
+        println!(
+            "image slice 256×256 of {name}: {:.1} ms (best of 5)",
+            best * 1e3
+        );
+        let key = sh_overlay::ShKey {
+            revision: 1,
+            incident: (45.0, 0.0),
+            order: 16,
+            cosine: false,
+            log: false,
+        };
+        let t = Instant::now();
+        let r = sh_overlay::compute(b.as_ref(), 1, key).unwrap();
+        println!(
+            "SH projection L = 16 of {name} ({} rings, mesh and curve included): {:.0} ms, error {:.1} %",
+            r.lobe.n_theta,
+            t.elapsed().as_secs_f64() * 1e3,
+            100.0 * r.lobe.rel_l2_error
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
