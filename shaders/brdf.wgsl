@@ -19,6 +19,7 @@
 #import bv::models::disney
 #import bv::models::mirror
 #import bv::models::glass
+#import bv::models::merl
 
 // A model that is not a mix. Unknown indices (a model without a port) give 0,
 // which the parity test reports as a failure.
@@ -39,6 +40,8 @@ fn eval_leaf(model: u32, o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         // Delta models: 0 at every finite pair (their lobes are in env.wgsl).
         case L::MODEL_MIRROR: { return mirror::eval(o, wi, wo); }
         case L::MODEL_GLASS: { return glass::eval(o, wi, wo); }
+        // Measured: the table is in its own buffer (bv::models::merl).
+        case L::MODEL_MERL: { return merl::eval(o, wi, wo); }
         default: { return vec3<f32>(0.0); }
     }
 }

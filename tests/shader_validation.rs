@@ -42,16 +42,13 @@ fn every_module_validates_on_its_own() {
 #[test]
 fn every_catalogue_model_has_a_port() {
     // The dispatcher must name every model of the catalogue (the parity test
-    // then checks the values). `merl` arrives with its table upload.
+    // then checks the values).
     let brdf = MODULES
         .iter()
         .find(|(p, _)| *p == "shaders/brdf.wgsl")
         .unwrap()
         .1;
     for m in bv_core::catalogue() {
-        if m.id == "merl" {
-            continue;
-        }
         let name = format!("L::MODEL_{}", bv::gpu::layout::ident(m.id));
         assert!(
             brdf.contains(&name),

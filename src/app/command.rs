@@ -70,6 +70,18 @@ pub enum Command {
     ToggleMaximise(String),
     /// Switches the colour theme.
     SetTheme(Theme),
+    /// Reads a measured table (`.binary`) in the background; once it is read
+    /// and valid, sets it as the path of BRDF `into` (its path parameter), or
+    /// adds a new `merl` BRDF with it. A file the reader refuses changes
+    /// nothing and shows the reader's message (see [`super::loader`]).
+    OpenFile {
+        /// The file.
+        path: String,
+        /// The BRDF whose file it becomes, or `None` for a new BRDF.
+        into: Option<u64>,
+    },
+    /// Opens the file dialog for measured tables.
+    OpenFileDialog,
     /// Opens or closes the keyboard help.
     ToggleHelp,
     /// Sets the lit sphere view's settings.
@@ -85,6 +97,10 @@ pub struct Applied {
     pub message: Option<String>,
     /// The help overlay should toggle.
     pub toggle_help: bool,
+    /// A file to read in the background, and where its table goes.
+    pub open: Option<(String, super::loader::LoadTarget)>,
+    /// The file dialog should open.
+    pub open_dialog: bool,
 }
 
 impl Command {
@@ -220,9 +236,39 @@ impl Command {
                 state.lighting.env = v;
                 state.lighting = std::mem::take(&mut state.lighting).sanitised();
             }
+            Command::OpenFile { path, into } => {
+                let target = match into.and_then(|id| state.entry(id)) {
+                    Some(e) => match path_param(&e.spec.model) {
+                        Some(param) => super::loader::LoadTarget::Into {
+                            brdf: e.id,
+                            param: param.to_string(),
+                        },
+                        None => {
+                            out.message = Some(format!(
+                                "{} takes no file; opening {path} as a new BRDF",
+                                e.spec.model
+                            ));
+                            super::loader::LoadTarget::New
+                        }
+                    },
+                    None => super::loader::LoadTarget::New,
+                };
+                out.open = Some((path, target));
+            }
+            Command::OpenFileDialog => out.open_dialog = true,
         }
         out
     }
+}
+
+/// The id of model `model`'s file parameter, if it has one.
+pub fn path_param(model: &str) -> Option<&'static str> {
+    bv_core::find(model).ok().and_then(|m| {
+        m.params
+            .iter()
+            .find(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
+            .map(|d| d.id)
+    })
 }
 
 #[cfg(test)]

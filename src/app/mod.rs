@@ -11,6 +11,8 @@
 pub mod command;
 pub mod files;
 pub mod lighting;
+pub mod loader;
+pub mod measured_ui;
 pub mod panel;
 pub mod params_ui;
 pub mod runtime;
@@ -63,6 +65,11 @@ pub struct ViewerArgs {
     /// Start with the light theme.
     #[arg(long)]
     pub light: bool,
+
+    /// Open a measured BRDF (a MERL `.binary` file) as one more BRDF, read in
+    /// the background with a progress bar (repeat for several).
+    #[arg(long = "open", value_name = "FILE")]
+    pub open: Vec<PathBuf>,
 
     /// Open this scene file (TOML, see `bv scene --help`) instead of the saved
     /// session.
@@ -209,6 +216,12 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 },
             );
             let mut viewer = Viewer::new(state);
+            for f in &args2.open {
+                viewer.push(Command::OpenFile {
+                    path: f.display().to_string(),
+                    into: None,
+                });
+            }
             if let Some(rs) = &cc.wgpu_render_state {
                 viewer.export.set_gpu(rs.clone());
             }

@@ -14,11 +14,32 @@ use eframe::egui::{
 /// The name shown for an entry: the model's name, numbered when the same
 /// model is loaded more than once ("Lambert", "Lambert 2").
 pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
+    // A model read from a file is named after the file ("gold-paint (MERL)").
+    if let Some(param) = super::command::path_param(&e.spec.model)
+        && let Ok(path) = e.spec.params.text(param)
+        && let Some(stem) = std::path::Path::new(path).file_stem()
+    {
+        let kind = if e.spec.model == "merl" {
+            // Nearest and trilinear lookups of one file side by side.
+            match e.spec.params.text("interpolation") {
+                Ok("nearest") => "MERL, nearest".to_string(),
+                _ => "MERL".to_string(),
+            }
+        } else {
+            e.spec.model.clone()
+        };
+        return format!("{} ({kind})", stem.to_string_lossy());
+    }
     let name = bv_core::find(&e.spec.model).map(|m| m.name).unwrap_or("?");
+    let has_file = |b: &BrdfEntry| {
+        super::command::path_param(&b.spec.model)
+            .and_then(|p| b.spec.params.text(p).ok())
+            .is_some_and(|p| std::path::Path::new(p).file_stem().is_some())
+    };
     let same: Vec<u64> = state
         .brdfs
         .iter()
-        .filter(|b| b.spec.model == e.spec.model)
+        .filter(|b| b.spec.model == e.spec.model && !has_file(b))
         .map(|b| b.id)
         .collect();
     match same.iter().position(|&id| id == e.id) {
@@ -48,6 +69,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             })
             .response
             .on_hover_text("Add any model of the catalogue");
+            super::measured_ui::load_button(ui, out);
         });
     });
     if state.brdfs.is_empty() {
@@ -289,6 +311,17 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
     );
     for edit in edits {
         out.push(match edit {
+            // A file is read in the background first; a file the reader
+            // refuses leaves the BRDF as it was (see `loader`).
+            Edit::Set(param, bv_core::ParamValue::Text(path))
+                if super::command::path_param(&e.spec.model) == Some(param.as_str())
+                    && !path.trim().is_empty() =>
+            {
+                Command::OpenFile {
+                    path,
+                    into: Some(e.id),
+                }
+            }
             Edit::Set(param, value) => Command::SetParam {
                 brdf: e.id,
                 param,
@@ -311,5 +344,11 @@ mod tests {
         let b = s.add(ModelSpec::new("lambert").unwrap());
         assert_eq!(display_name(&s, s.entry(a).unwrap()), "Lambert");
         assert_eq!(display_name(&s, s.entry(b).unwrap()), "Lambert 2");
+        let mut spec = ModelSpec::new("merl").unwrap();
+        spec.set_str("path", "/data/gold-paint.binary").unwrap();
+        let m = s.add(spec);
+        assert_eq!(display_name(&s, s.entry(m).unwrap()), "gold-paint (MERL)");
+        let fresh = s.add(ModelSpec::new("merl").unwrap());
+        assert_eq!(display_name(&s, s.entry(fresh).unwrap()), "MERL measured");
     }
 }

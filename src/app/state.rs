@@ -117,6 +117,11 @@ pub struct Display {
     /// Lobe view: scale the scene so that the largest lobe fills the unit
     /// hemisphere; otherwise keep the last scale while parameters change.
     pub auto_scale: bool,
+    /// Lobe and polar views: overlay the selected lobe's spherical-harmonics
+    /// reconstruction (issue 5, item 6).
+    pub sh_overlay: bool,
+    /// Its highest order L (0–16).
+    pub sh_order: u8,
 }
 
 impl Default for Display {
@@ -127,6 +132,8 @@ impl Default for Display {
             wireframe: false,
             color_by_value: true,
             auto_scale: true,
+            sh_overlay: false,
+            sh_order: 4,
         }
     }
 }
@@ -351,6 +358,10 @@ impl AppState {
         p.fixed_theta_d_deg = clamp_deg(p.fixed_theta_d_deg, 0.0, 89.5);
         p.fixed_theta_h_deg = clamp_deg(p.fixed_theta_h_deg, 0.0, 89.5);
         self.lighting = self.lighting.sanitised();
+        self.display.sh_order = self
+            .display
+            .sh_order
+            .min(bv_core::represent::sh::MAX_ORDER as u8);
         self.version = STATE_VERSION;
         self
     }

@@ -6,6 +6,9 @@
 //! shortcuts, then apply the commands.
 
 use super::command::Command;
+use super::files::Files;
+use super::loader::{self, LoadError, LoadTarget, Loader};
+use super::measured_ui;
 use super::panel;
 use super::runtime::Runtime;
 use super::scene;
@@ -65,6 +68,10 @@ pub struct Viewer {
     status: Option<String>,
     help: bool,
     applied_theme: Option<Theme>,
+    loader: Loader,
+    load_errors: Vec<LoadError>,
+    last_load: Option<String>,
+    files: Files<()>,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
     /// Draw as a figure (a screenshot of the window): views finish slow work
@@ -85,6 +92,10 @@ impl Viewer {
             status: None,
             help: false,
             applied_theme: None,
+            loader: Loader::default(),
+            load_errors: Vec::new(),
+            last_load: None,
+            files: Files::default(),
             force_interacting: false,
             figure: false,
             export: ExportUi::default(),
@@ -166,6 +177,74 @@ impl Viewer {
         }
     }
 
+    /// The background reads of measured tables.
+    pub fn loader(&self) -> &Loader {
+        &self.loader
+    }
+
+    /// Files that could not be opened, oldest first (the error dialog shows
+    /// the first until it is dismissed).
+    pub fn load_errors(&self) -> &[LoadError] {
+        &self.load_errors
+    }
+
+    /// Whether the file dialog is open.
+    pub fn dialog_open(&self) -> bool {
+        self.files.is_open()
+    }
+
+    /// Applies the reads that have finished: a valid table becomes a BRDF (or
+    /// a BRDF's new file), a refused one an entry of the error dialog.
+    fn finish_loads(&mut self) {
+        for done in self.loader.poll() {
+            let path = std::fs::canonicalize(&done.path).unwrap_or(done.path.clone());
+            let text = path.display().to_string();
+            match done.result {
+                Ok(_) => {
+                    self.last_load = Some(format!(
+                        "read {} ({:.1} MB) in {:.2} s",
+                        loader::file_name(&path),
+                        done.bytes as f64 / 1e6,
+                        done.elapsed.as_secs_f64()
+                    ));
+                    let value = bv_core::ParamValue::Text(text);
+                    let cmd = match done.target {
+                        LoadTarget::Into { brdf, param } => {
+                            Command::SetParam { brdf, param, value }
+                        }
+                        LoadTarget::New => {
+                            let mut spec = match bv_core::ModelSpec::new("merl") {
+                                Ok(s) => s,
+                                Err(e) => {
+                                    self.status = Some(e.to_string());
+                                    continue;
+                                }
+                            };
+                            if let Err(e) = spec.set("path", value) {
+                                self.status = Some(e.to_string());
+                                continue;
+                            }
+                            Command::AddSpec(spec)
+                        }
+                    };
+                    self.apply(vec![cmd]);
+                }
+                Err(message) => self.load_errors.push(LoadError {
+                    path: text,
+                    message,
+                }),
+            }
+        }
+    }
+
+    /// Waits (up to `timeout`) for the background reads and applies them; for
+    /// tests and scripted drivers. Returns whether all finished.
+    pub fn wait_for_loads(&mut self, timeout: std::time::Duration) -> bool {
+        let ok = self.loader.wait(timeout);
+        self.finish_loads();
+        ok
+    }
+
     /// The current state (what is saved).
     pub fn state(&self) -> &AppState {
         &self.state
@@ -213,6 +292,13 @@ impl Viewer {
             if let Some(m) = r.message {
                 self.status = Some(m);
             }
+            if let Some((path, target)) = r.open {
+                self.loader.start(path.into(), target);
+            }
+            if r.open_dialog && !self.files.is_open() {
+                self.files
+                    .open((), "Load a MERL table (.binary)", measured_ui::MERL_FILES);
+            }
         }
     }
 
@@ -228,6 +314,11 @@ impl Viewer {
             self.applied_theme = Some(self.state.theme);
         }
         self.apply_pending();
+        self.finish_loads();
+        if self.loader.busy() {
+            // Keep the progress bar moving while nothing else happens.
+            ctx.request_repaint_after(std::time::Duration::from_millis(40));
+        }
         self.runtime.sync(&self.state);
         let interacting = self.force_interacting || ctx.input(|i| i.pointer.any_down());
         let mut out = Vec::new();
@@ -242,8 +333,18 @@ impl Viewer {
             });
         }
         self.shortcuts(&ctx, &mut out);
-        dropped_files(&ctx, &self.state, &mut out);
+        dropped_files(&ctx, &self.state, &self.runtime, &mut out);
         self.help_window(&ctx);
+        if let Some(((), path)) = self.files.show(&ctx) {
+            out.push(Command::OpenFile {
+                path: path.display().to_string(),
+                into: None,
+            });
+        }
+        if measured_ui::error_window(&ctx, &self.load_errors) {
+            self.load_errors.remove(0);
+            ctx.request_repaint();
+        }
         for r in self.export.ui(&ctx) {
             self.handle(r, &ctx);
         }
@@ -315,10 +416,20 @@ impl Viewer {
                     .auto_shrink([false, false])
                     .show(ui, |ui| {
                         panel::brdf_list(ui, &self.state, &self.runtime, out);
+                        measured_ui::progress_ui(ui, &self.loader);
                         ui.separator();
                         panel::light_ui(ui, &self.state, out);
                         ui.separator();
                         panel::params_section(ui, &self.state, &self.runtime, out);
+                        if let Some(e) = self.state.selected_entry() {
+                            measured_ui::measured_section(
+                                ui,
+                                &self.state,
+                                &self.runtime,
+                                e,
+                                self.last_load.as_deref(),
+                            );
+                        }
                         if let Some(msg) = &self.status {
                             ui.separator();
                             ui.horizontal_wrapped(|ui| {
@@ -534,48 +645,39 @@ fn central(
     }
 }
 
-/// Files dropped on the window go to a path parameter (a MERL table): the
-/// selected BRDF's if it has one, otherwise a new BRDF of the first catalogue
-/// model that takes a file.
-fn dropped_files(ctx: &egui::Context, state: &AppState, out: &mut Vec<Command>) {
+/// Files dropped on the window are opened as measured tables (see
+/// [`file_command`]).
+fn dropped_files(ctx: &egui::Context, state: &AppState, runtime: &Runtime, out: &mut Vec<Command>) {
     let paths: Vec<String> = ctx.input(|i| {
         i.raw
             .dropped_files
             .iter()
             .map(|f| f.path().display().to_string())
+            .filter(|p| !p.is_empty())
             .collect()
     });
+    let several = paths.len() > 1;
     for path in paths {
-        out.extend(file_command(state, &path));
+        out.push(file_command(state, runtime, &path, several));
     }
 }
 
-/// The command that loads `path` (see [`dropped_files`]).
-pub fn file_command(state: &AppState, path: &str) -> Option<Command> {
-    let path_param = |model: &str| {
-        bv_core::find(model).ok().and_then(|m| {
-            m.params
-                .iter()
-                .find(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
-        })
-    };
-    let value = bv_core::ParamValue::Text(path.to_string());
-    if let Some(e) = state.selected_entry()
-        && let Some(d) = path_param(&e.spec.model)
-    {
-        return Some(Command::SetParam {
-            brdf: e.id,
-            param: d.id.to_string(),
-            value,
-        });
+/// The command that opens `path` (a dropped file): it becomes the file of
+/// the selected BRDF when that one takes a file but has none that loads (a
+/// fresh `merl`, or one whose file went away), and a new BRDF otherwise, so
+/// that dropping tables one after the other puts them side by side.
+/// `several` files dropped at once always become new BRDFs.
+pub fn file_command(state: &AppState, runtime: &Runtime, path: &str, several: bool) -> Command {
+    let into = state
+        .selected_entry()
+        .filter(|_| !several)
+        .filter(|e| super::command::path_param(&e.spec.model).is_some())
+        .filter(|e| runtime.get(e.id).is_none_or(|b| b.brdf.is_none()))
+        .map(|e| e.id);
+    Command::OpenFile {
+        path: path.to_string(),
+        into,
     }
-    let info = bv_core::catalogue()
-        .iter()
-        .find(|m| path_param(m.id).is_some())?;
-    let decl = path_param(info.id)?;
-    let mut spec = bv_core::ModelSpec::new(info.id).ok()?;
-    spec.set(decl.id, value).ok()?;
-    Some(Command::AddSpec(spec))
 }
 
 /// Builds the frame's scene from the state and the built evaluators.
@@ -735,30 +837,50 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_dropped_file_goes_to_a_path_parameter() {
-        let Some(model) = bv_core::catalogue().iter().find(|m| {
-            m.params
-                .iter()
-                .any(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
-        }) else {
-            return; // no model of this build takes a file
-        };
-        // Nothing selected that takes a file: a new BRDF of that model.
+    fn a_dropped_file_opens_as_a_new_brdf_or_fills_an_empty_one() {
         let mut s = AppState::first_run();
-        match file_command(&s, "/data/gold.binary") {
-            Some(Command::AddSpec(spec)) => {
-                assert_eq!(spec.model, model.id);
-                assert!(spec.to_json().to_string().contains("/data/gold.binary"));
-                Command::AddSpec(spec).apply(&mut s);
+        let mut rt = Runtime::default();
+        rt.sync(&s);
+        // The selected BRDF takes no file: a new one.
+        assert_eq!(
+            file_command(&s, &rt, "/data/gold.binary", false),
+            Command::OpenFile {
+                path: "/data/gold.binary".into(),
+                into: None
             }
-            other => panic!("{other:?}"),
-        }
-        // Now it is selected: the next file replaces its path.
-        let id = s.selected.unwrap();
+        );
+        // A fresh merl (no file yet, so it does not build) is filled in.
+        let id = s.add(bv_core::ModelSpec::new("merl").unwrap());
+        rt.sync(&s);
+        assert!(rt.get(id).unwrap().brdf.is_none());
+        assert_eq!(
+            file_command(&s, &rt, "/data/red.binary", false),
+            Command::OpenFile {
+                path: "/data/red.binary".into(),
+                into: Some(id)
+            }
+        );
+        // Several files at once: each its own BRDF.
         assert!(matches!(
-            file_command(&s, "/data/red.binary"),
-            Some(Command::SetParam { brdf, .. }) if brdf == id
+            file_command(&s, &rt, "/data/a.binary", true),
+            Command::OpenFile { into: None, .. }
         ));
+        // The command names the path parameter of the target.
+        let r = Command::OpenFile {
+            path: "/x.binary".into(),
+            into: Some(id),
+        }
+        .apply(&mut s);
+        assert_eq!(
+            r.open,
+            Some((
+                "/x.binary".to_string(),
+                LoadTarget::Into {
+                    brdf: id,
+                    param: "path".into()
+                }
+            ))
+        );
     }
 
     #[test]

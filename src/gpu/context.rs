@@ -40,7 +40,7 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("bv"),
             required_features: wgpu::Features::empty(),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            required_limits: limits(&adapter),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
@@ -97,6 +97,22 @@ impl Gpu {
         buffer.unmap();
         Ok(bytes)
     }
+}
+
+/// What a headless device asks for: the downlevel defaults (so that what
+/// works here works on modest hardware), with the adapter's texture sizes and
+/// up to 8 storage buffers per shader stage. The environment pass binds 5
+/// (parameters, tiles, accumulation, environment map, MERL tables); downlevel
+/// promises only 4, while every Vulkan, Metal and DX12 device has at least 8,
+/// which is also what egui-wgpu's window device requests (`Limits::default()`).
+pub fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+    let have = adapter.limits();
+    let mut l = wgpu::Limits::downlevel_defaults().using_resolution(have.clone());
+    l.max_storage_buffers_per_shader_stage = have
+        .max_storage_buffers_per_shader_stage
+        .min(8)
+        .max(l.max_storage_buffers_per_shader_stage);
+    l
 }
 
 /// Opens the headless device for a test. Without an adapter the test FAILS

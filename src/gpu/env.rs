@@ -7,7 +7,7 @@
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
-use super::pack::pack_all;
+use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Context, Result, bail};
 use bv_core::ModelSpec;
@@ -326,6 +326,7 @@ pub struct EnvRenderer {
     samples: u64,
     target: Option<Target>,
     object: Object,
+    tables: TableBuffer,
 }
 
 impl std::fmt::Debug for EnvRenderer {
@@ -342,6 +343,14 @@ const WORKGROUP: u32 = 8;
 impl EnvRenderer {
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
+        // params, tiles, accumulation, environment map and MERL tables.
+        let have = gpu.device.limits().max_storage_buffers_per_shader_stage;
+        if have < 5 {
+            bail!(
+                "the environment view needs 5 storage buffers per shader stage; this device \
+                 allows {have} (a downlevel or OpenGL device: try the Vulkan, Metal or DX12 backend)"
+            );
+        }
         let module = library.shader_module(&gpu.device, "env")?;
         let accumulate = gpu
             .device
@@ -389,6 +398,7 @@ impl EnvRenderer {
             samples: 0,
             target: None,
             object: Object::Sphere,
+            tables: TableBuffer::default(),
         })
     }
 
@@ -621,7 +631,8 @@ impl EnvRenderer {
             self.samples = 0;
         }
         let accum = self.accum.as_ref().context("accumulation buffer")?;
-        let (params, refs) = pack_all(models)?;
+        let (params, refs, tables) = pack_all(models)?;
+        let tbuf = self.tables.get(&self.gpu, &tables)?;
         let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
         let frame = FrameUniform {
             size: [width as f32, height as f32],
@@ -677,6 +688,7 @@ impl EnvRenderer {
                 entry(1, &fbuf),
                 entry(2, &mbuf),
                 entry(3, accum),
+                entry(8, tbuf),
             ],
         });
         let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor {

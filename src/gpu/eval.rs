@@ -1,7 +1,7 @@
 //! Batch evaluation of a model on the GPU (the parity test's compute pass, also
 //! usable by any tool that wants GPU values of f).
 
-use super::pack::pack;
+use super::pack::{MerlTables, TableBuffer, pack};
 use super::{Gpu, shaders::ShaderLibrary};
 use anyhow::Result;
 use bv_core::ModelSpec;
@@ -43,7 +43,8 @@ impl GpuEvaluator {
     /// `f(wi, wo)` of `spec` for every pair, computed by the WGSL port in f32.
     pub fn eval(&self, spec: &ModelSpec, pairs: &[([f32; 3], [f32; 3])]) -> Result<Vec<[f32; 3]>> {
         let mut params = Vec::new();
-        let r = pack(spec, &mut params)?;
+        let mut tables = MerlTables::default();
+        let r = pack(spec, &mut params, &mut tables)?;
         if params.is_empty() {
             params.push(0.0);
         }
@@ -87,6 +88,9 @@ impl GpuEvaluator {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // A fresh buffer per call: the evaluator is a batch tool, not a view.
+        let mut tbuf = TableBuffer::default();
+        let tbuf = tbuf.get(&self.gpu, &tables)?;
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("parity"),
             layout: &self.pipeline.get_bind_group_layout(0),
@@ -95,6 +99,7 @@ impl GpuEvaluator {
                 entry(1, &dbuf),
                 entry(2, &obuf),
                 entry(3, &jbuf),
+                entry(8, tbuf),
             ],
         });
         let mut enc = d.create_command_encoder(&Default::default());

@@ -6,7 +6,7 @@
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
-use super::pack::pack_all;
+use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Result, bail};
 use bv_core::ModelSpec;
@@ -85,6 +85,7 @@ pub struct LitSphereRenderer {
     gpu: Gpu,
     pipeline: wgpu::RenderPipeline,
     target: Option<Target>,
+    tables: TableBuffer,
 }
 
 impl LitSphereRenderer {
@@ -118,6 +119,7 @@ impl LitSphereRenderer {
             gpu,
             pipeline,
             target: None,
+            tables: TableBuffer::default(),
         })
     }
 
@@ -139,7 +141,7 @@ impl LitSphereRenderer {
         if models.is_empty() {
             bail!("the lit sphere needs at least one model");
         }
-        let (params, refs) = pack_all(models)?;
+        let (params, refs, tables) = pack_all(models)?;
         let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
         let light = settings.light.try_normalize().unwrap_or(DVec3::Z);
         let (background, checker, color, color2) = match settings.background {
@@ -186,10 +188,16 @@ impl LitSphereRenderer {
             bytemuck::cast_slice(&tiles),
             wgpu::BufferUsages::STORAGE,
         );
+        let tbuf = self.tables.get(&self.gpu, &tables)?;
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lit sphere"),
             layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[entry(0, &pbuf), entry(1, &ubuf), entry(2, &mbuf)],
+            entries: &[
+                entry(0, &pbuf),
+                entry(1, &ubuf),
+                entry(2, &mbuf),
+                entry(8, tbuf),
+            ],
         });
         let target = Target::ensure(&mut self.target, &self.gpu, width, height)?;
         let mut enc = d.create_command_encoder(&Default::default());

@@ -51,6 +51,7 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("models/disney.wgsl"),
     shader!("models/mirror.wgsl"),
     shader!("models/glass.wgsl"),
+    shader!("models/merl.wgsl"),
     shader!("brdf.wgsl"),
     shader!("brdf_sampling.wgsl"),
 ];

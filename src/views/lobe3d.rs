@@ -11,6 +11,7 @@
 
 use super::camera::{self, CameraMatrices};
 use super::lobe_gpu::{LineSeg, LobeCallback, LobeFrame, MeshDraw, MeshStyle};
+use super::sh_overlay::{self, ShDone};
 use super::{Scene, View, colormap, curves};
 use crate::app::command::Command;
 use crate::app::state::{Camera, Display, Incident};
@@ -28,6 +29,14 @@ pub const IDLE_RESOLUTION: (usize, usize) = (128, 256);
 
 /// Opacity of overlaid (non-primary) lobes.
 const OVERLAY_ALPHA: f32 = 0.38;
+
+/// Opacity of the primary lobe under the SH overlay: see-through, so that the
+/// reconstruction's wireframe shows where it lies inside the lobe (a sharp
+/// peak's reconstruction is mostly inside).
+const UNDER_SH_ALPHA: f32 = 0.6;
+
+/// Mesh key of the SH reconstruction (distinct from BRDF ids and the disc).
+const SH_MESH_KEY: u64 = u64::MAX - 2;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct MeshKey {
@@ -53,6 +62,8 @@ pub struct Lobe3dView {
     last_scale: f32,
     rebuilds: u64,
     last_frame: Option<Arc<LobeFrame>>,
+    /// The SH overlay's latest result and its mesh revision.
+    sh: Option<(ShDone, u64)>,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
 }
@@ -76,8 +87,27 @@ impl Lobe3dView {
             last_scale: 1.0,
             rebuilds: 0,
             last_frame: None,
+            sh: None,
             view_rect: None,
         }
+    }
+
+    /// The SH overlay result the view draws (with the overlay on).
+    pub fn sh_result(&self) -> Option<&ShDone> {
+        self.sh.as_ref().map(|(d, _)| d)
+    }
+
+    /// Takes the SH overlay's latest result (`None` with the overlay off);
+    /// a new result gets a new mesh revision.
+    pub fn set_sh(&mut self, done: Option<ShDone>) {
+        self.sh = done.map(|d| match &self.sh {
+            Some((old, rev)) if Arc::ptr_eq(old, &d) => (d, *rev),
+            _ => {
+                let rev = self.next_revision;
+                self.next_revision += 1;
+                (d, rev)
+            }
+        });
     }
 
     /// The cached lobe mesh of BRDF `id` (what the view last drew).
@@ -181,6 +211,12 @@ impl Lobe3dView {
         let d = scene.state.display;
         let cam = CameraMatrices::new(&scene.state.camera, size.x, size.y);
         let primary = scene.primary().map(|b| b.id);
+        let sh = self
+            .sh
+            .as_ref()
+            .filter(|_| d.sh_overlay)
+            .and_then(|(done, rev)| Some((done.value.as_ref().ok()?, *rev)))
+            .filter(|(r, _)| Some(r.brdf_id) == primary);
         let mut meshes = Vec::new();
         for b in &scene.brdfs {
             let Some(c) = self.cache.get(&b.id) else {
@@ -194,8 +230,10 @@ impl Lobe3dView {
                 style: MeshStyle {
                     by_value: is_primary && d.color_by_value,
                     color: super::srgb_f32(b.color),
-                    alpha: if is_primary || d.wireframe {
+                    alpha: if d.wireframe {
                         1.0
+                    } else if is_primary {
+                        if sh.is_some() { UNDER_SH_ALPHA } else { 1.0 }
                     } else {
                         OVERLAY_ALPHA
                     },
@@ -204,6 +242,27 @@ impl Lobe3dView {
                     log: d.log,
                     scale,
                     unlit: d.wireframe,
+                },
+            });
+        }
+        if let Some((r, rev)) = sh {
+            meshes.push(MeshDraw {
+                key: SH_MESH_KEY,
+                revision: rev,
+                mesh: r.mesh.clone(),
+                style: MeshStyle {
+                    by_value: false,
+                    color: if dark {
+                        [0.97, 0.97, 0.97]
+                    } else {
+                        [0.05, 0.05, 0.05]
+                    },
+                    alpha: 1.0,
+                    wireframe: true,
+                    value_max: 1.0,
+                    log: d.log,
+                    scale,
+                    unlit: true,
                 },
             });
         }
@@ -484,6 +543,8 @@ impl View for Lobe3dView {
         ) {
             set(out, &|n| n.color_by_value = !n.color_by_value);
         }
+        sh_overlay::control(ui, scene, out);
+        sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
         if super::toolbar_toggle(
             ui,
             d.auto_scale,
@@ -519,6 +580,7 @@ impl View for Lobe3dView {
         if scene.transparent {
             bg = [0.0; 4];
         }
+        self.set_sh(sh_overlay::request(ui.ctx(), scene));
         let frame = self.frame(scene, rect.size(), bg, dark);
         ui.painter().add(
             LobeCallback {

@@ -1,14 +1,16 @@
 //! The viewer's views: the 3D polar lobe, the lit sphere, the polar plot of
 //! the plane of incidence, the Cartesian plot, the environment-lit object,
-//! the directional albedo and the Fresnel curves. Each is a struct with its
-//! own `ui()`; they read one [`Scene`] per frame and ask for changes by
-//! pushing [`Command`]s. A view is added by writing its module and one line in
-//! [`REGISTRY`]; the window, screenshots and `bv render` all go through the
-//! registry. A view with its own wgpu pipeline also adds one line to
-//! [`install_gpu`]; one that renders into a texture of its own finds egui's
-//! render state through its context ([`install_context`]).
+//! the directional albedo, the Fresnel curves and the image slice in
+//! half/difference angles. Each is a struct with its own `ui()`; they read
+//! one [`Scene`] per frame and ask for changes by pushing [`Command`]s. A view
+//! is added by writing its module and one line in [`REGISTRY`]; the window,
+//! screenshots and `bv render` all go through the registry. A view with its
+//! own wgpu pipeline also adds one line to [`install_gpu`]; one that renders
+//! into a texture of its own finds egui's render state through its context
+//! ([`install_context`]).
 
 pub mod albedo;
+pub mod background;
 pub mod camera;
 pub mod cartesian;
 pub mod chart;
@@ -17,10 +19,12 @@ pub mod curves;
 pub mod environment;
 pub mod fresnel;
 pub mod gpu_image;
+pub mod image_slice;
 pub mod lit_sphere;
 pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
+pub mod sh_overlay;
 
 use crate::app::command::Command;
 use crate::app::state::{AppState, Incident};
@@ -158,6 +162,11 @@ pub const REGISTRY: &[ViewEntry] = &[
         id: "fresnel",
         title: "Fresnel reflectance",
         make: || Box::new(fresnel::FresnelView::default()),
+    },
+    ViewEntry {
+        id: "slice",
+        title: "Image slice (θh × θd)",
+        make: || Box::new(image_slice::ImageSliceView::default()),
     },
 ];
 

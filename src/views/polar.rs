@@ -5,7 +5,7 @@
 //! and the exact values under the pointer.
 
 use super::curves::{self, Sample};
-use super::{Scene, View};
+use super::{Scene, View, sh_overlay};
 use crate::app::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
@@ -22,6 +22,8 @@ pub struct PolarView {
     pub readout: Option<Readout>,
     /// Where the plot was drawn in the last frame.
     pub plot_rect: Option<egui::Rect>,
+    /// The SH overlay's curve drawn in the last frame (plot coordinates).
+    pub sh_curve: Option<Vec<[f64; 2]>>,
 }
 
 /// Exact values at one hovered angle.
@@ -80,6 +82,8 @@ fn value_at(r: f64, log: bool) -> f64 {
 impl View for PolarView {
     fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         super::display_toggles(ui, scene, out);
+        sh_overlay::control(ui, scene, out);
+        sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
@@ -91,6 +95,21 @@ impl View for PolarView {
         );
         let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
         let (curves, outer) = polar_curves(scene);
+        // The SH reconstruction of the selected lobe, dashed (issue 5, item 6).
+        let sh = sh_overlay::request(ui.ctx(), scene).and_then(|done| {
+            let r = done.value.as_ref().ok()?;
+            let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;
+            let pts: Vec<[f64; 2]> = r
+                .plane
+                .iter()
+                .map(|s| {
+                    let rad = radius(s.value, d.log);
+                    [rad * s.x.sin(), rad * s.x.cos()]
+                })
+                .collect();
+            Some((format!("{} SH L = {}", b.label, r.lobe.order), b.color, pts))
+        });
+        self.sh_curve = sh.as_ref().map(|s| s.2.clone());
 
         let grid = super::grid_color(dark);
         let text_col = super::strong_text(ui);
@@ -232,6 +251,14 @@ impl View for PolarView {
                     Line::new(label.clone(), PlotPoints::from(pts.clone()))
                         .color(*color)
                         .width(if *selected { 2.5 } else { 1.8 }),
+                );
+            }
+            if let Some((label, color, pts)) = &sh {
+                pui.line(
+                    Line::new(label.clone(), PlotPoints::from(pts.clone()))
+                        .color(*color)
+                        .style(LineStyle::Dashed { length: 8.0 })
+                        .width(2.0),
                 );
             }
             // Delta lobes in the plane, as spikes reaching `weight` of the outer ring.

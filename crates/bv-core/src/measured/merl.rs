@@ -446,6 +446,17 @@ impl MerlTable {
     /// Reads a `.binary` file. The header and the file's size are checked
     /// against each other before anything large is allocated.
     pub fn read(path: impl AsRef<Path>) -> Result<Self> {
+        Self::read_with_progress(path, &mut |_, _| {})
+    }
+
+    /// [`Self::read`], calling `progress(bytes_read, file_len)` as the data
+    /// streams in (after the header and after every 64 KiB chunk), so that a
+    /// GUI can show how far a 35 MB file has got. The callback sees counts
+    /// only: the samples go straight into the table, with no second copy.
+    pub fn read_with_progress(
+        path: impl AsRef<Path>,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<Self> {
         let path = path.as_ref();
         let name = path.display().to_string();
         let file = std::fs::File::open(path).map_err(|e| file_err(&name, e.to_string()))?;
@@ -455,7 +466,7 @@ impl MerlTable {
         if !meta.is_file() {
             return Err(file_err(&name, "not a regular file"));
         }
-        Self::read_from(file, meta.len(), &name)
+        Self::read_from_with_progress(file, meta.len(), &name, progress)
     }
 
     /// Reads a table from a stream of `len` bytes (`name` is used in errors).
@@ -466,7 +477,18 @@ impl MerlTable {
     /// differs from `12 + 24 · cells`; a stream that ends early or goes on
     /// past `len`. The table is allocated only after these checks, so memory
     /// stays within half of `len`.
-    pub fn read_from(mut reader: impl Read, len: u64, name: &str) -> Result<Self> {
+    pub fn read_from(reader: impl Read, len: u64, name: &str) -> Result<Self> {
+        Self::read_from_with_progress(reader, len, name, &mut |_, _| {})
+    }
+
+    /// [`Self::read_from`] with a progress callback `progress(bytes_read, len)`
+    /// (see [`Self::read_with_progress`]).
+    pub fn read_from_with_progress(
+        mut reader: impl Read,
+        len: u64,
+        name: &str,
+        progress: &mut dyn FnMut(u64, u64),
+    ) -> Result<Self> {
         if len < HEADER_BYTES {
             return Err(file_err(
                 name,
@@ -516,6 +538,7 @@ impl MerlTable {
         const CHUNK: usize = 8192; // samples per read: a 64 KiB buffer
         let mut buf = vec![0u8; CHUNK * 8];
         let mut offset = HEADER_BYTES;
+        progress(offset, len);
         for (c, range) in ranges.iter_mut().enumerate() {
             let mut acc = Acc::new();
             let mut left = dims.cells();
@@ -524,6 +547,7 @@ impl MerlTable {
                 let bytes = &mut buf[..k * 8];
                 read_exact(&mut reader, bytes, name, offset, len)?;
                 offset += bytes.len() as u64;
+                progress(offset, len);
                 for b in bytes.chunks_exact(8) {
                     let raw = f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]);
                     let mut v = (raw * SCALES[c]) as f32;
@@ -807,25 +831,63 @@ static CACHE: Mutex<(u64, Vec<CacheEntry>)> = Mutex::new((0, Vec::new()));
 /// move in the GUI, every `bv eval` line) does not reread the file. A changed
 /// file is read again. At most 4 tables are kept (least recently used goes).
 pub fn read_cached(path: impl AsRef<Path>) -> Result<Arc<MerlTable>> {
-    let path = path.as_ref();
+    read_cached_with_progress(path, &mut |_, _| {})
+}
+
+/// Identity of a file for the cache: canonical path, modification time, size.
+fn cache_key(path: &Path) -> Result<(PathBuf, Option<std::time::SystemTime>, u64)> {
     let name = path.display().to_string();
     let canon = std::fs::canonicalize(path).map_err(|e| file_err(&name, e.to_string()))?;
     let meta = std::fs::metadata(&canon).map_err(|e| file_err(&name, e.to_string()))?;
-    let (modified, len) = (meta.modified().ok(), meta.len());
+    Ok((canon, meta.modified().ok(), meta.len()))
+}
+
+fn cache_lock() -> std::sync::MutexGuard<'static, (u64, Vec<CacheEntry>)> {
     // A poisoned lock only means another thread panicked mid-update; the
     // entries are still whole tables, so keep using them.
-    let mut guard = CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    CACHE.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// The cached table of `key`, marked as just used.
+fn cache_get(key: &(PathBuf, Option<std::time::SystemTime>, u64)) -> Option<Arc<MerlTable>> {
+    let mut guard = cache_lock();
     let (clock, entries) = &mut *guard;
     *clock += 1;
     let now = *clock;
-    if let Some(e) = entries
+    let e = entries
         .iter_mut()
-        .find(|e| e.path == canon && e.modified == modified && e.len == len && modified.is_some())
-    {
-        e.last_use = now;
-        return Ok(e.table.clone());
+        .find(|e| e.path == key.0 && e.modified == key.1 && e.len == key.2 && key.1.is_some())?;
+    e.last_use = now;
+    Some(e.table.clone())
+}
+
+/// Whether [`read_cached`] of `path` would return at once (the file is in the
+/// cache and unchanged), so that a GUI can decide whether to read it on a
+/// background thread.
+pub fn is_cached(path: impl AsRef<Path>) -> bool {
+    cache_key(path.as_ref()).is_ok_and(|k| cache_get(&k).is_some())
+}
+
+/// [`read_cached`] with a progress callback for a read that misses the cache
+/// (see [`MerlTable::read_with_progress`]). The cache lock is not held while
+/// the file is read, so a long read on one thread never blocks another
+/// thread's lookups of other tables.
+pub fn read_cached_with_progress(
+    path: impl AsRef<Path>,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Arc<MerlTable>> {
+    let path = path.as_ref();
+    let key = cache_key(path)?;
+    if let Some(t) = cache_get(&key) {
+        progress(key.2, key.2);
+        return Ok(t);
     }
-    let table = Arc::new(MerlTable::read(path)?);
+    let table = Arc::new(MerlTable::read_with_progress(path, progress)?);
+    let mut guard = cache_lock();
+    let (clock, entries) = &mut *guard;
+    *clock += 1;
+    let now = *clock;
+    let (canon, modified, len) = key;
     entries.retain(|e| e.path != canon);
     if entries.len() >= CACHE_ENTRIES
         && let Some(oldest) = entries
@@ -1472,6 +1534,36 @@ mod tests {
             .unwrap();
         let b4 = spec.build().unwrap();
         assert_eq!(b4.measured().unwrap().0.dims(), dims(4, 4, 8));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn progress_reaches_the_file_length_and_the_cache_reports_hits() {
+        let dir = temp_dir("progress");
+        let path = dir.join("smooth.binary");
+        let dm = dims(20, 20, 40); // 192,012 bytes: several 64 KiB chunks
+        tabulate(&Smooth, dm).unwrap().write(&path).unwrap();
+        let mut seen: Vec<(u64, u64)> = Vec::new();
+        let t = MerlTable::read_with_progress(&path, &mut |a, b| seen.push((a, b))).unwrap();
+        let len = dm.file_len();
+        assert!(seen.len() >= 4, "{seen:?}");
+        assert!(seen.iter().all(|&(_, total)| total == len));
+        assert!(seen.windows(2).all(|w| w[0].0 < w[1].0), "{seen:?}");
+        assert_eq!(seen.first().unwrap().0, HEADER_BYTES);
+        assert_eq!(seen.last().unwrap().0, len);
+        assert_eq!(t, MerlTable::read(&path).unwrap());
+
+        assert!(!is_cached(&path));
+        assert!(!is_cached(dir.join("missing.binary")));
+        let mut calls = 0;
+        let a = read_cached_with_progress(&path, &mut |_, _| calls += 1).unwrap();
+        assert!(calls >= 4);
+        assert!(is_cached(&path));
+        // A hit reports completion once and returns the same table.
+        let mut hit = Vec::new();
+        let b = read_cached_with_progress(&path, &mut |x, y| hit.push((x, y))).unwrap();
+        assert!(Arc::ptr_eq(&a, &b));
+        assert_eq!(hit, vec![(len, len)]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

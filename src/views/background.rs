@@ -1,0 +1,299 @@
+//! Results computed off the UI thread and kept until their inputs change (SH
+//! projections, tabulated-versus-analytic errors): the UI asks every frame for
+//! the result of a key; it gets the latest finished one at once (perhaps for an
+//! older key, which it may show marked as stale) and a job starts when nothing
+//! has been computed or is being computed for that key. At most one job runs
+//! per slot; a request that arrives while one runs replaces any waiting one,
+//! so a slider drag computes the first and the last position, not every one.
+//!
+//! The slots live in egui's context memory ([`shared`]), so that two views
+//! (the 3D lobe and the polar plot) asking for the same key share one job and
+//! one result without any other plumbing.
+
+use eframe::egui;
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+type Job<V> = Box<dyn FnOnce() -> V + Send>;
+
+/// A finished result.
+#[derive(Debug)]
+pub struct Done<K, V> {
+    /// What it was computed for.
+    pub key: K,
+    /// The value.
+    pub value: V,
+    /// How long the job took.
+    pub elapsed: Duration,
+}
+
+struct Slot<K, V> {
+    running: Option<K>,
+    waiting: Option<(K, Job<V>)>,
+    done: Option<Arc<Done<K, V>>>,
+    last_use: u64,
+}
+
+struct Inner<K, V> {
+    slots: HashMap<u64, Slot<K, V>>,
+    clock: u64,
+}
+
+/// Background slots keyed by a `u64` (a BRDF id, a pair of ids).
+pub struct Slots<K, V> {
+    inner: Mutex<Inner<K, V>>,
+}
+
+impl<K, V> Default for Slots<K, V> {
+    fn default() -> Self {
+        Self {
+            inner: Mutex::new(Inner {
+                slots: HashMap::new(),
+                clock: 0,
+            }),
+        }
+    }
+}
+
+impl<K, V> std::fmt::Debug for Slots<K, V> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Slots").finish_non_exhaustive()
+    }
+}
+
+/// Slots not asked for in this many requests are dropped (removed BRDFs).
+const FORGET_AFTER: u64 = 2000;
+
+impl<K, V> Slots<K, V>
+where
+    K: Clone + PartialEq + Send + Sync + 'static,
+    V: Send + Sync + 'static,
+{
+    fn lock(&self) -> MutexGuard<'_, Inner<K, V>> {
+        // A poisoned lock means a job panicked; the map itself is consistent.
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The latest finished result of `slot` (whatever its key), starting
+    /// `compute` on a background thread if `key` is neither finished nor
+    /// running. `notify` runs when a job finishes (e.g. a repaint request).
+    pub fn request(
+        self: &Arc<Self>,
+        slot: u64,
+        key: K,
+        compute: impl FnOnce() -> V + Send + 'static,
+        notify: impl Fn() + Send + Sync + 'static,
+    ) -> Option<Arc<Done<K, V>>> {
+        let mut g = self.lock();
+        g.clock += 1;
+        let now = g.clock;
+        g.slots
+            .retain(|_, s| s.running.is_some() || now.saturating_sub(s.last_use) < FORGET_AFTER);
+        let s = g.slots.entry(slot).or_insert_with(|| Slot {
+            running: None,
+            waiting: None,
+            done: None,
+            last_use: now,
+        });
+        s.last_use = now;
+        let have = s.done.as_ref().is_some_and(|d| d.key == key);
+        let running = s.running.as_ref() == Some(&key);
+        let mut start = None;
+        if !have && !running {
+            if s.running.is_some() {
+                s.waiting = Some((key, Box::new(compute)));
+            } else {
+                s.running = Some(key.clone());
+                s.waiting = None;
+                start = Some((key, Box::new(compute) as Job<V>));
+            }
+        } else if running {
+            // The key asked for is on its way: a waiting older request is moot.
+            s.waiting = None;
+        }
+        let done = s.done.clone();
+        drop(g);
+        if let Some((key, job)) = start {
+            let notify: Arc<dyn Fn() + Send + Sync> = Arc::new(notify);
+            self.spawn(slot, key, job, notify);
+        }
+        done
+    }
+
+    /// Stores a result computed by the caller (figures compute before they
+    /// draw instead of waiting for a job).
+    pub fn insert(&self, slot: u64, key: K, value: V, elapsed: Duration) -> Arc<Done<K, V>> {
+        let done = Arc::new(Done {
+            key,
+            value,
+            elapsed,
+        });
+        let mut g = self.lock();
+        g.clock += 1;
+        let now = g.clock;
+        let s = g.slots.entry(slot).or_insert_with(|| Slot {
+            running: None,
+            waiting: None,
+            done: None,
+            last_use: now,
+        });
+        s.last_use = now;
+        s.done = Some(done.clone());
+        done
+    }
+
+    /// The latest finished result of `slot`, without starting anything.
+    pub fn latest(&self, slot: u64) -> Option<Arc<Done<K, V>>> {
+        self.lock().slots.get(&slot).and_then(|s| s.done.clone())
+    }
+
+    /// Whether a job of `slot` is running or waiting.
+    pub fn busy(&self, slot: u64) -> bool {
+        self.lock()
+            .slots
+            .get(&slot)
+            .is_some_and(|s| s.running.is_some() || s.waiting.is_some())
+    }
+
+    /// Waits until no job of any slot runs (tests and scripted drivers).
+    pub fn wait_idle(&self, timeout: Duration) -> bool {
+        let t0 = Instant::now();
+        loop {
+            let idle = self
+                .lock()
+                .slots
+                .values()
+                .all(|s| s.running.is_none() && s.waiting.is_none());
+            if idle {
+                return true;
+            }
+            if t0.elapsed() > timeout {
+                return false;
+            }
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn spawn(
+        self: &Arc<Self>,
+        slot: u64,
+        key: K,
+        job: Job<V>,
+        notify: Arc<dyn Fn() + Send + Sync>,
+    ) {
+        let me = self.clone();
+        let run = move || {
+            let t0 = Instant::now();
+            // A job that panics must not leave the slot "running" forever.
+            let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+            let elapsed = t0.elapsed();
+            let next = {
+                let mut g = me.lock();
+                let s = g.slots.get_mut(&slot);
+                match s {
+                    Some(s) => {
+                        if let Ok(value) = out {
+                            s.done = Some(Arc::new(Done {
+                                key: key.clone(),
+                                value,
+                                elapsed,
+                            }));
+                        }
+                        match s.waiting.take() {
+                            Some((k, j)) => {
+                                s.running = Some(k.clone());
+                                Some((k, j))
+                            }
+                            None => {
+                                s.running = None;
+                                None
+                            }
+                        }
+                    }
+                    None => None,
+                }
+            };
+            notify();
+            if let Some((k, j)) = next {
+                me.spawn(slot, k, j, notify);
+            }
+        };
+        if std::thread::Builder::new()
+            .name("bv compute".into())
+            .spawn(run)
+            .is_err()
+        {
+            // No thread to be had: forget the job rather than block the UI.
+            let mut g = self.lock();
+            if let Some(s) = g.slots.get_mut(&slot) {
+                s.running = None;
+            }
+        }
+    }
+}
+
+/// The slots of type `Slots<K, V>` named `name`, shared through `ctx`'s memory.
+pub fn shared<K, V>(ctx: &egui::Context, name: &str) -> Arc<Slots<K, V>>
+where
+    K: Clone + PartialEq + Send + Sync + 'static,
+    V: Send + Sync + 'static,
+{
+    ctx.data_mut(|d| {
+        d.get_temp_mut_or_insert_with(egui::Id::unique(("bv background", name)), || {
+            Arc::new(Slots::<K, V>::default())
+        })
+        .clone()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn computes_once_per_key_and_keeps_the_last_request() {
+        let s: Arc<Slots<u32, u32>> = Arc::new(Slots::default());
+        let runs = Arc::new(AtomicUsize::new(0));
+        let gate = Arc::new(Mutex::new(()));
+        let hold = gate.lock().unwrap();
+        let job = |v: u32| {
+            let runs = runs.clone();
+            let gate = gate.clone();
+            move || {
+                let _g = gate.lock();
+                runs.fetch_add(1, Ordering::SeqCst);
+                v * 10
+            }
+        };
+        assert!(s.request(1, 1, job(1), || {}).is_none());
+        // Same key while running: nothing new. Keys 2 and 3 while running:
+        // only the last one waits.
+        s.request(1, 1, job(1), || {});
+        s.request(1, 2, job(2), || {});
+        s.request(1, 3, job(3), || {});
+        assert!(s.busy(1));
+        drop(hold);
+        assert!(s.wait_idle(Duration::from_secs(10)));
+        assert_eq!(runs.load(Ordering::SeqCst), 2, "key 1, then key 3");
+        let d = s.latest(1).unwrap();
+        assert_eq!((d.key, d.value), (3, 30));
+        // A finished key is returned without a new job.
+        let d = s.request(1, 3, job(3), || {}).unwrap();
+        assert_eq!(d.value, 30);
+        assert!(!s.busy(1));
+        assert_eq!(runs.load(Ordering::SeqCst), 2);
+    }
+
+    #[test]
+    fn a_panicking_job_frees_its_slot() {
+        let s: Arc<Slots<u32, u32>> = Arc::new(Slots::default());
+        s.request(7, 1, || panic!("boom"), || {});
+        assert!(s.wait_idle(Duration::from_secs(10)));
+        assert!(s.latest(7).is_none());
+        s.request(7, 2, || 5, || {});
+        assert!(s.wait_idle(Duration::from_secs(10)));
+        assert_eq!(s.latest(7).unwrap().value, 5);
+    }
+}
