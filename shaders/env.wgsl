@@ -29,6 +29,11 @@ struct Frame {
     // Samples per pixel accumulated before this pass (index of its first
     // sample in each pixel's sequence).
     base: u32,
+    // The pixel columns of this dispatch, [x0, x1): one tile, drawn by the
+    // pipeline specialised for its model (the dispatch starts at x0).
+    x0: u32,
+    x1: u32,
+    pad: vec2<u32>,
 }
 
 // Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
@@ -55,6 +60,11 @@ fn r4(shift: vec4<u32>, n: u32) -> vec4<f32> {
     let v = shift + n * R4;
     return vec4<f32>(unit(v.x), unit(v.y), unit(v.z), unit(v.w));
 }
+
+// The model of every tile when the pipeline is specialised for one model
+// (src/gpu/shaders.rs, specialised_wgsl, which replaces this line); the
+// generic pipeline reads it per tile.
+const FIXED_MODEL: u32 = 0xffffffffu;
 
 @group(0) @binding(1) var<uniform> view: Frame;
 @group(0) @binding(2) var<storage, read> models: array<vec2<u32>>;
@@ -199,11 +209,12 @@ fn delta_radiance(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, on_torus: bo
 fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = u32(view.size.x);
     let h = u32(view.size.y);
-    if (id.x >= w || id.y >= h) {
+    let px = id.x + view.x0;
+    if (px >= min(view.x1, w) || id.y >= h) {
         return;
     }
-    let pixel = id.y * w + id.x;
-    let p = vec2<f32>(id.xy) + vec2<f32>(0.5);
+    let pixel = id.y * w + px;
+    let p = vec2<f32>(f32(px), f32(id.y)) + vec2<f32>(0.5);
     let on_torus = view.object == 1u;
     var s: SpherePoint;
     var x = vec3<f32>(0.0);
@@ -221,6 +232,7 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
         sum = envmap::radiance(normalize(vec3<f32>(q.x, -q.y, -1.0))) * f32(view.spp);
     } else {
         let m = models[u32(s.tile)];
+        let model = select(m.x, FIXED_MODEL, FIXED_MODEL != 0xffffffffu);
         let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
         // The pixel's shifts: fixed for the whole accumulation (the sequence
         // goes on across passes through view.base).
@@ -237,13 +249,13 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
             let n = view.base + k;
             // BRDF strategy.
             let u = r3(shift_b, n);
-            let wi = brdf_sampling::sample(m.x, m.y, wo, u);
+            let wi = brdf_sampling::sample(model, m.y, wo, u);
             if (wi.z > 0.0) {
-                let pb = brdf_sampling::pdf(m.x, m.y, wo, wi);
+                let pb = brdf_sampling::pdf(model, m.y, wo, wi);
                 if (pb > 0.0) {
                     let d = to_view(s, wi);
                     let pe = envmap::pdf(d);
-                    let f = brdf::eval(m.x, m.y, wi, wo);
+                    let f = brdf::eval(model, m.y, wi, wo);
                     let c = f * wi.z * (balance2(pb, pe) / pb);
                     // Trace the shadow ray only where it matters.
                     if (any(c > vec3<f32>(0.0)) && (!on_torus || torus::unoccluded(x, s.n, d))) {
@@ -258,8 +270,8 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
                 let wi2 = to_local(s, d);
                 let pe = envmap::pdf(d);
                 if (wi2.z > 0.0 && pe > 0.0) {
-                    let pb = brdf_sampling::pdf(m.x, m.y, wo, wi2);
-                    let f = brdf::eval(m.x, m.y, wi2, wo);
+                    let pb = brdf_sampling::pdf(model, m.y, wo, wi2);
+                    let f = brdf::eval(model, m.y, wi2, wo);
                     let c = f * wi2.z * (balance2(pe, pb) / pe);
                     if (any(c > vec3<f32>(0.0)) && (!on_torus || torus::unoccluded(x, s.n, d))) {
                         sum += c * envmap::radiance(d);
@@ -267,7 +279,7 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
         }
-        sum += delta_radiance(m.x, m.y, s, x, on_torus) * f32(view.spp);
+        sum += delta_radiance(model, m.y, s, x, on_torus) * f32(view.spp);
     }
     accum[pixel] += vec4<f32>(sum, f32(view.spp));
 }

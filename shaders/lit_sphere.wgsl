@@ -22,6 +22,11 @@ struct View {
     color2: vec4<f32>,
 }
 
+// The model of every tile when the pipeline is specialised for one model
+// (src/gpu/shaders.rs, specialised_wgsl, which replaces this line); the
+// generic pipeline reads it per tile.
+const FIXED_MODEL: u32 = 0xffffffffu;
+
 @group(0) @binding(1) var<uniform> view: View;
 // (model index, parameter offset) of the sphere in each tile.
 @group(0) @binding(2) var<storage, read> models: array<vec2<u32>>;
@@ -56,7 +61,8 @@ fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
     let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
     var radiance = vec3<f32>(0.0);
     if (wi.z > 0.0) {
-        radiance = brdf::eval(m.x, m.y, wi, wo) * wi.z * view.light.w;
+        let model = select(m.x, FIXED_MODEL, FIXED_MODEL != 0xffffffffu);
+        radiance = brdf::eval(model, m.y, wi, wo) * wi.z * view.light.w;
     }
     return vec4<f32>(display(radiance, view.exposure, view.tone), 1.0);
 }

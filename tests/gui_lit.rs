@@ -646,3 +646,74 @@ fn environment_error_rate() {
         }
     }
 }
+
+/// Lit sphere render time per model at a GUI size (not a pass/fail test).
+#[test]
+#[ignore]
+fn lit_timing() {
+    use bv::gpu::{Gpu, LitSphereRenderer};
+    let gpu = Gpu::headless().unwrap();
+    let mut lib = bv::gpu::shaders::ShaderLibrary::new().unwrap();
+    let mut lit = LitSphereRenderer::new(gpu.clone(), &mut lib).unwrap();
+    let (w, h) = (465u32, 370u32);
+    for m in ["lambert", "cook-torrance", "ward", "disney"] {
+        let spec = ModelSpec::new(m).unwrap();
+        let mut times = Vec::new();
+        for k in 0..12 {
+            let settings = bv::gpu::LitSphereSettings {
+                light: glam::DVec3::new(0.05 * k as f64, 0.3, 0.8),
+                ..Default::default()
+            };
+            let t = std::time::Instant::now();
+            lit.render(std::slice::from_ref(&spec), &settings, w, h)
+                .unwrap();
+            gpu.wait().unwrap();
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let first = times[0];
+        times.sort_by(f64::total_cmp);
+        println!(
+            "lit sphere {w}x{h} {m}: median {:.1} ms (first, with the pipeline build: {first:.0} ms)",
+            times[times.len() / 2]
+        );
+    }
+}
+
+/// Cost of a full-screen pass that does almost nothing (the environment
+/// view's display pass) at the lit sphere's size, for comparison.
+#[test]
+#[ignore]
+fn display_pass_timing() {
+    use bv::gpu::{EnvRenderer, EnvSettings, EnvironmentMap, Gpu};
+    let gpu = Gpu::headless().unwrap();
+    let mut lib = bv::gpu::shaders::ShaderLibrary::new().unwrap();
+    let mut env =
+        EnvRenderer::new(gpu.clone(), &mut lib, &EnvironmentMap::constant([1.0; 3])).unwrap();
+    let (w, h) = (465u32, 370u32);
+    let spec = ModelSpec::new("lambert").unwrap();
+    env.render(
+        std::slice::from_ref(&spec),
+        &EnvSettings::default(),
+        w,
+        h,
+        1,
+    )
+    .unwrap();
+    gpu.wait().unwrap();
+    let mut times = Vec::new();
+    for k in 0..12 {
+        let s = EnvSettings {
+            exposure_ev: 0.1 * k as f64,
+            ..Default::default()
+        };
+        let t = std::time::Instant::now();
+        env.display(&s, w, h).unwrap();
+        gpu.wait().unwrap();
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    println!(
+        "display pass {w}x{h}: median {:.1} ms",
+        times[times.len() / 2]
+    );
+}

@@ -271,6 +271,9 @@ struct FrameUniform {
     fov_tan: f32,
     object: u32,
     base: u32,
+    x0: u32,
+    x1: u32,
+    pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -317,7 +320,14 @@ struct Key {
 /// The progressive environment renderer.
 pub struct EnvRenderer {
     gpu: Gpu,
+    library: ShaderLibrary,
+    layout: wgpu::PipelineLayout,
+    frame_layout: wgpu::BindGroupLayout,
+    map_layout: wgpu::BindGroupLayout,
+    /// The generic accumulation pipeline, and those specialised for one
+    /// model (built on first use; `None` remembers a failure).
     accumulate: wgpu::ComputePipeline,
+    specialised: std::collections::HashMap<u32, Option<wgpu::ComputePipeline>>,
     show: wgpu::RenderPipeline,
     env: EnvBuffers,
     accum: Option<wgpu::Buffer>,
@@ -340,6 +350,53 @@ impl std::fmt::Debug for EnvRenderer {
 
 const WORKGROUP: u32 = 8;
 
+/// The bindings of env.wgsl (group 0: the frame; group 1: the map), all
+/// visible to the compute stage: one layout for the generic and the
+/// specialised pipelines (a specialised shader may leave some unused).
+fn bind_group_layouts(device: &wgpu::Device) -> (wgpu::BindGroupLayout, wgpu::BindGroupLayout) {
+    let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let read = wgpu::BufferBindingType::Storage { read_only: true };
+    let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("env frame"),
+        entries: &[
+            buffer(0, read),
+            buffer(1, wgpu::BufferBindingType::Uniform),
+            buffer(2, read),
+            buffer(3, wgpu::BufferBindingType::Storage { read_only: false }),
+            buffer(8, read),
+        ],
+    });
+    let map = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("env map"),
+        entries: &[buffer(0, wgpu::BufferBindingType::Uniform), buffer(1, read)],
+    });
+    (frame, map)
+}
+
+fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("env accumulate"),
+        layout: Some(layout),
+        module,
+        entry_point: Some("accumulate"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
 impl EnvRenderer {
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
@@ -352,16 +409,15 @@ impl EnvRenderer {
             );
         }
         let module = library.shader_module(&gpu.device, "env")?;
-        let accumulate = gpu
+        let (frame_layout, map_layout) = bind_group_layouts(&gpu.device);
+        let layout = gpu
             .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("env accumulate"),
-                layout: None,
-                module: &module,
-                entry_point: Some("accumulate"),
-                compilation_options: Default::default(),
-                cache: None,
+                bind_group_layouts: &[Some(&frame_layout), Some(&map_layout)],
+                immediate_size: 0,
             });
+        let accumulate = compute_pipeline(&gpu.device, &layout, &module);
         let show_module = library.shader_module(&gpu.device, "env_display")?;
         let show = gpu
             .device
@@ -389,7 +445,12 @@ impl EnvRenderer {
         let env = Self::upload(&gpu, map, 0)?;
         Ok(Self {
             gpu,
+            library: ShaderLibrary::new()?,
+            layout,
+            frame_layout,
+            map_layout,
             accumulate,
+            specialised: std::collections::HashMap::new(),
             show,
             env,
             accum: None,
@@ -630,8 +691,18 @@ impl EnvRenderer {
             self.frame = 0;
             self.samples = 0;
         }
-        let accum = self.accum.as_ref().context("accumulation buffer")?;
         let (params, refs, tables) = pack_all(models)?;
+        for r in &refs {
+            if !self.specialised.contains_key(&r.model) {
+                let built = self
+                    .library
+                    .specialised_module(&d, "env", Some(r.model))
+                    .ok()
+                    .map(|m| compute_pipeline(&d, &self.layout, &m));
+                self.specialised.insert(r.model, built);
+            }
+        }
+        let accum = self.accum.as_ref().context("accumulation buffer")?;
         let tbuf = self.tables.get(&self.gpu, &tables)?;
         let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
         let frame = FrameUniform {
@@ -643,6 +714,9 @@ impl EnvRenderer {
             object: self.object.index(),
             // Sequences restart after 2^32 samples per pixel (never in practice).
             base: self.samples as u32,
+            x0: 0,
+            x1: width,
+            pad: [0; 2],
         };
         let env = EnvUniform {
             width: self.env.size.0,
@@ -665,11 +739,6 @@ impl EnvRenderer {
             bytemuck::cast_slice(&params),
             wgpu::BufferUsages::STORAGE,
         );
-        let fbuf = init(
-            "frame",
-            bytemuck::bytes_of(&frame),
-            wgpu::BufferUsages::UNIFORM,
-        );
         let mbuf = init(
             "models",
             bytemuck::cast_slice(&tiles),
@@ -680,29 +749,51 @@ impl EnvRenderer {
             bytemuck::bytes_of(&env),
             wgpu::BufferUsages::UNIFORM,
         );
-        let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("env frame"),
-            layout: &self.accumulate.get_bind_group_layout(0),
-            entries: &[
-                entry(0, &pbuf),
-                entry(1, &fbuf),
-                entry(2, &mbuf),
-                entry(3, accum),
-                entry(8, tbuf),
-            ],
-        });
         let g1 = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("env map"),
-            layout: &self.accumulate.get_bind_group_layout(1),
+            layout: &self.map_layout,
             entries: &[entry(0, &ebuf), entry(1, &self.env.data)],
         });
         let mut enc = d.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.accumulate);
-            pass.set_bind_group(0, &g0, &[]);
             pass.set_bind_group(1, &g1, &[]);
-            pass.dispatch_workgroups(width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP), 1);
+            // One dispatch per tile, over its columns, with its model's
+            // pipeline.
+            for (k, r) in refs.iter().enumerate() {
+                let x0 = super::lit_sphere::tile_start(k, refs.len(), width);
+                let x1 = super::lit_sphere::tile_start(k + 1, refs.len(), width);
+                if x1 <= x0 {
+                    continue;
+                }
+                let fbuf = init(
+                    "frame",
+                    bytemuck::bytes_of(&FrameUniform { x0, x1, ..frame }),
+                    wgpu::BufferUsages::UNIFORM,
+                );
+                let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("env frame"),
+                    layout: &self.frame_layout,
+                    entries: &[
+                        entry(0, &pbuf),
+                        entry(1, &fbuf),
+                        entry(2, &mbuf),
+                        entry(3, accum),
+                        entry(8, tbuf),
+                    ],
+                });
+                let p = match self.specialised.get(&r.model) {
+                    Some(Some(p)) => p,
+                    _ => &self.accumulate,
+                };
+                pass.set_pipeline(p);
+                pass.set_bind_group(0, &g0, &[]);
+                pass.dispatch_workgroups(
+                    (x1 - x0).div_ceil(WORKGROUP),
+                    height.div_ceil(WORKGROUP),
+                    1,
+                );
+            }
         }
         self.gpu.queue.submit([enc.finish()]);
         self.frame = self.frame.wrapping_add(1);

@@ -79,48 +79,148 @@ struct ViewUniform {
     color2: [f32; 4],
 }
 
-/// The lit-sphere renderer: persistent pipeline, re-renders on demand.
-#[derive(Debug)]
+/// The lit-sphere renderer: persistent pipelines, re-renders on demand.
+///
+/// Each sphere is drawn by a pipeline specialised for its model (built on
+/// first use and kept; see [`ShaderLibrary::specialised_wgsl`] for why), the
+/// generic pipeline standing in while one cannot be built.
 pub struct LitSphereRenderer {
     gpu: Gpu,
-    pipeline: wgpu::RenderPipeline,
+    library: ShaderLibrary,
+    layout: wgpu::PipelineLayout,
+    bind_layout: wgpu::BindGroupLayout,
+    generic: wgpu::RenderPipeline,
+    specialised: std::collections::HashMap<u32, Option<wgpu::RenderPipeline>>,
     target: Option<Target>,
     tables: TableBuffer,
 }
 
+impl std::fmt::Debug for LitSphereRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LitSphereRenderer")
+            .field("specialised", &self.specialised.len())
+            .finish_non_exhaustive()
+    }
+}
+
+/// The bindings of lit_sphere.wgsl, all visible to the fragment stage: a
+/// layout shared by the generic and the specialised pipelines (a specialised
+/// shader may leave some unused).
+fn bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("lit sphere"),
+        entries: &[
+            storage(0),
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            storage(2),
+            storage(8),
+        ],
+    })
+}
+
+fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("lit sphere"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(TARGET_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The first pixel column of tile `k` of `tiles` in an image `width` wide:
+/// pixel x belongs to the tile of its centre, ⌊(x + ½)/tile_w⌋, as in
+/// shaders/common/sphere.wgsl (columns at a boundary are background).
+pub fn tile_start(k: usize, tiles: usize, width: u32) -> u32 {
+    if k == 0 {
+        return 0;
+    }
+    if k >= tiles {
+        return width;
+    }
+    let tile_w = f64::from(width) / tiles as f64;
+    ((k as f64 * tile_w - 0.5).ceil().max(0.0) as u32).min(width)
+}
+
 impl LitSphereRenderer {
-    /// Builds the pipeline on `gpu`.
+    /// Builds the generic pipeline on `gpu` (specialised ones follow on use).
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary) -> Result<Self> {
         let module = library.shader_module(&gpu.device, "lit_sphere")?;
-        let pipeline = gpu
+        let bind_layout = bind_group_layout(&gpu.device);
+        let layout = gpu
             .device
-            .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            .create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("lit sphere"),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: None,
-                multisample: wgpu::MultisampleState::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some("fs_main"),
-                    compilation_options: Default::default(),
-                    targets: &[Some(TARGET_FORMAT.into())],
-                }),
-                multiview_mask: None,
-                cache: None,
+                bind_group_layouts: &[Some(&bind_layout)],
+                immediate_size: 0,
             });
+        let generic = pipeline(&gpu.device, &layout, &module);
         Ok(Self {
             gpu,
-            pipeline,
+            library: ShaderLibrary::new()?,
+            layout,
+            bind_layout,
+            generic,
+            specialised: std::collections::HashMap::new(),
             target: None,
             tables: TableBuffer::default(),
         })
+    }
+
+    /// Builds the pipeline specialised for catalogue model `model` if it is
+    /// not there yet (`None` remembers a failure: the generic one is used).
+    fn ensure_specialised(&mut self, model: u32) {
+        if self.specialised.contains_key(&model) {
+            return;
+        }
+        let built = self
+            .library
+            .specialised_module(&self.gpu.device, "lit_sphere", Some(model))
+            .ok()
+            .map(|m| pipeline(&self.gpu.device, &self.layout, &m));
+        self.specialised.insert(model, built);
+    }
+
+    /// How many specialised pipelines exist (for tests).
+    pub fn specialised_count(&self) -> usize {
+        self.specialised.values().filter(|p| p.is_some()).count()
     }
 
     /// The device it renders on.
@@ -188,10 +288,14 @@ impl LitSphereRenderer {
             bytemuck::cast_slice(&tiles),
             wgpu::BufferUsages::STORAGE,
         );
+        for r in &refs {
+            self.ensure_specialised(r.model);
+        }
+        let d = &self.gpu.device;
         let tbuf = self.tables.get(&self.gpu, &tables)?;
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lit sphere"),
-            layout: &self.pipeline.get_bind_group_layout(0),
+            layout: &self.bind_layout,
             entries: &[
                 entry(0, &pbuf),
                 entry(1, &ubuf),
@@ -218,9 +322,23 @@ impl LitSphereRenderer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..3, 0..1);
+            // One draw per sphere, each clipped to its tile, with its model's
+            // pipeline.
+            for (k, r) in refs.iter().enumerate() {
+                let x0 = tile_start(k, refs.len(), width);
+                let x1 = tile_start(k + 1, refs.len(), width);
+                if x1 <= x0 {
+                    continue;
+                }
+                let p = match self.specialised.get(&r.model) {
+                    Some(Some(p)) => p,
+                    _ => &self.generic,
+                };
+                pass.set_pipeline(p);
+                pass.set_scissor_rect(x0, 0, x1 - x0, height);
+                pass.draw(0..3, 0..1);
+            }
         }
         self.gpu.queue.submit([enc.finish()]);
         Ok(&target.texture)
@@ -296,4 +414,32 @@ pub fn reference_image(
         *px = image::Rgba([to_u8(c.x), to_u8(c.y), to_u8(c.z), 255]);
     }
     Ok(img)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu::sphere::sphere_at;
+    use glam::DVec2;
+
+    #[test]
+    fn tile_columns_partition_the_image_like_the_shader() {
+        for (tiles, width) in [(1usize, 7u32), (2, 300), (3, 301), (5, 97), (4, 1024)] {
+            assert_eq!(tile_start(0, tiles, width), 0);
+            assert_eq!(tile_start(tiles, tiles, width), width);
+            for k in 0..tiles {
+                let (x0, x1) = (tile_start(k, tiles, width), tile_start(k + 1, tiles, width));
+                assert!(x0 <= x1);
+                // Every sphere pixel of a column in [x0, x1) belongs to tile k.
+                let size = DVec2::new(f64::from(width), 100.0);
+                for x in x0..x1 {
+                    for y in [10.0, 50.0, 90.0] {
+                        if let Some(s) = sphere_at(DVec2::new(f64::from(x) + 0.5, y), size, tiles) {
+                            assert_eq!(s.tile, k, "{tiles} tiles, width {width}, x {x}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
