@@ -717,3 +717,35 @@ fn display_pass_timing() {
         times[times.len() / 2]
     );
 }
+
+/// The lit sphere view's frame in a harness while a parameter changes every
+/// frame (not a pass/fail test): ui + render of the window image.
+#[test]
+#[ignore]
+fn lit_view_frame_timing() {
+    let state = state_with(&[("cook-torrance", serde_json::json!({}))]);
+    for interacting in [true, false] {
+        let mut h = view_only(state.clone(), LitSphereView::new(), [930.0, 740.0], LitSphereView::ready);
+        h.state_mut().interacting = interacting;
+        let mut times = Vec::new();
+        for k in 0..15 {
+            let id = h.state().state.brdfs[0].id;
+            let e = h.state_mut().state.entry_mut(id).unwrap();
+            e.spec
+                .set("alpha_x", ParamValue::Float(0.1 + 0.02 * k as f64))
+                .unwrap();
+            let s = h.state().state.clone();
+            h.state_mut().runtime.sync(&s);
+            let t = std::time::Instant::now();
+            h.run_steps(1);
+            let _ = h.render().unwrap();
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        times.sort_by(f64::total_cmp);
+        println!(
+            "lit sphere view 930x740 (interacting {interacting}): median frame {:.1} ms, renders {}",
+            times[times.len() / 2],
+            h.state().view.render_count()
+        );
+    }
+}
