@@ -290,6 +290,20 @@ fn environment_accumulates_and_restarts_on_changes() {
     assert!(s1 > s0, "no new samples: {s0} then {s1}");
     let restarts = env(&h).restart_count();
 
+    // A click that changes nothing (on the view itself) keeps the samples.
+    let rect = env(&h).view_rect.unwrap();
+    for pressed in [true, false] {
+        h.event(egui::Event::PointerButton {
+            pos: rect.center(),
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+        h.run_steps(1);
+    }
+    assert_eq!(env(&h).restart_count(), restarts, "a click restarted");
+    assert!(env(&h).samples_per_pixel() > s1);
+
     // A parameter change restarts.
     let id = h.state().state().brdfs[0].id;
     h.state_mut().push(Command::SetParam {
@@ -725,7 +739,12 @@ fn display_pass_timing() {
 fn lit_view_frame_timing() {
     let state = state_with(&[("cook-torrance", serde_json::json!({}))]);
     for interacting in [true, false] {
-        let mut h = view_only(state.clone(), LitSphereView::new(), [930.0, 740.0], LitSphereView::ready);
+        let mut h = view_only(
+            state.clone(),
+            LitSphereView::new(),
+            [930.0, 740.0],
+            LitSphereView::ready,
+        );
         h.state_mut().interacting = interacting;
         let mut times = Vec::new();
         for k in 0..15 {

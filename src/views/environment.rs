@@ -122,6 +122,7 @@ pub struct EnvironmentView {
     /// Measured device seconds per sample per pixel (running average).
     spp_cost: Option<f64>,
     max_pass: u32,
+    scale_in_use: Option<f32>,
     restarts: u64,
     restarted_at: Option<Instant>,
     /// Seconds from the last restart to the target sample count.
@@ -155,6 +156,7 @@ impl EnvironmentView {
             pass_spp: 1,
             spp_cost: None,
             max_pass: MAX_PASS_SPP,
+            scale_in_use: None,
             restarts: 0,
             restarted_at: None,
             converged_after: None,
@@ -286,6 +288,40 @@ impl EnvironmentView {
                     self.loading = None;
                 }
             }
+        }
+    }
+
+    /// The resolution of this frame: the preview resolution only when the
+    /// image has to restart while a pointer button is held (a slider drag),
+    /// so that a click elsewhere does not throw the samples away; back to the
+    /// resting resolution when the button is released.
+    fn choose_scale(
+        &self,
+        rect: Rect,
+        pixels_per_point: f32,
+        scene: &Scene<'_>,
+        drawables: &[Drawable],
+        software: bool,
+    ) -> f32 {
+        let rest = accumulation_scale(scene.figure, false, software);
+        if scene.figure || !scene.interacting {
+            return rest;
+        }
+        let current = self.scale_in_use.unwrap_or(rest);
+        let env = &scene.state.lighting.env;
+        let changed = match self.renderer.ready() {
+            Some(r) => {
+                let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
+                let (w, h) = gpu_image::pixel_size(rect, pixels_per_point * current);
+                r.object() != env.object.to_gpu()
+                    || r.would_restart(&specs, &Self::settings(env), w, h)
+            }
+            None => false,
+        };
+        if changed {
+            accumulation_scale(false, true, software)
+        } else {
+            current
         }
     }
 
@@ -629,7 +665,14 @@ impl View for EnvironmentView {
             gpu_image::drawables(scene, env.side_by_side, &mut self.pack_check);
         let rs = gpu_image::render_state(ui.ctx());
         let software = rs.as_ref().is_some_and(gpu_image::is_software);
-        let scale = accumulation_scale(scene.figure, scene.interacting, software);
+        let scale = self.choose_scale(
+            rect,
+            ui.ctx().pixels_per_point(),
+            scene,
+            &drawables,
+            software,
+        );
+        self.scale_in_use = Some(scale);
         if let Some(rs) = &rs {
             self.image.set_filter(
                 rs,

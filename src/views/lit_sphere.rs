@@ -37,6 +37,8 @@ struct FrameKey {
     specs: Vec<ModelSpec>,
     settings: LitSphereSettings,
     size: (u32, u32),
+    /// Resolution relative to the view's pixels.
+    scale: f32,
 }
 
 /// The lit sphere view.
@@ -109,6 +111,7 @@ impl LitSphereView {
         drawables: &[Drawable],
         settings: LitSphereSettings,
         size: (u32, u32),
+        scale: f32,
         figure: bool,
     ) -> Option<egui::TextureId> {
         let rs = gpu_image::render_state(ui.ctx())?;
@@ -135,6 +138,7 @@ impl LitSphereView {
             specs: drawables.iter().map(|d| d.spec.clone()).collect(),
             settings,
             size,
+            scale,
         };
         if self.drawn.as_ref() == Some(&key) {
             return self.image.current();
@@ -215,11 +219,19 @@ impl View for LitSphereView {
         }
         let ppp = ui.ctx().pixels_per_point();
         // While something is dragged on a software renderer, a quarter of the
-        // pixels keeps the drag smooth; the full image follows on release.
+        // pixels keeps the drag smooth; the full image follows on release. A
+        // click that changes nothing keeps the image as it is.
         let rs = gpu_image::render_state(ui.ctx());
         let software = rs.as_ref().is_some_and(gpu_image::is_software);
         let scale = if software && scene.interacting && !scene.figure {
-            DRAG_SCALE
+            let current = self.drawn.as_ref().map_or(1.0, |k| k.scale);
+            let unchanged = self.drawn.as_ref().is_some_and(|k| {
+                k.specs.len() == drawables.len()
+                    && k.specs.iter().zip(&drawables).all(|(a, b)| *a == b.spec)
+                    && k.settings == Self::settings(scene, dark, ppp * current)
+                    && k.size == gpu_image::pixel_size(rect, ppp * current)
+            });
+            if unchanged { current } else { DRAG_SCALE }
         } else {
             1.0
         };
@@ -236,7 +248,7 @@ impl View for LitSphereView {
         let size = gpu_image::pixel_size(rect, ppp * scale);
         let settings = Self::settings(scene, dark, ppp * scale);
         if !drawables.is_empty()
-            && let Some(id) = self.render(ui, &drawables, settings, size, scene.figure)
+            && let Some(id) = self.render(ui, &drawables, settings, size, scale, scene.figure)
         {
             painter.image(
                 id,
@@ -398,8 +410,8 @@ impl LitSphereView {
         let painter = ui.painter_at(rect);
         gpu_image::plate_text(
             &painter,
-            rect.right_top() + Vec2::new(-6.0, 6.0),
-            Align2::RIGHT_TOP,
+            rect.right_bottom() + Vec2::new(-6.0, -6.0),
+            Align2::RIGHT_BOTTOM,
             &format!(
                 "L = f·cos θi·E = ({:.4}, {:.4}, {:.4})\nθi {:.1}°, θo {:.1}° in the local frame",
                 l.x,
