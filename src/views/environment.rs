@@ -31,9 +31,10 @@ use std::time::Instant;
 pub const MAX_PASS_SPP: u32 = 64;
 
 /// Device time a pass may take per frame while the image is left alone: the
-/// window then still answers at about 15–20 frames per second on a software
-/// renderer, and a GPU adds its 64 samples per frame at once.
-pub const PASS_BUDGET_S: f64 = 0.045;
+/// window then still answers at about 10 frames per second on a software
+/// renderer (whose own frame takes ~40 ms), and a GPU adds its 64 samples
+/// per frame at once.
+pub const PASS_BUDGET_S: f64 = 0.06;
 
 /// Resolution of the accumulation relative to the view's pixels (the image is
 /// stretched with linear filtering when it is smaller):
