@@ -11,19 +11,49 @@
 #import bv::models::mirror
 #import bv::models::glass
 #import bv::frame::PI
-#import bv::sampling::{pcg, rand}
+#import bv::sampling::pcg
 #import bv::sphere::{sphere_at, to_local, to_view, SpherePoint}
+#import bv::torus
 
 struct Frame {
     size: vec2<f32>,
     tiles: u32,
-    // Index of this pass since the last restart (seeds the random numbers).
+    // Index of this pass since the last restart (the sampler uses `base`).
     frame: u32,
     // Samples of each strategy per pixel in this pass.
     spp: u32,
     // tan of half the background's field of view.
     fov_tan: f32,
-    pad: vec2<f32>,
+    // 0: spheres, 1: tori (src/gpu/env.rs, Object).
+    object: u32,
+    // Samples per pixel accumulated before this pass (index of its first
+    // sample in each pixel's sequence).
+    base: u32,
+}
+
+// Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
+// quasirandom sequences", 2018): point n is fract(shift + n·α) with
+// α_i = φ_d^−i, φ_d the positive root of x^(d+1) = x + 1. Kept in 0.32 fixed
+// point so that n·α wraps exactly (an f32 product loses the fraction after a
+// few thousand samples). Each pixel gets its own random shift (Cranley-
+// Patterson rotation), so every sample is still uniform (the estimate stays
+// unbiased) while the samples of one pixel are stratified, which takes the
+// visible noise down much faster than independent random numbers.
+const R3: vec3<u32> = vec3<u32>(3518319155u, 2882110345u, 2360945575u);
+const R4: vec4<u32> = vec4<u32>(3679390609u, 3152041523u, 2700274806u, 2313257605u);
+
+fn unit(v: u32) -> f32 {
+    return f32(v >> 8u) * (1.0 / 16777216.0);
+}
+
+fn r3(shift: vec3<u32>, n: u32) -> vec3<f32> {
+    let v = shift + n * R3;
+    return vec3<f32>(unit(v.x), unit(v.y), unit(v.z));
+}
+
+fn r4(shift: vec4<u32>, n: u32) -> vec4<f32> {
+    let v = shift + n * R4;
+    return vec4<f32>(unit(v.x), unit(v.y), unit(v.z), unit(v.w));
 }
 
 @group(0) @binding(1) var<uniform> view: Frame;
@@ -84,16 +114,83 @@ fn delta_leaf(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
-fn delta_radiance(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
+// The environment seen from torus point p (normal n) along d: 0 where the
+// torus itself is in the way (direct lighting only, no interreflection).
+fn torus_radiance(p: vec3<f32>, n: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
+    if (torus::unoccluded(p, n, d)) {
+        return envmap::radiance(d);
+    }
+    return vec3<f32>(0.0);
+}
+
+// glass_path for the torus: the refracted path is traced through the tube by
+// its distance function (up to 8 exits); light leaving the tube is taken from
+// the environment even where it would meet the torus again.
+fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let eta = glass::eta(o);
+    let d = vec3<f32>(0.0, 0.0, -1.0);
+    let c = -dot(d, n);
+    let f = glass::reflectance(o, c);
+    var l = f * torus_radiance(p0, n, reflect(d, n));
+    var dir = refract(d, n, 1.0 / eta);
+    if (dot(dir, dir) == 0.0) {
+        return l;
+    }
+    var p = p0;
+    var m_in = n;
+    var through = 1.0 - f;
+    for (var k = 0; k < 8; k++) {
+        let t = torus::trace_inside(p, m_in, dir);
+        if (t < 0.0) {
+            break;
+        }
+        p = p + t * dir;
+        let m = torus::normal(p);
+        let ci = dot(dir, m);
+        let fi = glass::reflectance(o, -ci);
+        let out = refract(dir, -m, eta);
+        if (dot(out, out) > 0.0) {
+            l += through * (1.0 - fi) * envmap::radiance(out);
+        }
+        through *= fi;
+        dir = reflect(dir, -m);
+        m_in = m;
+        if (through < 1e-4) {
+            break;
+        }
+    }
+    return l;
+}
+
+fn delta_leaf_torus(model: u32, o: u32, s: SpherePoint, p: vec3<f32>) -> vec3<f32> {
+    if (model == L::MODEL_MIRROR) {
+        let v = vec3<f32>(0.0, 0.0, 1.0);
+        let c = dot(v, s.n);
+        return mirror::reflectance(o, c) * torus_radiance(p, s.n, 2.0 * c * s.n - v);
+    }
+    if (model == L::MODEL_GLASS) {
+        return glass_path_torus(o, p, s.n);
+    }
+    return vec3<f32>(0.0);
+}
+
+fn delta_any(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, on_torus: bool) -> vec3<f32> {
+    if (on_torus) {
+        return delta_leaf_torus(model, o, s, p);
+    }
+    return delta_leaf(model, o, s);
+}
+
+fn delta_radiance(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, on_torus: bool) -> vec3<f32> {
     if (model != L::MODEL_MIX) {
-        return delta_leaf(model, o, s);
+        return delta_any(model, o, s, p, on_torus);
     }
     let n = pu(o + L::MIX_COMPONENTS);
     let table = pu(o + L::MIX_COMPONENTS + 1u);
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < n; j++) {
         let e = table + L::COMPONENT_ENTRY_SLOTS * j;
-        sum += pf(e) * delta_leaf(pu(e + 1u), pu(e + 2u), s);
+        sum += pf(e) * delta_any(pu(e + 1u), pu(e + 2u), s, p, on_torus);
     }
     return sum;
 }
@@ -107,7 +204,16 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let pixel = id.y * w + id.x;
     let p = vec2<f32>(id.xy) + vec2<f32>(0.5);
-    let s = sphere_at(p, view.size, view.tiles);
+    let on_torus = view.object == 1u;
+    var s: SpherePoint;
+    var x = vec3<f32>(0.0);
+    if (on_torus) {
+        let hit = torus::torus_at(p, view.size, view.tiles);
+        s = hit.s;
+        x = hit.p;
+    } else {
+        s = sphere_at(p, view.size, view.tiles);
+    }
     var sum = vec3<f32>(0.0);
     if (s.tile < 0) {
         // Background: the environment through a pinhole of the given field of view.
@@ -116,10 +222,21 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         let m = models[u32(s.tile)];
         let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
-        var rng = pcg(pixel ^ pcg(view.frame * 9781u + 1u));
+        // The pixel's shifts: fixed for the whole accumulation (the sequence
+        // goes on across passes through view.base).
+        let h0 = pcg(pixel * 7919u + 17u);
+        let h1 = pcg(h0 ^ 0x9e3779b9u);
+        let h2 = pcg(h1 ^ 0x85ebca6bu);
+        let h3 = pcg(h2 ^ 0xc2b2ae35u);
+        let h4 = pcg(h3 ^ 0x27d4eb2fu);
+        let h5 = pcg(h4 ^ 0x165667b1u);
+        let h6 = pcg(h5 ^ 0xd3a2646cu);
+        let shift_b = vec3<u32>(h0, h1, h2);
+        let shift_e = vec4<u32>(h3, h4, h5, h6);
         for (var k = 0u; k < view.spp; k++) {
+            let n = view.base + k;
             // BRDF strategy.
-            let u = vec3<f32>(rand(&rng), rand(&rng), rand(&rng));
+            let u = r3(shift_b, n);
             let wi = brdf_sampling::sample(m.x, m.y, wo, u);
             if (wi.z > 0.0) {
                 let pb = brdf_sampling::pdf(m.x, m.y, wo, wi);
@@ -127,23 +244,30 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
                     let d = to_view(s, wi);
                     let pe = envmap::pdf(d);
                     let f = brdf::eval(m.x, m.y, wi, wo);
-                    sum += f * wi.z * envmap::radiance(d) * (balance2(pb, pe) / pb);
+                    let c = f * wi.z * (balance2(pb, pe) / pb);
+                    // Trace the shadow ray only where it matters.
+                    if (any(c > vec3<f32>(0.0)) && (!on_torus || torus::unoccluded(x, s.n, d))) {
+                        sum += c * envmap::radiance(d);
+                    }
                 }
             }
             // Environment strategy.
             if (envmap::env.sampling != 0u) {
-                let ue = vec4<f32>(rand(&rng), rand(&rng), rand(&rng), rand(&rng));
+                let ue = r4(shift_e, n);
                 let d = envmap::sample(ue);
                 let wi2 = to_local(s, d);
                 let pe = envmap::pdf(d);
                 if (wi2.z > 0.0 && pe > 0.0) {
                     let pb = brdf_sampling::pdf(m.x, m.y, wo, wi2);
                     let f = brdf::eval(m.x, m.y, wi2, wo);
-                    sum += f * wi2.z * envmap::radiance(d) * (balance2(pe, pb) / pe);
+                    let c = f * wi2.z * (balance2(pe, pb) / pe);
+                    if (any(c > vec3<f32>(0.0)) && (!on_torus || torus::unoccluded(x, s.n, d))) {
+                        sum += c * envmap::radiance(d);
+                    }
                 }
             }
         }
-        sum += delta_radiance(m.x, m.y, s) * f32(view.spp);
+        sum += delta_radiance(m.x, m.y, s, x, on_torus) * f32(view.spp);
     }
     accum[pixel] += vec4<f32>(sum, f32(view.spp));
 }

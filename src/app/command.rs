@@ -84,6 +84,10 @@ pub enum Command {
     OpenFileDialog,
     /// Opens or closes the keyboard help.
     ToggleHelp,
+    /// Sets the lit sphere view's settings.
+    SetLitView(super::lighting::LitView),
+    /// Sets the environment view's settings.
+    SetEnvView(super::lighting::EnvView),
 }
 
 /// What applying a command did, beyond changing the state.
@@ -244,6 +248,14 @@ impl Command {
                 out.open = Some((path, target));
             }
             Command::OpenFileDialog => out.open_dialog = true,
+            Command::SetLitView(v) => {
+                state.lighting.lit = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
+            Command::SetEnvView(v) => {
+                state.lighting.env = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
         }
         out
     }

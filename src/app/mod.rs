@@ -10,6 +10,7 @@
 
 pub mod command;
 pub mod files;
+pub mod lighting;
 pub mod loader;
 pub mod measured_ui;
 pub mod panel;

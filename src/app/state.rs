@@ -260,6 +260,8 @@ pub struct AppState {
     pub maximised: Option<String>,
     /// Colour theme.
     pub theme: Theme,
+    /// Settings of the lit sphere and environment views.
+    pub lighting: super::lighting::Lighting,
 }
 
 impl Default for AppState {
@@ -276,6 +278,7 @@ impl Default for AppState {
             plots: PlotSettings::default(),
             maximised: None,
             theme: Theme::default(),
+            lighting: Default::default(),
         }
     }
 }
@@ -358,6 +361,7 @@ impl AppState {
             .display
             .sh_order
             .min(bv_core::represent::sh::MAX_ORDER as u8);
+        self.lighting = self.lighting.sanitised();
         self.version = STATE_VERSION;
         self
     }

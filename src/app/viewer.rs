@@ -50,6 +50,11 @@ pub const GESTURES: &[(&str, &str)] = &[
     ("shift + drag (lobe)", "move the light"),
     ("double-click (lobe)", "reset the camera"),
     ("drag (light disc)", "move the light"),
+    (
+        "drag (lit sphere)",
+        "move the light to the point under the pointer",
+    ),
+    ("drop a .hdr / .exr file", "use it as the environment"),
     ("double-click (slider)", "reset the value to its default"),
     ("drag / scroll (plots)", "pan / zoom; double-click to fit"),
 ];
@@ -69,6 +74,9 @@ pub struct Viewer {
     files: Files<()>,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
+    /// Draw as a figure (a screenshot of the window): views finish slow work
+    /// (renderer builds, environment sampling) before drawing.
+    pub figure: bool,
     /// Scene files, figure export and toasts.
     pub export: ExportUi,
 }
@@ -89,6 +97,7 @@ impl Viewer {
             last_load: None,
             files: Files::default(),
             force_interacting: false,
+            figure: false,
             export: ExportUi::default(),
         }
     }
@@ -316,7 +325,8 @@ impl Viewer {
         self.top_bar(ui, &mut out);
         self.left_panel(ui, &mut out);
         {
-            let scene = build_scene(&self.state, &self.runtime, interacting);
+            let mut scene = build_scene(&self.state, &self.runtime, interacting);
+            scene.figure = self.figure;
             let views = &mut self.views;
             egui::CentralPanel::default().show(ui, |ui| {
                 central(ui, views, &scene, &mut out);
@@ -700,8 +710,11 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
     }
 }
 
-/// Where each view goes: the maximised one fills the area; otherwise the
-/// first view takes the left part and the others stack on the right.
+/// Where each view goes: the maximised one fills the area. Up to three views:
+/// the first takes the left part and the others stack on the right. From four
+/// on: the first two share the top row (the lobe and the lit sphere side by
+/// side), the others fill rows of up to three below (four views make a 2×2
+/// grid).
 pub fn layout(area: Rect, n: usize, maximised: Option<usize>) -> Vec<(usize, Rect)> {
     const GAP: f32 = 6.0;
     if let Some(i) = maximised.filter(|&i| i < n) {
@@ -710,7 +723,7 @@ pub fn layout(area: Rect, n: usize, maximised: Option<usize>) -> Vec<(usize, Rec
     match n {
         0 => Vec::new(),
         1 => vec![(0, area)],
-        _ => {
+        2 | 3 => {
             let left_w = (area.width() * 0.56).round();
             let left = Rect::from_min_size(area.min, Vec2::new(left_w - GAP * 0.5, area.height()));
             let right_x = area.min.x + left_w + GAP * 0.5;
@@ -723,6 +736,46 @@ pub fn layout(area: Rect, n: usize, maximised: Option<usize>) -> Vec<(usize, Rec
                     k + 1,
                     Rect::from_min_max(egui::pos2(right_x, y), egui::pos2(area.max.x, y + h)),
                 ));
+            }
+            out
+        }
+        _ => {
+            // Rows: the top one (2 views, weight TOP) and ⌈(n − 2)/3⌉ below
+            // (weight 1 each), the views of a row sharing its width equally
+            // except the top row's 55/45 split.
+            const TOP: f32 = 1.3;
+            let rest = n - 2;
+            let rows_below = rest.div_ceil(3);
+            let weights = TOP + rows_below as f32;
+            let free = area.height() - GAP * rows_below as f32;
+            let top_h = free * TOP / weights;
+            let row_h = free / weights;
+            let mut out = Vec::with_capacity(n);
+            let split = (area.width() * 0.55).round();
+            out.push((
+                0,
+                Rect::from_min_size(area.min, Vec2::new(split - GAP * 0.5, top_h)),
+            ));
+            out.push((
+                1,
+                Rect::from_min_max(
+                    egui::pos2(area.min.x + split + GAP * 0.5, area.min.y),
+                    egui::pos2(area.max.x, area.min.y + top_h),
+                ),
+            ));
+            let mut i = 2;
+            for row in 0..rows_below {
+                let in_row = (n - i).min(3);
+                let y = area.min.y + top_h + GAP + row as f32 * (row_h + GAP);
+                let w = (area.width() - GAP * (in_row as f32 - 1.0)) / in_row as f32;
+                for c in 0..in_row {
+                    let x = area.min.x + c as f32 * (w + GAP);
+                    out.push((
+                        i,
+                        Rect::from_min_size(egui::pos2(x, y), Vec2::new(w, row_h)),
+                    ));
+                    i += 1;
+                }
             }
             out
         }
@@ -842,5 +895,34 @@ mod tests {
         assert!((l[1].1.height() + l[2].1.height() + 6.0 - 600.0).abs() < 1e-3);
         assert_eq!(layout(area, 3, Some(2)), vec![(2, area)]);
         assert_eq!(layout(area, 3, Some(7)).len(), 3);
+    }
+
+    #[test]
+    fn grid_layouts_tile_the_area_without_overlap() {
+        let area = Rect::from_min_size(egui::pos2(10.0, 20.0), Vec2::new(900.0, 700.0));
+        for n in 4..=9 {
+            let l = layout(area, n, None);
+            assert_eq!(l.len(), n);
+            let covered: f32 = l.iter().map(|(_, r)| r.area()).sum();
+            assert!(
+                covered > 0.9 * area.area() && covered <= area.area() + 1e-2,
+                "{n}"
+            );
+            for (i, (k, a)) in l.iter().enumerate() {
+                assert_eq!(*k, i);
+                assert!(area.expand(1e-3).contains_rect(*a), "{n}: {a:?}");
+                assert!(a.width() > 100.0 && a.height() > 100.0, "{n}: {a:?}");
+                for (_, b) in &l[i + 1..] {
+                    assert!(a.intersect(*b).area() <= 1e-3, "{n}: {a:?} {b:?}");
+                }
+            }
+            // The first two views share the top row.
+            assert_eq!(l[0].1.min.y, l[1].1.min.y);
+            assert!(l[1].1.min.x > l[0].1.max.x);
+        }
+        // Four views: a 2×2 grid.
+        let l = layout(area, 4, None);
+        assert!((l[2].1.min.x - l[0].1.min.x).abs() < 1e-3);
+        assert!(l[2].1.min.y > l[0].1.max.y);
     }
 }

@@ -78,6 +78,7 @@ pub fn render_window(
         }
     }
     let mut viewer = Viewer::new(state.clone());
+    viewer.figure = true;
     off.render(frame, |ui| viewer.ui(ui))
 }
 

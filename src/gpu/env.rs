@@ -175,6 +175,68 @@ impl EnvironmentMap {
     }
 }
 
+/// The bundled studio environment (`assets/studio.hdr`, made by
+/// `examples/make_studio.rs`), compiled in so that the environment view works
+/// on a fresh machine whatever the working directory.
+pub const STUDIO_HDR: &[u8] = include_bytes!("../../assets/studio.hdr");
+
+impl EnvironmentMap {
+    /// Decodes a Radiance `.hdr` or OpenEXR file held in memory; `name` is
+    /// used in error messages.
+    pub fn decode(bytes: &[u8], name: &str) -> Result<Self> {
+        let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .with_context(|| format!("reading {name}"))?;
+        let (w, h) = reader
+            .into_dimensions()
+            .with_context(|| format!("reading the size of {name}"))?;
+        if w == 0 || h == 0 || w > MAX_ENV_SIDE || h > MAX_ENV_SIDE {
+            bail!("{name}: {w}×{h} is not a usable environment (1..={MAX_ENV_SIDE} per side)");
+        }
+        let img = image::load_from_memory(bytes)
+            .with_context(|| format!("decoding {name}"))?
+            .into_rgb32f();
+        let texels = img
+            .pixels()
+            .map(|p| {
+                let c = p.0.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+                [c[0], c[1], c[2]]
+            })
+            .collect();
+        Ok(Self {
+            width: img.width(),
+            height: img.height(),
+            texels,
+        })
+    }
+
+    /// The bundled studio ([`STUDIO_HDR`]).
+    pub fn builtin_studio() -> Result<Self> {
+        Self::decode(STUDIO_HDR, "the built-in studio.hdr")
+    }
+}
+
+/// What stands under the environment, once per model (tile).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Object {
+    /// A sphere (the lit sphere's geometry, `shaders/common/sphere.wgsl`).
+    #[default]
+    Sphere,
+    /// A torus with its ring tilted towards the viewer, self-shadowing
+    /// (`shaders/common/torus.wgsl`).
+    Torus,
+}
+
+impl Object {
+    /// Index the shader uses (`Frame.object` in env.wgsl).
+    pub fn index(self) -> u32 {
+        match self {
+            Object::Sphere => 0,
+            Object::Torus => 1,
+        }
+    }
+}
+
 /// Settings of an environment-lit frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvSettings {
@@ -207,7 +269,8 @@ struct FrameUniform {
     frame: u32,
     spp: u32,
     fov_tan: f32,
-    pad: [f32; 2],
+    object: u32,
+    base: u32,
 }
 
 #[repr(C)]
@@ -248,6 +311,7 @@ struct Key {
     fov: f64,
     size: (u32, u32),
     env: u64,
+    object: Object,
 }
 
 /// The progressive environment renderer.
@@ -262,6 +326,7 @@ pub struct EnvRenderer {
     samples: u64,
     target: Option<Target>,
     tables: TableBuffer,
+    object: Object,
 }
 
 impl std::fmt::Debug for EnvRenderer {
@@ -333,6 +398,7 @@ impl EnvRenderer {
             samples: 0,
             target: None,
             tables: TableBuffer::default(),
+            object: Object::Sphere,
         })
     }
 
@@ -375,6 +441,47 @@ impl EnvRenderer {
     pub fn set_environment(&mut self, map: &EnvironmentMap) -> Result<()> {
         self.env = Self::upload(&self.gpu, map, self.env.generation + 1)?;
         Ok(())
+    }
+
+    /// Chooses the object drawn under the environment (restarts the
+    /// accumulation when it changes).
+    pub fn set_object(&mut self, object: Object) {
+        self.object = object;
+    }
+
+    /// The object drawn under the environment.
+    pub fn object(&self) -> Object {
+        self.object
+    }
+
+    /// Shows the samples accumulated so far again (after a change of exposure
+    /// or tone map, which need no new samples) without adding any.
+    pub fn display(
+        &mut self,
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Texture> {
+        if self
+            .accum
+            .as_ref()
+            .is_none_or(|a| a.size() != 16 * u64::from(width) * u64::from(height))
+        {
+            bail!("nothing accumulated at {width}×{height}");
+        }
+        self.show(settings, width, height)
+    }
+
+    /// Whether the next [`EnvRenderer::render`] with these arguments would
+    /// restart the accumulation.
+    pub fn would_restart(
+        &self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+    ) -> bool {
+        !self.key_matches(models, settings, width, height)
     }
 
     /// Samples per pixel accumulated so far (each counts one BRDF and one
@@ -480,6 +587,7 @@ impl EnvRenderer {
             fov: settings.background_fov_deg,
             size: (width, height),
             env: self.env.generation,
+            object: self.object,
         }
     }
 
@@ -532,7 +640,9 @@ impl EnvRenderer {
             frame: self.frame,
             spp: spp.max(1),
             fov_tan: (0.5 * settings.background_fov_deg.to_radians()).tan() as f32,
-            pad: [0.0; 2],
+            object: self.object.index(),
+            // Sequences restart after 2^32 samples per pixel (never in practice).
+            base: self.samples as u32,
         };
         let env = EnvUniform {
             width: self.env.size.0,

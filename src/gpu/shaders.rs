@@ -34,6 +34,7 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("common/microfacet.wgsl"),
     shader!("common/display.wgsl"),
     shader!("common/sphere.wgsl"),
+    shader!("common/torus.wgsl"),
     shader!("common/sampling.wgsl"),
     shader!("common/envmap.wgsl"),
     shader!("models/lambert.wgsl"),

@@ -1,10 +1,13 @@
-//! The viewer's views: the 3D polar lobe, the polar plot of the plane of
-//! incidence, the Cartesian plot, the directional albedo, the Fresnel
-//! curves and the image slice in half/difference angles. Each is a struct with its own `ui()`; they read one [`Scene`] per
-//! frame and ask for changes by pushing [`Command`]s. A view is added by
-//! writing its module and one line in [`REGISTRY`]; the window, screenshots
-//! and `bv render` all go through the registry. A view with its own wgpu
-//! pipeline also adds one line to [`install_gpu`].
+//! The viewer's views: the 3D polar lobe, the lit sphere, the polar plot of
+//! the plane of incidence, the Cartesian plot, the environment-lit object,
+//! the directional albedo, the Fresnel curves and the image slice in
+//! half/difference angles. Each is a struct with its own `ui()`; they read one
+//! [`Scene`] per frame and ask for changes by pushing [`Command`]s. A view is
+//! added by writing its module and one line in [`REGISTRY`]; the window,
+//! screenshots and `bv render` all go through the registry. A view with its own
+//! wgpu pipeline also adds one line to [`install_gpu`]; one that renders into a
+//! texture of its own finds egui's render state through its context
+//! ([`install_context`]).
 
 pub mod albedo;
 pub mod background;
@@ -13,8 +16,11 @@ pub mod cartesian;
 pub mod chart;
 pub mod colormap;
 pub mod curves;
+pub mod environment;
 pub mod fresnel;
+pub mod gpu_image;
 pub mod image_slice;
+pub mod lit_sphere;
 pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
@@ -119,13 +125,18 @@ pub struct ViewEntry {
     pub make: fn() -> Box<dyn View>,
 }
 
-/// Every view, in layout order: the first fills the left of the central area,
-/// the others stack on the right. Add a view here.
+/// Every view, in layout order (see `app::viewer::layout`: the first two share
+/// the top row, the others fill the rows below). Add a view here.
 pub const REGISTRY: &[ViewEntry] = &[
     ViewEntry {
         id: "lobe",
         title: "3D lobe",
         make: || Box::new(lobe3d::Lobe3dView::new()),
+    },
+    ViewEntry {
+        id: "lit_sphere",
+        title: "Lit sphere",
+        make: || Box::new(lit_sphere::LitSphereView::new()),
     },
     ViewEntry {
         id: "polar",
@@ -136,6 +147,11 @@ pub const REGISTRY: &[ViewEntry] = &[
         id: "cartesian",
         title: "f versus angle",
         make: || Box::new(cartesian::CartesianView::default()),
+    },
+    ViewEntry {
+        id: "environment",
+        title: "Environment",
+        make: || Box::new(environment::EnvironmentView::new()),
     },
     ViewEntry {
         id: "albedo",
@@ -156,7 +172,14 @@ pub const REGISTRY: &[ViewEntry] = &[
 
 /// Other names a view answers to on the command line (`bv render --view
 /// lobe3d`).
-pub const ALIASES: &[(&str, &str)] = &[("lobe3d", "lobe"), ("3d", "lobe")];
+pub const ALIASES: &[(&str, &str)] = &[
+    ("lobe3d", "lobe"),
+    ("3d", "lobe"),
+    ("lit", "lit_sphere"),
+    ("sphere", "lit_sphere"),
+    ("lit-sphere", "lit_sphere"),
+    ("env", "environment"),
+];
 
 /// The registry entry with id `id`.
 pub fn entry(id: &str) -> Option<&'static ViewEntry> {
@@ -263,7 +286,9 @@ pub fn decade_label(k: i32) -> String {
 /// Gives the views of an egui context what they fetch from it (views that
 /// find egui's render state through the context install it here), for
 /// eframe's window and for offscreen figures alike.
-pub fn install_context(_ctx: &egui::Context, _render_state: &eframe::egui_wgpu::RenderState) {}
+pub fn install_context(ctx: &egui::Context, render_state: &eframe::egui_wgpu::RenderState) {
+    gpu_image::install(ctx, render_state);
+}
 
 /// The background a figure view fills: the panel's colour, or nothing.
 pub fn figure_fill(ui: &Ui, scene: &Scene<'_>) -> Color32 {

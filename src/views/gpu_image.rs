@@ -1,0 +1,305 @@
+//! What the rendered views (lit sphere, environment) share: the wgpu device
+//! they get from egui's render state, the registration of their offscreen
+//! texture with egui, and the split of the drawn BRDFs into those the GPU can
+//! draw and the messages for the others.
+//!
+//! The render state reaches the views through the egui context
+//! ([`install`]), so that neither the [`super::Scene`] nor the viewer has to
+//! carry it: eframe's window installs it at start-up, a test harness after
+//! building. Without it (kittest without a renderer) the views say so and draw
+//! nothing.
+
+use super::{Scene, SceneBrdf};
+use crate::gpu::Gpu;
+use crate::gpu::shaders::ShaderLibrary;
+use bv_core::ModelSpec;
+use eframe::egui::{self, TextureId};
+use eframe::egui_wgpu::RenderState;
+use eframe::wgpu;
+
+fn key() -> egui::Id {
+    egui::Id::unique("bv wgpu render state")
+}
+
+/// Makes egui's render state (device, queue, renderer) available to the
+/// rendered views of `ctx`.
+pub fn install(ctx: &egui::Context, render_state: &RenderState) {
+    ctx.data_mut(|d| d.insert_temp(key(), render_state.clone()));
+}
+
+/// The render state [`install`]ed into `ctx`, if any.
+pub fn render_state(ctx: &egui::Context) -> Option<RenderState> {
+    ctx.data(|d| d.get_temp::<RenderState>(key()))
+}
+
+/// Whether the adapter is a CPU (lavapipe, llvmpipe, WARP): the views then
+/// trade resolution for speed where a GPU would not need to.
+pub fn is_software(rs: &RenderState) -> bool {
+    rs.adapter.get_info().device_type == wgpu::DeviceType::Cpu
+}
+
+/// The renderers' device, built from egui's.
+pub fn gpu_of(rs: &RenderState) -> Gpu {
+    Gpu::from_parts(rs.device.clone(), rs.queue.clone(), rs.adapter.get_info())
+}
+
+/// The composed shader library (built once per view; composition takes a
+/// moment and the views create their pipelines once).
+pub fn library() -> anyhow::Result<ShaderLibrary> {
+    ShaderLibrary::new()
+}
+
+/// A renderer built on a worker thread: composing the shaders and, above
+/// all, the driver's compilation of the pipelines (seconds for the
+/// environment shader on lavapipe with a cold shader cache) must not freeze
+/// the window.
+#[derive(Default)]
+pub enum Deferred<T> {
+    /// Not asked for yet.
+    #[default]
+    Empty,
+    /// Being built.
+    Building(std::sync::mpsc::Receiver<Result<T, String>>),
+    /// Built.
+    Ready(T),
+    /// Building failed (the message says why).
+    Failed(String),
+}
+
+impl<T: Send + 'static> Deferred<T> {
+    /// Starts `build` on a worker thread the first time, takes its result when
+    /// it is there: `Ok(Some(_))` when ready, `Ok(None)` while building (the
+    /// worker asks `ctx` for a frame when it is done).
+    pub fn poll(
+        &mut self,
+        ctx: &egui::Context,
+        build: impl FnOnce() -> Result<T, String> + Send + 'static,
+    ) -> Result<Option<&mut T>, String> {
+        if matches!(self, Deferred::Empty) {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let ctx2 = ctx.clone();
+            let spawned = std::thread::Builder::new()
+                .name("bv renderer build".into())
+                .spawn(move || {
+                    // The receiver is gone only if the view was dropped.
+                    let _ = tx.send(build());
+                    ctx2.request_repaint();
+                });
+            *self = match spawned {
+                Ok(_) => Deferred::Building(rx),
+                Err(e) => Deferred::Failed(format!("cannot start a worker thread: {e}")),
+            };
+        }
+        if let Deferred::Building(rx) = self {
+            match rx.try_recv() {
+                Ok(Ok(t)) => *self = Deferred::Ready(t),
+                Ok(Err(e)) => *self = Deferred::Failed(e),
+                Err(std::sync::mpsc::TryRecvError::Empty) => return Ok(None),
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                    *self = Deferred::Failed("the renderer build stopped".into())
+                }
+            }
+        }
+        match self {
+            Deferred::Ready(t) => Ok(Some(t)),
+            Deferred::Failed(e) => Err(e.clone()),
+            Deferred::Empty | Deferred::Building(_) => Ok(None),
+        }
+    }
+
+    /// The value now: built on this thread if not asked for yet (or after a
+    /// failure), waited for if a worker is building it. For figures, which
+    /// are drawn in one go.
+    pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
+        if let Deferred::Building(rx) = self {
+            *self = match rx.recv() {
+                Ok(Ok(t)) => Deferred::Ready(t),
+                Ok(Err(e)) => Deferred::Failed(e),
+                Err(_) => Deferred::Empty,
+            };
+        }
+        if !matches!(self, Deferred::Ready(_)) {
+            *self = match build() {
+                Ok(t) => Deferred::Ready(t),
+                Err(e) => Deferred::Failed(e),
+            };
+        }
+        match self {
+            Deferred::Ready(t) => Ok(t),
+            Deferred::Failed(e) => Err(e.clone()),
+            Deferred::Empty | Deferred::Building(_) => Err("no renderer".into()),
+        }
+    }
+
+    /// The built value, if ready.
+    pub fn ready(&self) -> Option<&T> {
+        match self {
+            Deferred::Ready(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// The built value, if ready.
+    pub fn ready_mut(&mut self) -> Option<&mut T> {
+        match self {
+            Deferred::Ready(t) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// Whether it is being built.
+    pub fn building(&self) -> bool {
+        matches!(self, Deferred::Building(_))
+    }
+}
+
+/// An offscreen texture shown by egui: registered once, re-pointed when the
+/// renderer replaces the texture (on a resize), freed with the view.
+#[derive(Default)]
+pub struct GpuImage {
+    registered: Option<(TextureId, wgpu::Texture)>,
+    render_state: Option<RenderState>,
+    filter: Option<wgpu::FilterMode>,
+}
+
+impl GpuImage {
+    /// Sets how egui samples the texture (nearest for an image at screen
+    /// resolution, linear for one rendered smaller and stretched).
+    pub fn set_filter(&mut self, rs: &RenderState, filter: wgpu::FilterMode) {
+        if self.filter.unwrap_or(wgpu::FilterMode::Nearest) != filter {
+            self.filter = Some(filter);
+            if let Some((id, t)) = &self.registered {
+                let view = t.create_view(&wgpu::TextureViewDescriptor::default());
+                rs.renderer
+                    .write()
+                    .update_egui_texture_from_wgpu_texture(&rs.device, &view, filter, *id);
+            }
+        }
+    }
+
+    /// The egui id of `texture` (an `Rgba8Unorm` texture holding sRGB-encoded
+    /// values: what egui-wgpu expects of a native texture).
+    pub fn id(&mut self, rs: &RenderState, texture: &wgpu::Texture) -> TextureId {
+        let view = || texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let filter = self.filter.unwrap_or(wgpu::FilterMode::Nearest);
+        match &self.registered {
+            Some((id, t)) if t == texture => *id,
+            Some((id, _)) => {
+                let id = *id;
+                rs.renderer.write().update_egui_texture_from_wgpu_texture(
+                    &rs.device,
+                    &view(),
+                    filter,
+                    id,
+                );
+                self.registered = Some((id, texture.clone()));
+                id
+            }
+            None => {
+                let id = rs
+                    .renderer
+                    .write()
+                    .register_native_texture(&rs.device, &view(), filter);
+                self.registered = Some((id, texture.clone()));
+                self.render_state = Some(rs.clone());
+                id
+            }
+        }
+    }
+
+    /// The id of the texture registered last, if any.
+    pub fn current(&self) -> Option<TextureId> {
+        self.registered.as_ref().map(|(id, _)| *id)
+    }
+}
+
+impl Drop for GpuImage {
+    fn drop(&mut self) {
+        if let (Some((id, _)), Some(rs)) = (&self.registered, &self.render_state) {
+            rs.renderer.write().free_texture(id);
+        }
+    }
+}
+
+/// One BRDF the GPU can draw.
+#[derive(Debug, Clone)]
+pub struct Drawable {
+    /// The scene's BRDF (label, colour, id).
+    pub brdf: SceneBrdf,
+    /// Its spec (what the renderers pack).
+    pub spec: ModelSpec,
+}
+
+/// The BRDFs a rendered view shows: every drawn one side by side, or only the
+/// primary (selected) one; those the GPU cannot draw become messages.
+pub fn drawables(scene: &Scene<'_>, side_by_side: bool) -> (Vec<Drawable>, Vec<String>) {
+    let primary = scene.primary().map(|b| b.id);
+    let mut out = Vec::new();
+    let mut errors = Vec::new();
+    for b in &scene.brdfs {
+        if !side_by_side && Some(b.id) != primary {
+            continue;
+        }
+        let Some(entry) = scene.state.entry(b.id) else {
+            continue;
+        };
+        let mut scratch = Vec::new();
+        let mut tables = crate::gpu::pack::MerlTables::default();
+        match crate::gpu::pack::pack(&entry.spec, &mut scratch, &mut tables) {
+            Ok(_) => out.push(Drawable {
+                brdf: b.clone(),
+                spec: entry.spec.clone(),
+            }),
+            Err(e) => errors.push(format!("{}: {e:#}", b.label)),
+        }
+    }
+    (out, errors)
+}
+
+/// The size in physical pixels of a rectangle in points (at least 1×1).
+pub fn pixel_size(rect: egui::Rect, pixels_per_point: f32) -> (u32, u32) {
+    let w = (rect.width() * pixels_per_point).round().max(1.0) as u32;
+    let h = (rect.height() * pixels_per_point).round().max(1.0) as u32;
+    (w, h)
+}
+
+/// Centre and radius (points) of sphere `tile` of `tiles` in `rect` (the
+/// geometry of `gpu::sphere`, for overlays and hit tests).
+pub fn sphere_circle(rect: egui::Rect, tiles: usize) -> impl Fn(usize) -> (egui::Pos2, f32) {
+    let tiles = tiles.max(1);
+    let tile_w = rect.width() / tiles as f32;
+    let r = 0.5 * crate::gpu::sphere::FILL as f32 * tile_w.min(rect.height());
+    move |tile| {
+        (
+            egui::pos2(rect.min.x + (tile as f32 + 0.5) * tile_w, rect.center().y),
+            r,
+        )
+    }
+}
+
+/// Draws text on a translucent plate (messages over rendered images).
+pub fn plate_text(
+    painter: &egui::Painter,
+    pos: egui::Pos2,
+    align: egui::Align2,
+    text: &str,
+    color: egui::Color32,
+) -> egui::Rect {
+    let font = egui::FontId::proportional(12.5);
+    let galley = painter.layout(text.to_string(), font, color, 420.0);
+    let r = align.anchor_size(pos, galley.size());
+    let plate = r.expand(3.0);
+    painter.rect_filled(
+        plate,
+        3.0,
+        egui::Color32::from_rgba_unmultiplied(0, 0, 0, 150),
+    );
+    painter.galley(r.min, galley, color);
+    plate
+}
+
+/// The view background of the theme (sRGB 0..1), shared with the lobe view.
+pub fn theme_background(dark: bool) -> [f32; 3] {
+    let b = super::lobe3d::background(dark);
+    [b[0], b[1], b[2]]
+}

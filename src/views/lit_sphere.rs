@@ -1,0 +1,469 @@
+//! The lit sphere view (issue 4, item 3): every drawn BRDF on its own
+//! orthographic sphere (or only the selected one), with a per-pixel normal and
+//! a tangent frame whose tangent follows the parallels (so anisotropy shows),
+//! lit by one directional light from the incident direction; exposure, sRGB
+//! output, optional tone map and a choice of background. Drawing on a sphere
+//! moves the light there.
+//!
+//! The light is the scene's incident direction expressed in view space: at the
+//! centre of a sphere the shading frame is the view's (t right, b up, n
+//! towards the viewer), so the centre pixel shows exactly `f(ωi, n)·cos θi·E`
+//! for the (θi, φi) of the sliders, with irradiance E = 1.
+//!
+//! The image is rendered by [`crate::gpu::LitSphereRenderer`] at the view's
+//! pixel size, and only when something it depends on changed (BRDF specs,
+//! light, settings, size), so an idle or unrelated frame costs nothing.
+
+use super::gpu_image::{self, Deferred, Drawable, GpuImage};
+use super::{Scene, View};
+use crate::app::command::Command;
+use crate::app::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
+use crate::app::state::Incident;
+use crate::gpu::sphere::{light_from_drag, sphere_at};
+use crate::gpu::{LitSphereRenderer, LitSphereSettings};
+use bv_core::ModelSpec;
+use eframe::egui::{self, Align2, Color32, Rect, Sense, Stroke, Ui, Vec2};
+use glam::{DVec2, DVec3};
+use std::time::Instant;
+
+/// What a rendered frame depends on.
+#[derive(Debug, Clone, PartialEq)]
+struct FrameKey {
+    specs: Vec<ModelSpec>,
+    settings: LitSphereSettings,
+    size: (u32, u32),
+}
+
+/// The lit sphere view.
+#[derive(Default)]
+pub struct LitSphereView {
+    renderer: Deferred<LitSphereRenderer>,
+    image: GpuImage,
+    drawn: Option<FrameKey>,
+    renders: u64,
+    last_render_ms: f64,
+    error: Option<String>,
+    messages: Vec<String>,
+    /// Where the view was drawn in the last frame.
+    pub view_rect: Option<Rect>,
+    /// How many spheres the last frame showed.
+    pub tiles: usize,
+}
+
+impl LitSphereView {
+    /// A view that creates its renderer on first use.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// How many frames were rendered since the view was created (a frame is
+    /// rendered only when something changed).
+    pub fn render_count(&self) -> u64 {
+        self.renders
+    }
+
+    /// CPU time of the last render call (recording and submitting), ms.
+    pub fn last_render_ms(&self) -> f64 {
+        self.last_render_ms
+    }
+
+    /// The messages the last frame showed (BRDFs the GPU cannot draw, errors).
+    pub fn messages(&self) -> &[String] {
+        &self.messages
+    }
+
+    /// Whether the renderer is ready (it is built on a worker thread).
+    pub fn ready(&self) -> bool {
+        self.renderer.ready().is_some()
+    }
+
+    /// The last error (renderer creation or rendering), if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// The renderer's settings for the current scene.
+    pub fn settings(scene: &Scene<'_>, dark: bool, pixels_per_point: f32) -> LitSphereSettings {
+        let lit = scene.state.lighting.lit;
+        LitSphereSettings {
+            light: scene.wi(),
+            irradiance: 1.0,
+            exposure_ev: lit.exposure_ev,
+            tone_map: lit.tone_map.to_gpu(),
+            background: lit
+                .background
+                .to_gpu(gpu_image::theme_background(dark), pixels_per_point),
+        }
+    }
+
+    /// Renders the frame if anything changed; returns the egui texture.
+    fn render(
+        &mut self,
+        ui: &Ui,
+        drawables: &[Drawable],
+        settings: LitSphereSettings,
+        size: (u32, u32),
+        figure: bool,
+    ) -> Option<egui::TextureId> {
+        let rs = gpu_image::render_state(ui.ctx())?;
+        let gpu = gpu_image::gpu_of(&rs);
+        let build = move || {
+            gpu_image::library()
+                .and_then(|mut lib| LitSphereRenderer::new(gpu, &mut lib))
+                .map_err(|e| format!("cannot build the lit sphere renderer: {e:#}"))
+        };
+        let built = if figure {
+            self.renderer.now(build).map(Some)
+        } else {
+            self.renderer.poll(ui.ctx(), build)
+        };
+        let renderer = match built {
+            Ok(Some(r)) => r,
+            Ok(None) => return None,
+            Err(e) => {
+                self.error = Some(e);
+                return None;
+            }
+        };
+        let key = FrameKey {
+            specs: drawables.iter().map(|d| d.spec.clone()).collect(),
+            settings,
+            size,
+        };
+        if self.drawn.as_ref() == Some(&key) {
+            return self.image.current();
+        }
+        let t0 = Instant::now();
+        match renderer.render(&key.specs, &settings, size.0, size.1) {
+            Ok(texture) => {
+                let texture = texture.clone();
+                self.last_render_ms = t0.elapsed().as_secs_f64() * 1e3;
+                self.renders += 1;
+                self.drawn = Some(key);
+                self.error = None;
+                Some(self.image.id(&rs, &texture))
+            }
+            Err(e) => {
+                self.error = Some(format!("{e:#}"));
+                self.drawn = None;
+                None
+            }
+        }
+    }
+}
+
+impl View for LitSphereView {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let lit = scene.state.lighting.lit;
+        let mut next = lit;
+        exposure_control(ui, "lit", &mut next.exposure_ev);
+        tone_control(ui, "lit", &mut next.tone_map);
+        egui::ComboBox::from_id_salt("bv lit background")
+            .selected_text(lit.background.label())
+            .width(70.0)
+            .show_ui(ui, |ui| {
+                for b in BackgroundChoice::ALL {
+                    ui.selectable_value(&mut next.background, b, b.label());
+                }
+            })
+            .response
+            .on_hover_text("Background behind the spheres")
+            .widget_info(|| {
+                egui::WidgetInfo::labeled(egui::Role::ComboBox, true, "lit sphere background")
+            });
+        arrangement_control(ui, "lit", scene, &mut next.side_by_side, out);
+        if next != lit {
+            out.push(Command::SetLitView(next));
+        }
+    }
+
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let rect = ui.available_rect_before_wrap();
+        if rect.width() < 8.0 || rect.height() < 8.0 {
+            return;
+        }
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        self.view_rect = Some(rect);
+        let dark = ui.visuals().dark_mode;
+        let painter = ui.painter_at(rect);
+        if !scene.transparent {
+            let [r, g, b] = gpu_image::theme_background(dark).map(|c| (c * 255.0).round() as u8);
+            painter.rect_filled(rect, 0.0, Color32::from_rgb(r, g, b));
+        }
+        let weak = ui.visuals().weak_text_color();
+        let text = super::strong_text(ui);
+
+        let lit: LitView = scene.state.lighting.lit;
+        let (drawables, mut errors) = gpu_image::drawables(scene, lit.side_by_side);
+        self.tiles = drawables.len();
+        if gpu_image::render_state(ui.ctx()).is_none() {
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "The lit sphere needs the wgpu renderer",
+                egui::FontId::proportional(14.0),
+                weak,
+            );
+            return;
+        }
+        let ppp = ui.ctx().pixels_per_point();
+        let size = gpu_image::pixel_size(rect, ppp);
+        let settings = Self::settings(scene, dark, ppp);
+        if !drawables.is_empty()
+            && let Some(id) = self.render(ui, &drawables, settings, size, scene.figure)
+        {
+            painter.image(
+                id,
+                rect,
+                Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                Color32::WHITE,
+            );
+        }
+        if let Some(e) = &self.error {
+            errors.push(e.clone());
+        }
+        self.messages = errors.clone();
+
+        // Light drag: the light goes where the pointer is on the sphere.
+        if (response.dragged() || response.clicked())
+            && !drawables.is_empty()
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            let local = p - rect.min;
+            let dir = light_from_drag(
+                DVec2::new(local.x.into(), local.y.into()),
+                DVec2::new(rect.width().into(), rect.height().into()),
+                drawables.len(),
+            );
+            out.push(Command::SetIncident(Incident::from_direction(dir)));
+        }
+
+        if self.renderer.building() {
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "compiling the shaders…",
+                egui::FontId::proportional(14.0),
+                weak,
+            );
+        }
+        self.overlays(ui, rect, scene, &drawables, &errors, dark, text, weak);
+        if let Some(p) = response.hover_pos().filter(|_| !scene.figure) {
+            self.hover_value(ui, rect, p, scene, &drawables, text);
+        }
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+impl LitSphereView {
+    #[allow(clippy::too_many_arguments)]
+    fn overlays(
+        &self,
+        ui: &Ui,
+        rect: Rect,
+        scene: &Scene<'_>,
+        drawables: &[Drawable],
+        errors: &[String],
+        dark: bool,
+        text: Color32,
+        weak: Color32,
+    ) {
+        let painter = ui.painter_at(rect);
+        let circle = gpu_image::sphere_circle(rect, drawables.len());
+        let wi = scene.wi();
+        let light = super::light_color(dark);
+        for (k, d) in drawables.iter().enumerate() {
+            let (c, r) = circle(k);
+            // The point the light shines straight onto (its normal is ωi).
+            let at = c + Vec2::new(wi.x as f32, -wi.y as f32) * r;
+            painter.circle_stroke(at, 5.0, Stroke::new(2.0, light));
+            painter.circle_stroke(at, 6.5, Stroke::new(1.0, Color32::from_black_alpha(160)));
+            let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
+            gpu_image::plate_text(
+                &painter,
+                egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
+                Align2::CENTER_TOP,
+                &d.brdf.label,
+                Color32::from_rgb(cr, cg, cb),
+            );
+        }
+        let lit = scene.state.lighting.lit;
+        let status = format!(
+            "θi {:.0}° φi {:.0}° · E = 1 · EV {:+.1} · {}",
+            scene.incident.theta_deg,
+            scene.incident.phi_deg,
+            lit.exposure_ev,
+            lit.tone_map.label()
+        );
+        if !scene.figure {
+            painter.text(
+                rect.left_top() + Vec2::new(6.0, 4.0),
+                Align2::LEFT_TOP,
+                status,
+                egui::FontId::proportional(12.0),
+                text,
+            );
+        }
+        // The hint only where it clears the spheres' labels.
+        let below = rect.max.y - (circle(0).0.y + circle(0).1);
+        if below > 44.0 && !scene.figure {
+            painter.text(
+                rect.left_bottom() + Vec2::new(6.0, -5.0),
+                Align2::LEFT_BOTTOM,
+                "drag on a sphere: move the light · ring: where the light is",
+                egui::FontId::proportional(12.0),
+                weak,
+            );
+        }
+        let mut y = rect.min.y + 24.0;
+        for e in errors {
+            let r = gpu_image::plate_text(
+                &painter,
+                egui::pos2(rect.min.x + 6.0, y),
+                Align2::LEFT_TOP,
+                e,
+                ui.visuals().warn_fg_color,
+            );
+            y = r.max.y + 4.0;
+        }
+        if drawables.is_empty() && errors.is_empty() {
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "No BRDF shown: add one on the left",
+                egui::FontId::proportional(14.0),
+                weak,
+            );
+        }
+    }
+
+    /// The radiance under the pointer, from bv-core in f64 (what the pixel
+    /// shows before exposure and tone mapping).
+    fn hover_value(
+        &self,
+        ui: &Ui,
+        rect: Rect,
+        p: egui::Pos2,
+        scene: &Scene<'_>,
+        drawables: &[Drawable],
+        text: Color32,
+    ) {
+        let local = p - rect.min;
+        let Some(s) = sphere_at(
+            DVec2::new(local.x.into(), local.y.into()),
+            DVec2::new(rect.width().into(), rect.height().into()),
+            drawables.len(),
+        ) else {
+            return;
+        };
+        let Some(d) = drawables.get(s.tile) else {
+            return;
+        };
+        let wi = s.to_local(scene.wi());
+        let wo = s.to_local(DVec3::Z);
+        let l = if wi.z > 0.0 {
+            d.brdf.brdf.eval(wi, wo) * wi.z
+        } else {
+            DVec3::ZERO
+        };
+        let painter = ui.painter_at(rect);
+        gpu_image::plate_text(
+            &painter,
+            rect.right_top() + Vec2::new(-6.0, 6.0),
+            Align2::RIGHT_TOP,
+            &format!(
+                "L = f·cos θi·E = ({:.4}, {:.4}, {:.4})\nθi {:.1}°, θo {:.1}° in the local frame",
+                l.x,
+                l.y,
+                l.z,
+                wi.z.clamp(-1.0, 1.0).acos().to_degrees(),
+                wo.z.clamp(-1.0, 1.0).acos().to_degrees()
+            ),
+            text,
+        );
+    }
+}
+
+/// The exposure control of a rendered view's toolbar ("EV", ±0.1 per step,
+/// double-click resets to 0).
+pub fn exposure_control(ui: &mut Ui, salt: &str, ev: &mut f64) {
+    let label = ui.label("EV");
+    let r = ui
+        .add(
+            egui::DragValue::new(ev)
+                .speed(0.05)
+                .range(EV_RANGE.0..=EV_RANGE.1)
+                .fixed_decimals(1),
+        )
+        .labelled_by(label.id)
+        .on_hover_text("Exposure in stops: radiance × 2^EV (double-click: 0)");
+    r.widget_info(|| {
+        egui::WidgetInfo::labeled(egui::Role::SpinButton, true, format!("{salt} exposure"))
+    });
+    if r.double_clicked() {
+        *ev = 0.0;
+    }
+}
+
+/// The tone map choice of a rendered view's toolbar.
+pub fn tone_control(ui: &mut Ui, salt: &str, tone: &mut Tone) {
+    let current = *tone;
+    egui::ComboBox::from_id_salt(("bv tone", salt))
+        .selected_text(match current {
+            Tone::None => "clip",
+            Tone::Reinhard => "Reinhard",
+            Tone::Aces => "ACES",
+        })
+        .width(70.0)
+        .show_ui(ui, |ui| {
+            for t in Tone::ALL {
+                ui.selectable_value(tone, t, t.label());
+            }
+        })
+        .response
+        .on_hover_text("Tone map after exposure (then sRGB encoding)")
+        .widget_info(|| {
+            egui::WidgetInfo::labeled(egui::Role::ComboBox, true, format!("{salt} tone map"))
+        });
+}
+
+/// "all side by side" or one BRDF (the selected one; picking another selects it).
+pub fn arrangement_control(
+    ui: &mut Ui,
+    salt: &str,
+    scene: &Scene<'_>,
+    side_by_side: &mut bool,
+    out: &mut Vec<Command>,
+) {
+    let primary = scene.primary().map(|b| (b.id, b.label.clone()));
+    let text = match (&primary, *side_by_side) {
+        (_, true) | (None, _) => "all side by side".to_string(),
+        (Some((_, l)), false) => l.clone(),
+    };
+    egui::ComboBox::from_id_salt(("bv arrangement", salt))
+        .selected_text(text)
+        .width(110.0)
+        .show_ui(ui, |ui| {
+            if ui
+                .selectable_label(*side_by_side, "all side by side")
+                .clicked()
+            {
+                *side_by_side = true;
+            }
+            for b in &scene.brdfs {
+                let on = !*side_by_side && primary.as_ref().is_some_and(|(id, _)| *id == b.id);
+                if ui.selectable_label(on, &b.label).clicked() {
+                    *side_by_side = false;
+                    out.push(Command::Select(b.id));
+                }
+            }
+        })
+        .response
+        .on_hover_text("Every drawn BRDF side by side, or one at a time (the selected one)")
+        .widget_info(|| {
+            egui::WidgetInfo::labeled(egui::Role::ComboBox, true, format!("{salt} BRDFs shown"))
+        });
+}
