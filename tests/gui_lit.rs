@@ -369,8 +369,7 @@ struct ViewOnly<V> {
     state: AppState,
     runtime: bv::app::runtime::Runtime,
     view: V,
-    /// Passed to the scene: the environment view then adds one sample per
-    /// frame, which makes its image independent of the machine's speed.
+    /// Passed to the scene (a pointer button held).
     interacting: bool,
 }
 
@@ -382,7 +381,7 @@ impl<V: bv::views::View> ViewOnly<V> {
             state,
             runtime,
             view,
-            interacting: true,
+            interacting: false,
         }
     }
 

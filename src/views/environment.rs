@@ -35,11 +35,26 @@ pub const MAX_PASS_SPP: u32 = 64;
 /// renderer, and a GPU adds its 64 samples per frame at once.
 pub const PASS_BUDGET_S: f64 = 0.045;
 
-/// Resolution of the accumulation, relative to the view's pixels, on a
-/// software renderer (lavapipe): a quarter of the samples per frame buys a
-/// clean image in a quarter of the time, and the image is stretched with
-/// linear filtering. A GPU renders at full resolution.
-pub const SOFTWARE_SCALE: f32 = 0.5;
+/// Resolution of the accumulation relative to the view's pixels (the image is
+/// stretched with linear filtering when it is smaller):
+///
+/// | | at rest | while a pointer button is held |
+/// |---|---|---|
+/// | GPU | 1 | ½ |
+/// | software renderer (lavapipe) | ½ | ¼ |
+/// | figure | 1 | 1 |
+///
+/// A slider drag restarts the image every frame, so a drag shows a quick
+/// preview; on a software renderer a quarter of the pixels at rest buys a
+/// clean image in a quarter of the time.
+pub fn accumulation_scale(figure: bool, interacting: bool, software: bool) -> f32 {
+    match (figure, interacting, software) {
+        (true, _, _) => 1.0,
+        (false, false, false) => 1.0,
+        (false, true, false) | (false, false, true) => 0.5,
+        (false, true, true) => 0.25,
+    }
+}
 
 /// Largest sample count of a figure on a software renderer (a clean image
 /// at full resolution in well under a minute on lavapipe); a GPU takes the
@@ -106,6 +121,7 @@ pub struct EnvironmentView {
     pass_spp: u32,
     /// Measured device seconds per sample per pixel (running average).
     spp_cost: Option<f64>,
+    max_pass: u32,
     restarts: u64,
     restarted_at: Option<Instant>,
     /// Seconds from the last restart to the target sample count.
@@ -137,6 +153,7 @@ impl EnvironmentView {
             shown: None,
             pass_spp: 1,
             spp_cost: None,
+            max_pass: MAX_PASS_SPP,
             restarts: 0,
             restarted_at: None,
             converged_after: None,
@@ -152,6 +169,12 @@ impl EnvironmentView {
         self.renderer
             .ready()
             .map_or(0, EnvRenderer::samples_per_pixel)
+    }
+
+    /// Caps the samples per pixel a frame adds (1 makes the image independent
+    /// of the machine's speed, for tests; at most [`MAX_PASS_SPP`]).
+    pub fn set_max_pass(&mut self, spp: u32) {
+        self.max_pass = spp.clamp(1, MAX_PASS_SPP);
     }
 
     /// How many times the accumulation restarted.
@@ -405,7 +428,7 @@ impl EnvironmentView {
             // fit the per-frame budget at the measured cost.
             self.pass_spp = match self.spp_cost {
                 Some(c) if !restart && !interacting && c > 0.0 => {
-                    ((PASS_BUDGET_S / c).floor() as u32).clamp(1, MAX_PASS_SPP)
+                    ((PASS_BUDGET_S / c).floor() as u32).clamp(1, self.max_pass)
                 }
                 _ => 1,
             };
@@ -603,11 +626,7 @@ impl View for EnvironmentView {
         let (drawables, mut errors) = gpu_image::drawables(scene, env.side_by_side);
         let rs = gpu_image::render_state(ui.ctx());
         let software = rs.as_ref().is_some_and(gpu_image::is_software);
-        let scale = if software && !scene.figure {
-            SOFTWARE_SCALE
-        } else {
-            1.0
-        };
+        let scale = accumulation_scale(scene.figure, scene.interacting, software);
         if let Some(rs) = &rs {
             self.image.set_filter(
                 rs,
@@ -669,7 +688,10 @@ impl View for EnvironmentView {
                     (None, None) => ui.label(""),
                 };
                 if software {
-                    ui.label("Software renderer: accumulated at half the view's resolution.");
+                    ui.label(
+                        "Software renderer: accumulated at half the view's resolution \
+                     (a quarter during a drag).",
+                    );
                 }
             });
         }

@@ -12,7 +12,8 @@
 //!
 //! The image is rendered by [`crate::gpu::LitSphereRenderer`] at the view's
 //! pixel size, and only when something it depends on changed (BRDF specs,
-//! light, settings, size), so an idle or unrelated frame costs nothing.
+//! light, settings, size), so an idle or unrelated frame costs nothing. On a
+//! software renderer a drag renders at half the resolution ([`DRAG_SCALE`]).
 
 use super::gpu_image::{self, Deferred, Drawable, GpuImage};
 use super::{Scene, View};
@@ -25,6 +26,10 @@ use bv_core::ModelSpec;
 use eframe::egui::{self, Align2, Color32, Rect, Sense, Stroke, Ui, Vec2};
 use glam::{DVec2, DVec3};
 use std::time::Instant;
+
+/// Resolution of the image while a pointer button is held, on a software
+/// renderer (relative to the view's pixels).
+pub const DRAG_SCALE: f32 = 0.5;
 
 /// What a rendered frame depends on.
 #[derive(Debug, Clone, PartialEq)]
@@ -207,8 +212,27 @@ impl View for LitSphereView {
             return;
         }
         let ppp = ui.ctx().pixels_per_point();
-        let size = gpu_image::pixel_size(rect, ppp);
-        let settings = Self::settings(scene, dark, ppp);
+        // While something is dragged on a software renderer, a quarter of the
+        // pixels keeps the drag smooth; the full image follows on release.
+        let rs = gpu_image::render_state(ui.ctx());
+        let software = rs.as_ref().is_some_and(gpu_image::is_software);
+        let scale = if software && scene.interacting && !scene.figure {
+            DRAG_SCALE
+        } else {
+            1.0
+        };
+        if let Some(rs) = &rs {
+            self.image.set_filter(
+                rs,
+                if scale < 1.0 {
+                    eframe::wgpu::FilterMode::Linear
+                } else {
+                    eframe::wgpu::FilterMode::Nearest
+                },
+            );
+        }
+        let size = gpu_image::pixel_size(rect, ppp * scale);
+        let settings = Self::settings(scene, dark, ppp * scale);
         if !drawables.is_empty()
             && let Some(id) = self.render(ui, &drawables, settings, size, scene.figure)
         {
