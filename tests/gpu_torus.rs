@@ -31,7 +31,7 @@ fn torus_white_furnace_shows_shadowing_and_no_gain() {
             &EnvSettings::default(),
             w,
             h,
-            4096,
+            2048,
         )
         .unwrap();
     let at = |x: u32, y: u32| img[(y * w + x) as usize][0];
@@ -56,9 +56,12 @@ fn torus_white_furnace_shows_shadowing_and_no_gain() {
         let v = at(col(u), row);
         assert!((v - 1.0).abs() < 0.02, "outer rim at u = {u}: {v}");
     }
-    // The inner side of the tube (facing the hole) sees the far side of the
-    // ring: clearly darker.
-    let inner = at(col(MAJOR - MINOR + 0.05), row);
-    assert!(inner < 0.9, "inner side is not shadowed: {inner}");
+    // The inner side of the ring sees the ring's other side: clearly darker
+    // somewhere (the far part's inner side, seen through the hole's top).
+    let inner = img.iter().map(|c| c[0]).fold(1.0f32, f32::min);
+    assert!(inner < 0.75, "nothing is shadowed: darkest pixel {inner}");
+    let column: Vec<f32> = (0..h).map(|y| at(cx as u32, y)).collect();
+    let darkest = column.iter().cloned().fold(1.0f32, f32::min);
+    assert!(darkest < 0.75, "the vertical through the hole: {column:?}");
     println!("torus furnace: max {max:.4}, inner side {inner:.3}");
 }

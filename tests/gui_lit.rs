@@ -207,7 +207,7 @@ fn lit_sphere_renders_and_follows_a_slider_and_the_light_drag() {
 }
 
 #[test]
-fn lit_sphere_settings_change_the_image_and_merl_is_an_error_not_a_panic() {
+fn lit_sphere_settings_change_the_image_and_a_measured_brdf_is_drawn() {
     let mut state = state_with(&[
         ("cook-torrance", serde_json::json!({})),
         ("ward", serde_json::json!({"alpha_x": 0.05, "alpha_y": 0.3})),
@@ -228,8 +228,7 @@ fn lit_sphere_settings_change_the_image_and_merl_is_an_error_not_a_panic() {
     h.run();
     assert_eq!(lit(&h).tiles, 1, "one at a time");
 
-    // A measured (merl) BRDF: its table goes to the GPU too, so it is drawn
-    // as a third sphere with no message.
+    // A measured (merl) BRDF: drawn from its table, uploaded to the GPU.
     let dir = std::env::temp_dir().join(format!("bv-gui-lit-merl-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("grey.binary");
@@ -257,9 +256,23 @@ fn lit_sphere_settings_change_the_image_and_merl_is_an_error_not_a_panic() {
         "the table loads on the CPU"
     );
     h.run();
-    assert_eq!(lit(&h).tiles, 3, "merl is drawn beside the analytic models");
+    assert_eq!(lit(&h).tiles, 3, "the measured BRDF has its sphere");
     assert!(lit(&h).messages().is_empty(), "{:?}", lit(&h).messages());
     assert!(env(&h).messages().is_empty(), "{:?}", env(&h).messages());
+    // Its sphere is lit: constant f = 0.1 → the centre shows 0.1·cos θi
+    // (× 2^EV, EV = 2 from above).
+    let rect = lit(&h).view_rect.unwrap();
+    let img = crop(&h.render().unwrap(), rect);
+    let (c, _) = bv::views::gpu_image::sphere_circle(rect, 3)(2);
+    let c = c - rect.min;
+    let px = img.get_pixel(c.x as u32 - 2, c.y as u32 - 2).0;
+    let expected = bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
+        0.1 * 30f64.to_radians().cos() * 4.0,
+    ));
+    assert!(
+        (0..3).all(|k| px[k].abs_diff(expected) <= 3),
+        "merl sphere centre {px:?}, expected {expected}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -228,6 +228,14 @@ impl Command {
             }
             Command::SetTheme(t) => state.theme = t,
             Command::ToggleHelp => out.toggle_help = true,
+            Command::SetLitView(v) => {
+                state.lighting.lit = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
+            Command::SetEnvView(v) => {
+                state.lighting.env = v;
+                state.lighting = std::mem::take(&mut state.lighting).sanitised();
+            }
             Command::OpenFile { path, into } => {
                 let target = match into.and_then(|id| state.entry(id)) {
                     Some(e) => match path_param(&e.spec.model) {
@@ -248,14 +256,6 @@ impl Command {
                 out.open = Some((path, target));
             }
             Command::OpenFileDialog => out.open_dialog = true,
-            Command::SetLitView(v) => {
-                state.lighting.lit = v;
-                state.lighting = std::mem::take(&mut state.lighting).sanitised();
-            }
-            Command::SetEnvView(v) => {
-                state.lighting.env = v;
-                state.lighting = std::mem::take(&mut state.lighting).sanitised();
-            }
         }
         out
     }

@@ -357,11 +357,11 @@ impl AppState {
         let p = &mut self.plots;
         p.fixed_theta_d_deg = clamp_deg(p.fixed_theta_d_deg, 0.0, 89.5);
         p.fixed_theta_h_deg = clamp_deg(p.fixed_theta_h_deg, 0.0, 89.5);
+        self.lighting = self.lighting.sanitised();
         self.display.sh_order = self
             .display
             .sh_order
             .min(bv_core::represent::sh::MAX_ORDER as u8);
-        self.lighting = self.lighting.sanitised();
         self.version = STATE_VERSION;
         self
     }

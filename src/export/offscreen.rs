@@ -73,7 +73,9 @@ impl Offscreen {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("bv offscreen"),
             required_features: wgpu::Features::empty(),
-            required_limits: crate::gpu::context::headless_limits(&adapter),
+            // What the GPU renderers need (the environment view binds 5
+            // storage buffers), as for `gpu::Gpu::headless`.
+            required_limits: crate::gpu::context::limits(&adapter),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,

@@ -40,7 +40,7 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("bv"),
             required_features: wgpu::Features::empty(),
-            required_limits: headless_limits(&adapter),
+            required_limits: limits(&adapter),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
@@ -105,7 +105,7 @@ impl Gpu {
 /// (parameters, tiles, accumulation, environment map, MERL tables); downlevel
 /// promises only 4, while every Vulkan, Metal and DX12 device has at least 8,
 /// which is also what egui-wgpu's window device requests (`Limits::default()`).
-pub fn headless_limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
+pub fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
     let have = adapter.limits();
     let mut l = wgpu::Limits::downlevel_defaults().using_resolution(have.clone());
     l.max_storage_buffers_per_shader_stage = have

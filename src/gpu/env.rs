@@ -325,8 +325,8 @@ pub struct EnvRenderer {
     frame: u32,
     samples: u64,
     target: Option<Target>,
-    tables: TableBuffer,
     object: Object,
+    tables: TableBuffer,
 }
 
 impl std::fmt::Debug for EnvRenderer {
@@ -397,8 +397,8 @@ impl EnvRenderer {
             frame: 0,
             samples: 0,
             target: None,
-            tables: TableBuffer::default(),
             object: Object::Sphere,
+            tables: TableBuffer::default(),
         })
     }
 

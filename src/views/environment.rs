@@ -14,7 +14,7 @@
 //! - Maps load on a worker thread (a large EXR takes a moment); a bad file is
 //!   reported in the view and the previous map stays.
 
-use super::gpu_image::{self, Deferred, Drawable, GpuImage};
+use super::gpu_image::{self, Deferred, Drawable, GpuImage, PackCheck};
 use super::lit_sphere::{arrangement_control, exposure_control, tone_control};
 use super::{Scene, View};
 use crate::app::command::Command;
@@ -129,6 +129,7 @@ pub struct EnvironmentView {
     path_edit: Option<String>,
     files: Files<()>,
     messages: Vec<String>,
+    pack_check: PackCheck,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
 }
@@ -160,6 +161,7 @@ impl EnvironmentView {
             path_edit: None,
             files: Files::default(),
             messages: Vec::new(),
+            pack_check: PackCheck::default(),
             view_rect: None,
         }
     }
@@ -623,7 +625,8 @@ impl View for EnvironmentView {
             );
             return;
         }
-        let (drawables, mut errors) = gpu_image::drawables(scene, env.side_by_side);
+        let (drawables, mut errors) =
+            gpu_image::drawables(scene, env.side_by_side, &mut self.pack_check);
         let rs = gpu_image::render_state(ui.ctx());
         let software = rs.as_ref().is_some_and(gpu_image::is_software);
         let scale = accumulation_scale(scene.figure, scene.interacting, software);

@@ -230,9 +230,38 @@ pub struct Drawable {
     pub spec: ModelSpec,
 }
 
+/// Whether each BRDF (by id and revision) packs for the GPU, remembered so
+/// that a frame does not pack every model again (a measured model builds its
+/// table lookup to pack).
+#[derive(Default)]
+pub struct PackCheck {
+    known: std::collections::HashMap<u64, (u64, Result<(), String>)>,
+}
+
+impl PackCheck {
+    fn check(&mut self, b: &SceneBrdf, spec: &ModelSpec) -> Result<(), String> {
+        if let Some((rev, r)) = self.known.get(&b.id)
+            && *rev == b.revision
+        {
+            return r.clone();
+        }
+        let mut scratch = Vec::new();
+        let mut tables = crate::gpu::pack::MerlTables::default();
+        let r = crate::gpu::pack::pack(spec, &mut scratch, &mut tables)
+            .map(|_| ())
+            .map_err(|e| format!("{}: {e:#}", b.label));
+        self.known.insert(b.id, (b.revision, r.clone()));
+        r
+    }
+}
+
 /// The BRDFs a rendered view shows: every drawn one side by side, or only the
 /// primary (selected) one; those the GPU cannot draw become messages.
-pub fn drawables(scene: &Scene<'_>, side_by_side: bool) -> (Vec<Drawable>, Vec<String>) {
+pub fn drawables(
+    scene: &Scene<'_>,
+    side_by_side: bool,
+    check: &mut PackCheck,
+) -> (Vec<Drawable>, Vec<String>) {
     let primary = scene.primary().map(|b| b.id);
     let mut out = Vec::new();
     let mut errors = Vec::new();
@@ -243,16 +272,17 @@ pub fn drawables(scene: &Scene<'_>, side_by_side: bool) -> (Vec<Drawable>, Vec<S
         let Some(entry) = scene.state.entry(b.id) else {
             continue;
         };
-        let mut scratch = Vec::new();
-        let mut tables = crate::gpu::pack::MerlTables::default();
-        match crate::gpu::pack::pack(&entry.spec, &mut scratch, &mut tables) {
-            Ok(_) => out.push(Drawable {
+        match check.check(b, &entry.spec) {
+            Ok(()) => out.push(Drawable {
                 brdf: b.clone(),
                 spec: entry.spec.clone(),
             }),
-            Err(e) => errors.push(format!("{}: {e:#}", b.label)),
+            Err(e) => errors.push(e),
         }
     }
+    check
+        .known
+        .retain(|id, _| scene.brdfs.iter().any(|b| b.id == *id));
     (out, errors)
 }
 

@@ -15,7 +15,7 @@
 //! light, settings, size), so an idle or unrelated frame costs nothing. On a
 //! software renderer a drag renders at half the resolution ([`DRAG_SCALE`]).
 
-use super::gpu_image::{self, Deferred, Drawable, GpuImage};
+use super::gpu_image::{self, Deferred, Drawable, GpuImage, PackCheck};
 use super::{Scene, View};
 use crate::app::command::Command;
 use crate::app::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
@@ -49,6 +49,7 @@ pub struct LitSphereView {
     last_render_ms: f64,
     error: Option<String>,
     messages: Vec<String>,
+    pack_check: PackCheck,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
     /// How many spheres the last frame showed.
@@ -199,7 +200,8 @@ impl View for LitSphereView {
         let text = super::strong_text(ui);
 
         let lit: LitView = scene.state.lighting.lit;
-        let (drawables, mut errors) = gpu_image::drawables(scene, lit.side_by_side);
+        let (drawables, mut errors) =
+            gpu_image::drawables(scene, lit.side_by_side, &mut self.pack_check);
         self.tiles = drawables.len();
         if gpu_image::render_state(ui.ctx()).is_none() {
             painter.text(

@@ -1,12 +1,12 @@
 //! The viewer's views: the 3D polar lobe, the lit sphere, the polar plot of
 //! the plane of incidence, the Cartesian plot, the environment-lit object,
 //! the directional albedo, the Fresnel curves and the image slice in
-//! half/difference angles. Each is a struct with its own `ui()`; they read one
-//! [`Scene`] per frame and ask for changes by pushing [`Command`]s. A view is
-//! added by writing its module and one line in [`REGISTRY`]; the window,
-//! screenshots and `bv render` all go through the registry. A view with its own
-//! wgpu pipeline also adds one line to [`install_gpu`]; one that renders into a
-//! texture of its own finds egui's render state through its context
+//! half/difference angles. Each is a struct with its own `ui()`; they read
+//! one [`Scene`] per frame and ask for changes by pushing [`Command`]s. A view
+//! is added by writing its module and one line in [`REGISTRY`]; the window,
+//! screenshots and `bv render` all go through the registry. A view with its
+//! own wgpu pipeline also adds one line to [`install_gpu`]; one that renders
+//! into a texture of its own finds egui's render state through its context
 //! ([`install_context`]).
 
 pub mod albedo;
