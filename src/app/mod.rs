@@ -298,7 +298,10 @@ impl eframe::App for BvApp {
         }
         if let Some(s) = &mut self.shot {
             ctx.request_repaint();
-            match s.tick(&ctx) {
+            // Rendered views still at work (shaders compiling, environment
+            // sampling) are waited for, for at most MAX_BUSY.
+            let busy = self.viewer.views_busy();
+            match s.tick(&ctx, busy) {
                 ShotState::Waiting => {}
                 ShotState::Done(r) => {
                     self.shot = None;
@@ -468,6 +471,9 @@ impl Shot {
     /// Frames drawn before the screenshot (layout settles, meshes at full
     /// resolution).
     const SETTLE_FRAMES: usize = 6;
+    /// Longest wait for views that are still working (the environment view
+    /// converging on a software renderer).
+    const MAX_BUSY: Duration = Duration::from_secs(40);
 
     fn new(path: PathBuf) -> Self {
         Self {
@@ -479,9 +485,10 @@ impl Shot {
         }
     }
 
-    fn tick(&mut self, ctx: &egui::Context) -> ShotState {
+    fn tick(&mut self, ctx: &egui::Context, busy: bool) -> ShotState {
         self.frames += 1;
-        if !self.requested && self.frames >= Self::SETTLE_FRAMES {
+        let settled = !busy || self.started.elapsed() > Self::MAX_BUSY;
+        if !self.requested && self.frames >= Self::SETTLE_FRAMES && settled {
             let slot = self.image.clone();
             let ctx2 = ctx.clone();
             ctx.request_screenshot(move |img| {

@@ -268,6 +268,23 @@ impl Viewer {
             .find_map(|(_, v)| v.as_any().downcast_ref::<T>())
     }
 
+    /// Whether a rendered view shown in the last frame is still working
+    /// (building its renderer, or the environment view sampling towards its
+    /// target): screenshots wait for them.
+    pub fn views_busy(&self) -> bool {
+        // A view is hidden only by another one being maximised.
+        let shown = |id: &str| self.state.maximised.as_deref().is_none_or(|m| m == id);
+        let env = shown("environment")
+            && self
+                .view::<crate::views::environment::EnvironmentView>()
+                .is_some_and(|v| v.busy());
+        let lit = shown("lit_sphere")
+            && self
+                .view::<crate::views::lit_sphere::LitSphereView>()
+                .is_some_and(|v| v.busy());
+        env || lit
+    }
+
     /// Whether the help overlay is open.
     pub fn help_open(&self) -> bool {
         self.help

@@ -124,6 +124,7 @@ pub struct EnvironmentView {
     spp_cost: Option<f64>,
     max_pass: u32,
     scale_in_use: Option<f32>,
+    busy: bool,
     restarts: u64,
     restarted_at: Option<Instant>,
     /// Seconds from the last restart to the target sample count.
@@ -158,6 +159,7 @@ impl EnvironmentView {
             spp_cost: None,
             max_pass: MAX_PASS_SPP,
             scale_in_use: None,
+            busy: false,
             restarts: 0,
             restarted_at: None,
             converged_after: None,
@@ -204,6 +206,12 @@ impl EnvironmentView {
     /// The messages the last frame showed (BRDFs the GPU cannot draw, errors).
     pub fn messages(&self) -> &[String] {
         &self.messages
+    }
+
+    /// Whether the last frame left work to do (the renderer or a map still
+    /// loading, or samples still to take).
+    pub fn busy(&self) -> bool {
+        self.busy
     }
 
     /// Whether the renderer is ready (it is built on a worker thread).
@@ -711,6 +719,7 @@ impl View for EnvironmentView {
         if more || self.loading.is_some() {
             ui.ctx().request_repaint();
         }
+        self.busy = more || self.loading.is_some() || self.renderer.building();
         let (restarted, converged, pass, cost) = (
             self.restarted_at,
             self.converged_after,

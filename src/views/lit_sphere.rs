@@ -80,6 +80,11 @@ impl LitSphereView {
         &self.messages
     }
 
+    /// Whether the renderer is still being built (shown last frame).
+    pub fn busy(&self) -> bool {
+        self.renderer.building() && self.view_rect.is_some()
+    }
+
     /// Whether the renderer is ready (it is built on a worker thread).
     pub fn ready(&self) -> bool {
         self.renderer.ready().is_some()
