@@ -134,6 +134,18 @@ pub fn gpu_for_test() -> Option<Gpu> {
 }
 
 impl Gpu {
+    /// A buffer holding `contents` (the per-frame parameter, tile and uniform
+    /// buffers of every renderer are made this way).
+    pub fn buffer(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        self.device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
+    }
+
     /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image.
     pub fn read_rgba8(&self, texture: &wgpu::Texture) -> Result<image::RgbaImage> {
         let (w, h) = (texture.width(), texture.height());

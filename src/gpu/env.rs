@@ -727,13 +727,7 @@ impl EnvRenderer {
             rotation: settings.rotation as f32,
             pad: [0.0; 2],
         };
-        let init = |label: &str, contents: &[u8], usage| {
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
+        let init = |label: &str, contents: &[u8], usage| self.gpu.buffer(label, contents, usage);
         let pbuf = init(
             "params",
             bytemuck::cast_slice(&params),

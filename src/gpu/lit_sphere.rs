@@ -11,7 +11,6 @@ use super::shaders::ShaderLibrary;
 use anyhow::{Result, bail};
 use bv_core::ModelSpec;
 use glam::DVec3;
-use wgpu::util::DeviceExt;
 
 /// What is behind the spheres (display values, i.e. already sRGB-encoded, 0..1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -265,14 +264,7 @@ impl LitSphereRenderer {
             color: [color[0], color[1], color[2], 1.0],
             color2: [color2[0], color2[1], color2[2], 1.0],
         };
-        let d = &self.gpu.device;
-        let init = |label: &str, contents: &[u8], usage| {
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
-        };
+        let init = |label: &str, contents: &[u8], usage| self.gpu.buffer(label, contents, usage);
         let pbuf = init(
             "params",
             bytemuck::cast_slice(&params),
