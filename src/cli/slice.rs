@@ -42,8 +42,9 @@ pub enum Curve {
     f_cos_mean = f_mean * |cos theta_o|.\n  \
     theta-h, theta-d: the same with theta_h_deg / theta_d_deg first (phi_h = 0,\n    \
     phi_d = 90 deg; the other angle is --fixed).\n  \
-    albedo: theta_i_deg,rho_r,rho_g,rho_b,rho_mean,std_error_mean (Monte Carlo,\n    \
-    the albedo view's estimator)."
+    albedo: theta_i_deg,rho_r,rho_g,rho_b,rho_mean,std_error_mean (the albedo view's\n    \
+    estimators: Gauss-Kronrod quadrature for analytic models, std_error_mean then\n    \
+    being its error estimate; Monte Carlo for measured ones, one standard error)."
 )]
 pub struct SliceArgs {
     /// The model and its parameters.

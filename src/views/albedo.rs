@@ -1,11 +1,13 @@
 //! The directional albedo view: `ρhd(θi) = ∫ f cos θo dωo` (plus the weights
-//! of delta lobes) against θi for every drawn BRDF, with its Monte Carlo error
-//! band, the energy-conservation line ρ = 1 and the current θi; the legend
-//! gives each BRDF's bihemispherical albedo ρhh (SPEC §3). The numbers are
-//! `bv_core::analysis::albedo`'s, the same estimator `bv check` reports.
+//! of delta lobes) against θi for every drawn BRDF, with its error band, the
+//! energy-conservation line ρ = 1 and the current θi; the legend gives each
+//! BRDF's bihemispherical albedo ρhh and the method behind the numbers. They
+//! are `bv_core::analysis::albedo`'s, the estimators `bv check` reports:
+//! deterministic Gauss–Kronrod quadrature for analytic models (band: its
+//! error estimate), Monte Carlo for measured ones (band: ±3 standard errors).
 //!
-//! A curve costs [`N_THETA`] × [`SAMPLES`] evaluations plus [`RHH_SAMPLES`] for
-//! ρhh, so it is computed on a background thread and cached process-wide by
+//! A curve costs up to [`N_THETA`] × some 10⁵ evaluations plus ρhh, so it is
+//! computed on a background thread and cached process-wide by
 //! (model, parameters, φi): a slider drag shows the last finished curve and a
 //! progress bar, and starts no work until the pointer is released. Figures
 //! (screenshots, `bv render`) compute it before drawing.
@@ -13,7 +15,7 @@
 use super::chart::{self, Band, Chart, Marker, Palette, Series};
 use super::{Scene, SceneBrdf, View};
 use crate::app::command::Command;
-use bv_core::analysis::albedo::{Estimate, rho_hd, rho_hh, theta_grid};
+use bv_core::analysis::albedo::{AlbedoOptions, Estimate, rho_hd_auto, rho_hh_auto, theta_grid};
 use bv_core::analysis::directions::stream_seed;
 use bv_core::{Brdf, mean_rgb};
 use eframe::egui::{self, Ui};
@@ -31,9 +33,19 @@ pub const SAMPLES: usize = 4096;
 pub const RHH_SAMPLES: usize = 32768;
 /// Seed of the estimates (fixed: the same BRDF always gives the same curve).
 pub const SEED: u64 = 0x0062_7661_6c62;
-/// Half-width of the error band in standard errors (±3σ covers the true value
-/// with about 99 % probability for these 16-replica estimates).
+/// Half-width of a Monte Carlo error band in standard errors (±3σ covers the
+/// true value with about 99 % probability for these 16-replica estimates); a
+/// quadrature's band is its error estimate.
 pub const BAND_SIGMAS: f64 = 3.0;
+
+/// The estimators' settings (quadrature for analytic models).
+fn options(seed: u64) -> AlbedoOptions {
+    AlbedoOptions {
+        samples: SAMPLES,
+        seed,
+        ..AlbedoOptions::default()
+    }
+}
 
 /// One finished curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,7 +76,7 @@ impl AlbedoData {
                 if cancel.load(Ordering::Relaxed) {
                     return None;
                 }
-                let e = rho_hd(brdf, t, phi_i, SAMPLES, stream_seed(SEED, k as u64));
+                let e = rho_hd_auto(brdf, t, phi_i, &options(stream_seed(SEED, k as u64)));
                 progress.fetch_add(1, Ordering::Relaxed);
                 Some(e)
             })
@@ -73,7 +85,7 @@ impl AlbedoData {
         if cancel.load(Ordering::Relaxed) {
             return None;
         }
-        let rho_hh = rho_hh(brdf, RHH_SAMPLES, SEED);
+        let rho_hh = rho_hh_auto(brdf, RHH_SAMPLES, &options(SEED));
         progress.fetch_add(1, Ordering::Relaxed);
         Some(Self {
             theta_deg: thetas.iter().map(|t| t.to_degrees()).collect(),
@@ -85,14 +97,21 @@ impl AlbedoData {
     /// The plotted value (channel mean) and its band half-width at sample `k`.
     pub fn mean_and_band(&self, k: usize) -> (f64, f64) {
         let e = &self.rho[k];
-        (mean_rgb(e.value), BAND_SIGMAS * mean_rgb(e.std_error))
+        (mean_rgb(e.value), mean_rgb(e.allowance(BAND_SIGMAS)))
     }
 
     /// Whether some channel exceeds 1 by more than its error band somewhere.
     pub fn exceeds_one(&self) -> bool {
-        self.rho
-            .iter()
-            .any(|e| (0..3).any(|c| e.value[c] - BAND_SIGMAS * e.std_error[c] > 1.0 + 1e-9))
+        self.rho.iter().any(|e| {
+            let band = e.allowance(BAND_SIGMAS);
+            (0..3).any(|c| e.value[c] - band[c] > 1.0 + 1e-9)
+        })
+    }
+
+    /// How the numbers were computed, for the legend: `quadrature` or
+    /// `monte carlo`.
+    pub fn method(&self) -> &'static str {
+        self.rho.first().map_or("quadrature", |e| e.method.name())
     }
 }
 
@@ -286,11 +305,18 @@ impl AlbedoView {
 
 fn legend_label(s: &Shown) -> String {
     let hh = &s.data.rho_hh;
+    let err = mean_rgb(hh.allowance(BAND_SIGMAS));
+    // Four decimals, or the error's own first digit when it is coarser.
+    let err_text = if err < 5e-5 {
+        format!("{:.0e}", err.max(1e-12))
+    } else {
+        format!("{err:.4}")
+    };
     let mut l = format!(
-        "{}: ρhh = {:.3} ± {:.3}",
+        "{}: ρhh = {:.4} ± {err_text} ({})",
         s.brdf.label,
         mean_rgb(hh.value),
-        BAND_SIGMAS * mean_rgb(hh.std_error)
+        s.data.method()
     );
     if s.data.exceeds_one() {
         l.push_str(" (ρhd > 1!)");

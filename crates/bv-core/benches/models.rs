@@ -144,15 +144,33 @@ fn lobes(c: &mut Criterion) {
 }
 
 fn albedo_curves(c: &mut Criterion) {
+    use albedo::{AlbedoMethod, AlbedoOptions};
     let mut g = c.benchmark_group("rho_hd_curve");
     g.sample_size(10);
     g.warm_up_time(Duration::from_millis(300));
     g.measurement_time(Duration::from_secs(1));
+    // One core: the target is per core, and the curve is parallel over angles.
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+    let Ok(one) = one else {
+        return;
+    };
     for (name, _, b) in models() {
-        // 90 angles × 4096 samples, as `bv check` does by default.
-        g.bench_function(format!("{name}/90x4096"), |bench| {
-            bench.iter(|| black_box(albedo::rho_hd_curve(b.as_ref(), 0.0, 90, 4096, 1)))
-        });
+        // 90 angles, as `bv check` does by default: quadrature for analytic
+        // models, and Monte Carlo with 4096 samples as the cross-check.
+        for (label, method) in [
+            ("quadrature/90", AlbedoMethod::Quadrature),
+            ("monte-carlo/90x4096", AlbedoMethod::MonteCarlo),
+        ] {
+            let opts = AlbedoOptions {
+                method,
+                ..AlbedoOptions::default()
+            };
+            g.bench_function(format!("{name}/{label}/1-core"), |bench| {
+                bench.iter(|| {
+                    one.install(|| black_box(albedo::rho_hd_curve(b.as_ref(), 0.0, 90, &opts)))
+                })
+            });
+        }
     }
     g.finish();
 }

@@ -84,6 +84,22 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         sampling::cosine_hemisphere_pdf(wo)
     }
 
+    /// Outgoing directions (unit, upper hemisphere) near which `f(wi, ·)` has a
+    /// narrow peak or a cusp *away from the mirror direction*, so that the
+    /// albedo quadrature places panel breaks there (a Lafortune lobe about
+    /// `C wi`, Hapke's opposition surge at `wi`). The mirror direction is
+    /// always treated as a peak. Default: none.
+    fn peaks(&self, _wi: DVec3) -> Vec<DVec3> {
+        Vec::new()
+    }
+
+    /// Whether `f` is a closed-form function that a deterministic quadrature
+    /// may integrate to its stated accuracy. Tabulated and user-defined models
+    /// answer `false`: their albedo is estimated by Monte Carlo.
+    fn is_analytic(&self) -> bool {
+        self.measured().is_none()
+    }
+
     /// The microfacet distribution, for models that have one.
     fn ndf(&self) -> Option<&dyn Ndf> {
         None

@@ -11,12 +11,11 @@
 //! integrands), plus the inner integrals' errors carried through the outer
 //! rule's weights.
 
+use super::gauss_kronrod;
 use crate::Ndf;
 use crate::frame;
 use glam::DVec3;
 use serde::Serialize;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Result of a quadrature.
@@ -28,134 +27,6 @@ pub struct Quadrature {
     pub error: f64,
     /// Integrand evaluations used.
     pub evaluations: usize,
-}
-
-/// Kronrod nodes (non-negative half) of the 15-point rule, and weights.
-const XGK: [f64; 8] = [
-    0.991_455_371_120_812_6,
-    0.949_107_912_342_758_5,
-    0.864_864_423_359_769_1,
-    0.741_531_185_599_394_4,
-    0.586_087_235_467_691_1,
-    0.405_845_151_377_397_2,
-    0.207_784_955_007_898_5,
-    0.0,
-];
-const WGK: [f64; 8] = [
-    0.022_935_322_010_529_22,
-    0.063_092_092_629_978_55,
-    0.104_790_010_322_250_2,
-    0.140_653_259_715_525_9,
-    0.169_004_726_639_267_9,
-    0.190_350_578_064_785_4,
-    0.204_432_940_075_298_9,
-    0.209_482_141_084_727_8,
-];
-/// Gauss 7-point weights, at the odd Kronrod nodes (XGK[1], XGK[3], XGK[5], 0).
-const WG: [f64; 4] = [
-    0.129_484_966_168_869_7,
-    0.279_705_391_489_276_7,
-    0.381_830_050_505_118_9,
-    0.417_959_183_673_469_4,
-];
-
-/// One GK15 panel of an integrand returning `(value, error of the value)`:
-/// `(K15, |K15 − G7| + Σ wK · error)`.
-fn gk15(f: &mut impl FnMut(f64) -> (f64, f64), a: f64, b: f64) -> (f64, f64) {
-    let c = 0.5 * (a + b);
-    let h = 0.5 * (b - a);
-    let mut k = 0.0;
-    let mut g = 0.0;
-    let mut inner = 0.0;
-    for i in 0..8 {
-        let pts: &[f64] = if i == 7 {
-            &[c]
-        } else {
-            &[c - h * XGK[i], c + h * XGK[i]]
-        };
-        for &x in pts {
-            let (v, e) = f(x);
-            k += WGK[i] * v;
-            inner += WGK[i] * e;
-            if i % 2 == 1 {
-                g += WG[i / 2] * v;
-            }
-        }
-    }
-    (k * h, ((k - g) * h).abs() + inner * h)
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Panel {
-    a: f64,
-    b: f64,
-    value: f64,
-    error: f64,
-}
-
-impl PartialEq for Panel {
-    fn eq(&self, o: &Self) -> bool {
-        self.error.total_cmp(&o.error) == Ordering::Equal
-    }
-}
-impl Eq for Panel {}
-impl PartialOrd for Panel {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Panel {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.error.total_cmp(&o.error)
-    }
-}
-
-/// Global adaptive GK15 over the panels between consecutive `breaks`: bisects
-/// the panel with the largest error until the total error is at most
-/// `rel_tol · |value|` or `max_panels` panels exist. Returns
-/// `(value, error, evaluations)`.
-fn adaptive(
-    f: &mut impl FnMut(f64) -> (f64, f64),
-    breaks: &[f64],
-    rel_tol: f64,
-    max_panels: usize,
-) -> (f64, f64, usize) {
-    let mut heap = BinaryHeap::new();
-    let mut evals = 0;
-    for w in breaks.windows(2) {
-        let (value, error) = gk15(f, w[0], w[1]);
-        evals += 15;
-        heap.push(Panel {
-            a: w[0],
-            b: w[1],
-            value,
-            error,
-        });
-    }
-    loop {
-        let value: f64 = heap.iter().map(|p| p.value).sum();
-        let error: f64 = heap.iter().map(|p| p.error).sum();
-        let done = error <= rel_tol * value.abs() || !error.is_finite();
-        if done || heap.len() >= max_panels {
-            return (value, error, evals);
-        }
-        let Some(p) = heap.pop() else {
-            return (value, error, evals);
-        };
-        let m = 0.5 * (p.a + p.b);
-        if m <= p.a || m >= p.b {
-            // Cannot bisect further in floating point: keep the panel and stop.
-            heap.push(p);
-            let value: f64 = heap.iter().map(|p| p.value).sum();
-            let error: f64 = heap.iter().map(|p| p.error).sum();
-            return (value, error, evals);
-        }
-        for (a, b) in [(p.a, m), (m, p.b)] {
-            let (value, error) = gk15(f, a, b);
-            evals += 15;
-            heap.push(Panel { a, b, value, error });
-        }
-    }
 }
 
 /// `∫ g(h) dωh` over the upper hemisphere for an integrand peaked at the
@@ -173,6 +44,8 @@ pub fn integrate_hemisphere(
     // Panel budgets: inner rules are nested in outer ones, so split the budget.
     let inner_panels = 400usize;
     let outer_panels = (max_evals / (15 * 15 * 40)).clamp(8, 2000);
+    let theta_segs = gauss_kronrod::segments(&theta_breaks, false, false);
+    let phi_segs = gauss_kronrod::segments(&phi_breaks, false, false);
     let mut evals = 0usize;
     let mut outer = |phi: f64| {
         let mut inner = |theta: f64| {
@@ -180,14 +53,21 @@ pub fn integrate_hemisphere(
             // dω = sin θ dθ dφ.
             (g(h) * theta.sin(), 0.0)
         };
-        let (v, e, n) = adaptive(&mut inner, &theta_breaks, rel_tol * 0.1, inner_panels);
-        evals += n;
-        (v, e)
+        let r = gauss_kronrod::integrate(
+            &mut inner,
+            &theta_segs,
+            0.0,
+            rel_tol * 0.1,
+            inner_panels,
+            false,
+        );
+        evals += r.evaluations;
+        (r.value, r.error)
     };
-    let (value, error, _) = adaptive(&mut outer, &phi_breaks, rel_tol, outer_panels);
+    let r = gauss_kronrod::integrate(&mut outer, &phi_segs, 0.0, rel_tol, outer_panels, false);
     Quadrature {
-        value,
-        error,
+        value: r.value,
+        error: r.error,
         evaluations: evals,
     }
 }

@@ -161,6 +161,12 @@ impl Brdf for Hapke {
         Rgb::splat(f)
     }
 
+    /// The opposition surge and a backward Henyey–Greenstein lobe peak at
+    /// zero phase angle, `wo = wi` (the surge has a cusp there).
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        vec![wi]
+    }
+
     fn claims(&self) -> Claims {
         Claims {
             reciprocal: true,

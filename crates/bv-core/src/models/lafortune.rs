@@ -190,6 +190,15 @@ impl Brdf for Lafortune {
         f
     }
 
+    /// Each lobe `(C wi · wo)^n` peaks at `wo = C wi / |C wi|`.
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        self.lobes
+            .iter()
+            .filter_map(|l| (l.c * wi).try_normalize())
+            .filter(|v| v.z > 0.0)
+            .collect()
+    }
+
     /// Reciprocal: each lobe's base is symmetric in `wi` and `wo`.
     ///
     /// Isotropic when every lobe that contributes (`ks ≠ 0`) has `cx = cy`:

@@ -229,6 +229,14 @@ impl Brdf for Mix {
         self.parts.iter().any(|p| p.brdf.transmits())
     }
 
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        self.parts.iter().flat_map(|p| p.brdf.peaks(wi)).collect()
+    }
+
+    fn is_analytic(&self) -> bool {
+        self.parts.iter().all(|p| p.brdf.is_analytic())
+    }
+
     fn sample(&self, wi: DVec3, u: DVec2) -> Option<DVec3> {
         // Pick part j with probability w_j / Σw from u.x, rescale u.x within its
         // interval to a fresh uniform, and let the part draw: the density of the
