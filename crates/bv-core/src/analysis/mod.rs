@@ -670,7 +670,9 @@ mod tests {
         assert!(!text.contains("contradicts"), "{text}");
         let json = serde_json::to_value(&rep).unwrap();
         assert_eq!(json["model"], "lambert");
-        let hh = json["energy"]["rho_hh"]["value"][1].as_f64().unwrap_or(f64::NAN);
+        let hh = json["energy"]["rho_hh"]["value"][1]
+            .as_f64()
+            .unwrap_or(f64::NAN);
         assert!((hh - 0.5).abs() < 1e-9, "{hh}");
         assert_eq!(json["energy"]["method"], "quadrature");
     }
