@@ -263,17 +263,17 @@ pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
     // otherwise vanish from the figure without a word.
     for (i, b) in state.brdfs.iter().enumerate() {
         if let Err(e) = b.spec.build() {
-            let key = format!("brdfs[{i}] (model `{}`)", b.spec.model);
+            let reason = format!("the `{}` BRDF cannot be built: {e}", b.spec.model);
             match builds {
                 Builds::Required => {
                     return Err(SceneError::BadValue {
-                        key,
-                        reason: e.to_string(),
+                        key: format!("brdfs[{i}]"),
+                        reason,
                     });
                 }
-                Builds::Warn => warnings.push(format!(
-                    "`{key}` cannot be built and draws nothing: {e}"
-                )),
+                Builds::Warn => {
+                    warnings.push(format!("`brdfs[{i}]`: {reason}; it draws nothing"));
+                }
             }
         }
     }
@@ -580,6 +580,50 @@ mod tests {
         assert_eq!(back.warnings.len(), 1, "{:?}", back.warnings);
         assert!(back.warnings[0].contains("incident.shininess"));
         assert_eq!(back.state, sample());
+    }
+
+    #[test]
+    fn file_paths_are_relative_to_the_scene_file() {
+        use bv_core::measured::merl::{MerlDims, MerlTable};
+        let dir = std::env::temp_dir().join(format!("bv-scene-paths-{}", std::process::id()));
+        let sub = dir.join("scenes");
+        std::fs::create_dir_all(&sub).unwrap();
+        let dims = MerlDims::new(1, 1, 2).unwrap();
+        let table = MerlTable::from_values(dims, vec![0.1; 6]).unwrap();
+        table.write(sub.join("t.binary")).unwrap();
+        table.write(dir.join("outside.binary")).unwrap();
+        let merl = |p: &Path| {
+            ModelSpec::from_json(
+                "merl",
+                &serde_json::json!({"path": p.display().to_string()}),
+            )
+            .unwrap()
+        };
+        let mut s = AppState::default();
+        // Paths as the window holds them: usable from the current directory.
+        s.add(merl(&sub.join("t.binary")));
+        s.add(merl(&dir.join("outside.binary")));
+        s.lighting.env.map = Some(sub.join("env.hdr").display().to_string());
+        let file = sub.join("s.toml");
+        save(&file, &s).unwrap();
+        let text = std::fs::read_to_string(&file).unwrap();
+        // Inside the scene's folder: relative; outside: absolute.
+        assert!(text.contains("path = \"t.binary\""), "{text}");
+        assert!(text.contains("map = \"env.hdr\""), "{text}");
+        let abs = std::path::absolute(dir.join("outside.binary")).unwrap();
+        assert!(text.contains(&abs.display().to_string()), "{text}");
+        // Loading resolves them against the folder again, wherever bv runs.
+        let back = load(&file).unwrap();
+        let p = back.state.brdfs[0].spec.params.text("path").unwrap();
+        assert_eq!(Path::new(&p), sub.join("t.binary"));
+        // A table that is not there refuses the scene, or warns in the window.
+        std::fs::remove_file(sub.join("t.binary")).unwrap();
+        let e = load(&file).unwrap_err().to_string();
+        assert!(e.contains("brdfs[0]") && e.contains("t.binary"), "{e}");
+        let lenient = load_with(&file, Builds::Warn).unwrap();
+        assert_eq!(lenient.state.brdfs.len(), 2);
+        assert!(lenient.warnings.iter().any(|w| w.contains("brdfs[0]")));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
