@@ -63,7 +63,11 @@ impl Run {
 
     /// `bad` appears nowhere in stderr.
     fn never(&self, bad: &str) -> &Self {
-        assert!(!self.stderr.contains(bad), "stderr has `{bad}`: {}", self.stderr);
+        assert!(
+            !self.stderr.contains(bad),
+            "stderr has `{bad}`: {}",
+            self.stderr
+        );
         self
     }
 }
@@ -72,7 +76,13 @@ impl Run {
 /// given sinks, killing it at [`DEADLINE`].
 fn run_in(dir: &Path, args: &[&str], stdin: &[u8], out: Sink, err: Sink) -> Run {
     let full = || Stdio::from(File::options().write(true).open("/dev/full").unwrap());
-    let sink = |s: Sink| if s == Sink::Full { full() } else { Stdio::piped() };
+    let sink = |s: Sink| {
+        if s == Sink::Full {
+            full()
+        } else {
+            Stdio::piped()
+        }
+    };
     let mut child = Command::new(BV)
         .args(args)
         .current_dir(dir)
@@ -284,7 +294,9 @@ fn render_svg_never_replaces_what_it_must_not() {
     // every figure.
     check_writer(
         "render",
-        &["render", "--model", "lambert", "--view", "polar", "--out", "{}"],
+        &[
+            "render", "--model", "lambert", "--view", "polar", "--out", "{}",
+        ],
         ".svg",
     );
 }
@@ -307,7 +319,9 @@ fn reads_refuse_fifos_devices_directories_and_huge_files_at_once() {
             a.push(path);
             run(&d, &a)
         };
-        go("fifo").expect(1).says(&["fifo", "FIFO", "not a regular file"]);
+        go("fifo")
+            .expect(1)
+            .says(&["fifo", "FIFO", "not a regular file"]);
         go("/dev/zero")
             .expect(1)
             .says(&["/dev/zero", "character device"]);
@@ -321,12 +335,16 @@ fn reads_refuse_fifos_devices_directories_and_huge_files_at_once() {
             .expect(1)
             .says(&["dangling.toml", "missing.toml", "does not exist"]);
     }
-    run(&d, &["scene", "check", "huge.toml"])
-        .expect(1)
-        .says(&["huge.toml", "100000000 bytes", "over the 1 MiB limit"]);
-    run(&d, &["info", "huge.binary"])
-        .expect(1)
-        .says(&["huge.binary", "over the", "limit for a MERL"]);
+    run(&d, &["scene", "check", "huge.toml"]).expect(1).says(&[
+        "huge.toml",
+        "100000000 bytes",
+        "over the 1 MiB limit",
+    ]);
+    run(&d, &["info", "huge.binary"]).expect(1).says(&[
+        "huge.binary",
+        "over the",
+        "limit for a MERL",
+    ]);
     assert!(is_fifo(&d.join("fifo")));
     fs::remove_dir_all(&d).unwrap();
 }
@@ -334,7 +352,11 @@ fn reads_refuse_fifos_devices_directories_and_huge_files_at_once() {
 #[test]
 fn a_symlink_to_a_scene_reads_like_the_scene() {
     let d = dir("read-link");
-    run(&d, &["scene", "new", "--model", "lambert", "--out", "s.toml"]).expect(0);
+    run(
+        &d,
+        &["scene", "new", "--model", "lambert", "--out", "s.toml"],
+    )
+    .expect(0);
     symlink("s.toml", d.join("l.toml")).unwrap();
     let r = run(&d, &["scene", "check", "l.toml"]);
     r.expect(0);
@@ -346,11 +368,17 @@ fn a_symlink_to_a_scene_reads_like_the_scene() {
 fn a_full_stdout_is_an_error_not_a_panic() {
     let d = dir("full-out");
     fs::write(d.join("t.binary"), merl_bytes(1.0)).unwrap();
-    run(&d, &["scene", "new", "--model", "lambert", "--out", "s.toml"]).expect(0);
+    run(
+        &d,
+        &["scene", "new", "--model", "lambert", "--out", "s.toml"],
+    )
+    .expect(0);
     let cases: [&[&str]; 7] = [
         &["info", "t.binary"],
         &["info", "t.binary", "--json"],
-        &["tabulate", "--model", "lambert", "--dims", "1,1,2", "--out", "o.binary"],
+        &[
+            "tabulate", "--model", "lambert", "--dims", "1,1,2", "--out", "o.binary",
+        ],
         &["models"],
         &["check", "--model", "lambert"],
         &["scene", "print", "s.toml"],
@@ -377,8 +405,22 @@ fn a_full_stderr_never_panics() {
     let r = run_in(&d, &["eval"], b"[1]\n", Sink::Pipe, Sink::Full);
     r.expect(1);
     assert!(r.stdout.contains("must be a JSON object"), "{r:?}");
-    run_in(&d, &["scene", "check", "missing.toml"], b"", Sink::Pipe, Sink::Full).expect(1);
-    run_in(&d, &["info", "x", "--pairs", "0"], b"", Sink::Pipe, Sink::Full).expect(2);
+    run_in(
+        &d,
+        &["scene", "check", "missing.toml"],
+        b"",
+        Sink::Pipe,
+        Sink::Full,
+    )
+    .expect(1);
+    run_in(
+        &d,
+        &["info", "x", "--pairs", "0"],
+        b"",
+        Sink::Pipe,
+        Sink::Full,
+    )
+    .expect(2);
     // Both streams full.
     run_in(&d, &["models"], b"", Sink::Full, Sink::Full).expect(1);
     fs::remove_dir_all(&d).unwrap();
@@ -397,15 +439,33 @@ fn counts_are_capped_and_the_cap_is_stated() {
     run(&d, &["bench", "--model", "lambert", "--pairs", "1e9"])
         .expect(2)
         .says(&["1..=50000000"]);
-    run(&d, &["slice", "--model", "lambert", "--samples", "99999999999"])
-        .expect(1)
-        .says(&["--samples", "2..=1000000"]);
-    run(&d, &["tabulate", "--model", "lambert", "--dims", "5000,5000,5000", "--out", "x.binary"])
-        .expect(1)
-        .says(&["cap"]);
+    run(
+        &d,
+        &["slice", "--model", "lambert", "--samples", "99999999999"],
+    )
+    .expect(1)
+    .says(&["--samples", "2..=1000000"]);
+    run(
+        &d,
+        &[
+            "tabulate",
+            "--model",
+            "lambert",
+            "--dims",
+            "5000,5000,5000",
+            "--out",
+            "x.binary",
+        ],
+    )
+    .expect(1)
+    .says(&["cap"]);
     assert!(!d.join("x.binary").exists());
     // Within the caps all is well.
-    run(&d, &["info", "t.binary", "--pairs", "10", "--samples", "16"]).expect(0);
+    run(
+        &d,
+        &["info", "t.binary", "--pairs", "10", "--samples", "16"],
+    )
+    .expect(0);
     fs::remove_dir_all(&d).unwrap();
 }
 
@@ -445,7 +505,11 @@ fn every_clamped_value_is_a_warning() {
     let d = dir("clamps");
     let extra = "[display]\nsh_order = 200\n[lighting.lit]\nexposure_ev = 99.0\n\
                  [lighting.env]\ntarget_spp = 0\n";
-    fs::write(d.join("c.toml"), scene_text("lambert", "albedo = 0.5", extra)).unwrap();
+    fs::write(
+        d.join("c.toml"),
+        scene_text("lambert", "albedo = 0.5", extra),
+    )
+    .unwrap();
     let r = run(&d, &["scene", "check", "c.toml"]);
     r.expect(0).says(&[
         "display.sh_order = 200",
@@ -478,7 +542,8 @@ fn an_all_nan_table_says_it_has_no_valid_sample() {
     let r = run(&d, &["info", "nan.binary"]);
     r.expect(0);
     assert!(
-        r.stdout.contains("no valid sample at all in channels red, green, blue"),
+        r.stdout
+            .contains("no valid sample at all in channels red, green, blue"),
         "{}",
         r.stdout
     );
@@ -492,9 +557,21 @@ fn an_all_nan_table_says_it_has_no_valid_sample() {
 #[test]
 fn a_param_before_any_model_is_refused() {
     let d = dir("param-first");
-    run(&d, &["scene", "new", "-p", "albedo=0.2", "--model", "lambert", "--out", "s.toml"])
-        .expect(1)
-        .says(&["-p albedo=0.2", "before any --model"]);
+    run(
+        &d,
+        &[
+            "scene",
+            "new",
+            "-p",
+            "albedo=0.2",
+            "--model",
+            "lambert",
+            "--out",
+            "s.toml",
+        ],
+    )
+    .expect(1)
+    .says(&["-p albedo=0.2", "before any --model"]);
     assert!(!d.join("s.toml").exists());
     fs::remove_dir_all(&d).unwrap();
 }
@@ -522,7 +599,16 @@ fn messages_say_each_thing_once_and_truly() {
     for args in [
         &["check", "--model", "lambert", "-p", "albedo=1e300"][..],
         &["slice", "--model", "lambert", "--theta-i", "1e300"],
-        &["scene", "new", "--model", "lambert", "--theta-i", "1e300", "--out", "x.toml"],
+        &[
+            "scene",
+            "new",
+            "--model",
+            "lambert",
+            "--theta-i",
+            "1e300",
+            "--out",
+            "x.toml",
+        ],
     ] {
         let r = run(&d, args);
         r.expect(1).says(&["1e300"]);

@@ -36,9 +36,9 @@
 //! the old scene intact.
 
 use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
-use serde::Deserialize;
 use bv_core::fsio;
 use bv_core::{ModelSpec, ParamKind, ParamValue};
+use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -245,9 +245,8 @@ pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
     let mut ignored = Vec::new();
     let de = toml::Deserializer::parse(text)
         .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
-    let mut state: AppState =
-        serde_ignored::deserialize(de, |path| ignored.push(path.to_string()))
-            .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
+    let mut state: AppState = serde_ignored::deserialize(de, |path| ignored.push(path.to_string()))
+        .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
     for key in ignored {
         if key == "format" || key == "generator" {
             continue;
@@ -419,7 +418,10 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         } else {
             bad(
                 key,
-                format!("{} is outside {lo}..={hi}{unit}", bv_core::error::fmt_num(x)),
+                format!(
+                    "{} is outside {lo}..={hi}{unit}",
+                    bv_core::error::fmt_num(x)
+                ),
             )
         }
     };
@@ -435,7 +437,10 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     if !c.yaw_deg.is_finite() {
         return bad(
             "camera.yaw_deg",
-            format!("{} is not a finite angle", bv_core::error::fmt_num(f64::from(c.yaw_deg))),
+            format!(
+                "{} is not a finite angle",
+                bv_core::error::fmt_num(f64::from(c.yaw_deg))
+            ),
         );
     }
     range(

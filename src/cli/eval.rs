@@ -335,8 +335,7 @@ impl<'de> serde::de::Visitor<'de> for StrictVisitor {
             if out.contains_key(&key) {
                 return Err(serde::de::Error::custom(format!(
                     "duplicate key `{}`",
-                    quote(&Value::String(key))
-                        .trim_matches('"')
+                    quote(&Value::String(key)).trim_matches('"')
                 )));
             }
             let StrictValue(v) = map.next_value()?;

@@ -128,7 +128,8 @@ fn num(v: &Value) -> f64 {
 
 /// A statistic of the report, `-` where there is none (no valid sample).
 fn stat(v: &Value) -> String {
-    v.as_f64().map_or_else(|| "-".to_string(), |x| format!("{x:.6}"))
+    v.as_f64()
+        .map_or_else(|| "-".to_string(), |x| format!("{x:.6}"))
 }
 
 fn int(v: &Value) -> u64 {
@@ -151,7 +152,10 @@ fn text(r: &Value) -> String {
         "dimensions:  θh {} × θd {} × φd {} ({} cells per channel)",
         d[0], d[1], d[2], r["cells_per_channel"]
     );
-    let _ = writeln!(out, "values (f in 1/sr, channel scales applied; over valid samples):");
+    let _ = writeln!(
+        out,
+        "values (f in 1/sr, channel scales applied; over valid samples):"
+    );
     let _ = writeln!(
         out,
         "  {:<6} {:>12} {:>12} {:>12} {:>10} {:>11} {:>10}",
@@ -159,7 +163,7 @@ fn text(r: &Value) -> String {
     );
     for c in r["channels"].as_array().into_iter().flatten() {
         let _ = writeln!(
-        out,
+            out,
             "  {:<6} {:>12} {:>12} {:>12} {:>10} {:>11} {:>10}",
             c["name"].as_str().unwrap_or(""),
             stat(&c["min"]),
@@ -191,7 +195,7 @@ fn text(r: &Value) -> String {
             .collect();
         if v.len() == 3 && e.len() == 3 {
             let _ = writeln!(
-        out,
+                out,
                 "  θi = {:>4.0}°  r {:.4} ± {:.4}  g {:.4} ± {:.4}  b {:.4} ± {:.4}",
                 num(&x["theta_i_deg"]),
                 v[0],

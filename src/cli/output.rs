@@ -148,7 +148,8 @@ mod tests {
         let inner = anyhow::Error::new(io).context("dir.toml: Is a directory (os error 21)");
         let e = inner.context("dir.toml");
         assert_eq!(message(&e), "dir.toml: Is a directory (os error 21)");
-        let e: anyhow::Result<()> = Err(anyhow::anyhow!("x.toml: bad value")).context("--scene x.toml");
+        let e: anyhow::Result<()> =
+            Err(anyhow::anyhow!("x.toml: bad value")).context("--scene x.toml");
         assert_eq!(message(&e.unwrap_err()), "--scene x.toml: bad value");
         let e = anyhow::anyhow!("no parameter `alpha`").context("--param alpha=0.1");
         assert_eq!(message(&e), "--param alpha=0.1: no parameter `alpha`");
@@ -165,6 +166,8 @@ mod tests {
             "cannot write to stdout: No space left on device (os error 28)"
         );
         assert!(!is_broken_pipe(&e));
-        assert!(is_broken_pipe(&stdout_error(io::ErrorKind::BrokenPipe.into())));
+        assert!(is_broken_pipe(&stdout_error(
+            io::ErrorKind::BrokenPipe.into()
+        )));
     }
 }

@@ -2,9 +2,9 @@
 //! (the viewer opens them with `bv --scene FILE` or Ctrl+O; `bv render
 //! --scene FILE` draws them).
 
+use super::output::eprint;
 use crate::app::scene;
 use crate::app::state::AppState;
-use super::output::eprint;
 use anyhow::{Context as _, Result, bail};
 use std::path::PathBuf;
 
@@ -197,7 +197,10 @@ fn group_params(argv: &[String]) -> Result<Vec<Vec<String>>> {
             }
         } else if a.len() > 2 && a.starts_with('-') && a.is_char_boundary(2) {
             let v = &a[2..];
-            (a[..2].to_string(), Some(v.strip_prefix('=').unwrap_or(v).to_string()))
+            (
+                a[..2].to_string(),
+                Some(v.strip_prefix('=').unwrap_or(v).to_string()),
+            )
         } else {
             (a.clone(), None)
         };
@@ -266,7 +269,15 @@ mod tests {
 
     #[test]
     fn attached_short_values_are_paired_too() {
-        let argv = args(&["bv", "scene", "new", "-mlambert", "-palbedo=0.2", "-o", "-p"]);
+        let argv = args(&[
+            "bv",
+            "scene",
+            "new",
+            "-mlambert",
+            "-palbedo=0.2",
+            "-o",
+            "-p",
+        ]);
         assert_eq!(
             group_params(&argv).unwrap(),
             vec![vec!["albedo=0.2".to_string()]]

@@ -88,7 +88,7 @@ pub fn human_bytes(n: u64) -> String {
     for (unit, size) in UNITS {
         if n >= size {
             let x = n as f64 / size as f64;
-            let shown = if n % size == 0 {
+            let shown = if n.is_multiple_of(size) {
                 format!("{}", n / size)
             } else {
                 format!("{x:.1}")
@@ -344,10 +344,15 @@ pub fn write_atomic(
             ));
         }
         if is_read_only(&target, m) {
+            let what = if m.permissions().readonly() {
+                "read-only"
+            } else {
+                "not writable by this user"
+            };
             return Err(file_err(
                 path,
                 format!(
-                    "the file is read-only{}; bv does not overwrite it (make it writable \
+                    "the file is {what}{}; bv does not overwrite it (make it writable \
                      or choose another name)",
                     mode_text(m)
                 ),
@@ -381,8 +386,12 @@ pub fn write_atomic(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .ok_or_else(|| file_err(path, "not a file name"))?;
-    let (tmp, file) = create_temp(&dir, &name, existing.as_ref())
-        .map_err(|e| file_err(path, format!("cannot create a file in {}: {e}", dir.display())))?;
+    let (tmp, file) = create_temp(&dir, &name, existing.as_ref()).map_err(|e| {
+        file_err(
+            path,
+            format!("cannot create a file in {}: {e}", dir.display()),
+        )
+    })?;
     let result = (|| {
         let mut w = io::BufWriter::with_capacity(1 << 16, file);
         write(&mut w)?;
