@@ -31,9 +31,18 @@
 //! key is a warning (the rest still loads). A file that bv wrote carries
 //! `generator` and ends with [`END_MARKER`]; if the marker is missing the file
 //! was cut short, and loading it is refused rather than silently filling the
-//! lost tail with defaults. Saving writes a temporary file beside the target,
-//! syncs it and renames it over the target, so a crash or a full disk leaves
-//! the old scene intact.
+//! lost tail with defaults. A BRDF that cannot be built (a MERL table that is
+//! missing) refuses the scene on the command line and is a warning in the
+//! window ([`Builds`]); a value that would be clamped into range is a
+//! warning. File paths in a scene (MERL tables, the environment map) are
+//! relative to the scene file's folder: [`load`] resolves them there and
+//! [`save`] writes paths inside that folder relative to it, so a folder of a
+//! scene and its tables can move as a whole. Reading refuses anything but a
+//! regular file of at most 1 MiB ([`fsio::read_capped`]). Saving writes a
+//! temporary file beside the target, syncs it and renames it over the target,
+//! so a crash or a full disk leaves the old scene intact; FIFOs, devices and
+//! read-only files are refused, and a symlink is written through
+//! ([`fsio::write_atomic`]).
 
 use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
 use bv_core::fsio;

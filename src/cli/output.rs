@@ -2,9 +2,9 @@
 //!
 //! `println!` and `eprintln!` panic when the stream cannot be written
 //! (`bv info F > /dev/full`, `bv eval 2>/dev/full`). Results go through
-//! [`print`], which returns a [`StreamError`] that `main` reports as
+//! [`print()`], which returns a [`StreamError`] that `main` reports as
 //! `bv: cannot write to stdout: No space left on device (os error 28)` with
-//! exit status 1; messages go through [`eprint`], best effort (if stderr
+//! exit status 1; messages go through [`eprint()`], best effort (if stderr
 //! itself is gone there is nobody to tell). A closed pipe (`bv models |
 //! head`) is a quiet exit ([`is_broken_pipe`]).
 

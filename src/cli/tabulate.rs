@@ -21,7 +21,8 @@ pub struct TabulateArgs {
     /// Output file (see --help for what happens to an existing one).
     #[arg(long, value_name = "FILE.binary", long_help = super::output::OUT_HELP)]
     pub out: PathBuf,
-    /// Cells along θh, θd, φd.
+    /// Cells along θh, θd, φd: each 1 to 4096, at most 16777216 cells (a
+    /// 384 MiB file).
     #[arg(long, default_value = "90,90,180", value_name = "NθH,NθD,NΦD")]
     pub dims: String,
 }
