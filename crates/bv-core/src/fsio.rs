@@ -266,6 +266,16 @@ fn resolve_target(path: &Path) -> Result<PathBuf> {
                 }
                 return Ok(p);
             }
+            Err(e) if e.kind() == io::ErrorKind::NotADirectory => {
+                let parent = p.parent().map(|d| d.display().to_string());
+                return Err(file_err(
+                    path,
+                    format!(
+                        "a part of the folder {} is a file, not a directory",
+                        parent.unwrap_or_default()
+                    ),
+                ));
+            }
             Err(e) => return Err(file_err(path, e.to_string())),
         }
     }
