@@ -126,10 +126,19 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
+/// `x` with `prec` decimals, in exponent form when it is large (a table of
+/// absurd values must not print 40-digit numbers).
+fn fixed(x: f64, prec: usize) -> String {
+    if x.abs() < 1e6 || !x.is_finite() {
+        format!("{x:.prec$}")
+    } else {
+        format!("{x:.prec$e}")
+    }
+}
+
 /// A statistic of the report, `-` where there is none (no valid sample).
 fn stat(v: &Value) -> String {
-    v.as_f64()
-        .map_or_else(|| "-".to_string(), |x| format!("{x:.6}"))
+    v.as_f64().map_or_else(|| "-".to_string(), |x| fixed(x, 6))
 }
 
 fn int(v: &Value) -> u64 {
@@ -196,14 +205,14 @@ fn text(r: &Value) -> String {
         if v.len() == 3 && e.len() == 3 {
             let _ = writeln!(
                 out,
-                "  θi = {:>4.0}°  r {:.4} ± {:.4}  g {:.4} ± {:.4}  b {:.4} ± {:.4}",
+                "  θi = {:>4.0}°  r {} ± {}  g {} ± {}  b {} ± {}",
                 num(&x["theta_i_deg"]),
-                v[0],
-                e[0],
-                v[1],
-                e[1],
-                v[2],
-                e[2]
+                fixed(v[0], 4),
+                fixed(e[0], 4),
+                fixed(v[1], 4),
+                fixed(e[1], 4),
+                fixed(v[2], 4),
+                fixed(e[2], 4)
             );
         }
     }
