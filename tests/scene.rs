@@ -212,7 +212,6 @@ fn an_interrupted_save_leaves_the_old_file_intact() {
     // The writer dies half way (a full disk, a crash): the target is untouched
     // and no temporary file is left behind.
     let r = scene::write_atomic(&path, |f| {
-        use std::io::Write;
         f.write_all(&before[..before.len() / 2])?;
         Err(std::io::Error::other("simulated crash"))
     });

@@ -248,6 +248,33 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
+    #[cfg(unix)]
+    #[test]
+    fn a_fifo_or_a_device_is_refused_at_once_not_waited_on() {
+        let dir = std::env::temp_dir().join(format!("bv-loader-fifo-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let fifo = dir.join("pipe.binary");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let mut l = Loader::default();
+        l.start(fifo, LoadTarget::New);
+        l.start(PathBuf::from("/dev/zero"), LoadTarget::New);
+        // Opening a FIFO without O_NONBLOCK would wait for a writer forever.
+        assert!(l.wait(Duration::from_secs(10)), "a read is still blocked");
+        let mut errors: Vec<String> = l
+            .poll()
+            .into_iter()
+            .map(|f| f.result.unwrap_err())
+            .collect();
+        errors.sort();
+        assert!(errors[0].contains("/dev/zero") && errors[0].contains("character device"));
+        assert!(errors[1].contains("pipe.binary") && errors[1].contains("FIFO"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn texts() {
         assert_eq!(progress_text(0, 0), "opening…");

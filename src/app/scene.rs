@@ -31,14 +31,24 @@
 //! key is a warning (the rest still loads). A file that bv wrote carries
 //! `generator` and ends with [`END_MARKER`]; if the marker is missing the file
 //! was cut short, and loading it is refused rather than silently filling the
-//! lost tail with defaults. Saving writes a temporary file beside the target,
-//! syncs it and renames it over the target, so a crash or a full disk leaves
-//! the old scene intact.
+//! lost tail with defaults. A BRDF that cannot be built (a MERL table that is
+//! missing) refuses the scene on the command line and is a warning in the
+//! window ([`Builds`]); a value that would be clamped into range is a
+//! warning. File paths in a scene (MERL tables, the environment map) are
+//! relative to the scene file's folder: [`load`] resolves them there and
+//! [`save`] writes paths inside that folder relative to it, so a folder of a
+//! scene and its tables can move as a whole. Reading refuses anything but a
+//! regular file of at most 1 MiB ([`fsio::read_capped`]). Saving writes a
+//! temporary file beside the target, syncs it and renames it over the target,
+//! so a crash or a full disk leaves the old scene intact; FIFOs, devices and
+//! read-only files are refused, and a symlink is written through
+//! ([`fsio::write_atomic`]).
 
 use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
+use bv_core::fsio;
+use bv_core::{ModelSpec, ParamKind, ParamValue};
 use serde::Deserialize;
 use std::fmt::Write as _;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// The value of the `format` key.
@@ -54,14 +64,10 @@ pub const EXTENSION: &str = "toml";
 /// Why a scene could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file could not be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What the system said.
-        source: std::io::Error,
-    },
+    /// The file could not be read or written (the message names the file
+    /// and says why, once).
+    #[error(transparent)]
+    File(#[from] bv_core::BvError),
     /// The text is not valid TOML, or a value has the wrong type.
     #[error("not a valid scene file: {0}")]
     Syntax(String),
@@ -131,8 +137,29 @@ struct Header {
     version: Option<toml::Value>,
 }
 
-/// Parses scene text (strictly; see the module docs).
+/// Parses scene text (strictly; see the module docs). Relative file paths
+/// in it are taken relative to the current directory; [`load`] takes them
+/// relative to the scene file's folder.
 pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
+    from_toml_in(text, None, Builds::Required)
+}
+
+/// What loading does with a BRDF that cannot be built (a MERL table that
+/// is missing or unreadable).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Builds {
+    /// Refuse the scene (the command line: a figure must show what the file
+    /// says, so `bv render` and `bv scene check` exit with status 1).
+    Required,
+    /// Load it with a warning naming the BRDF and the reason (the window:
+    /// the scene opens, and that BRDF's panel shows the error until its file
+    /// is found).
+    Warn,
+}
+
+/// [`from_toml`] for a file in the folder `base`: relative paths (MERL
+/// tables, the environment map) are resolved against `base`.
+pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<Loaded, SceneError> {
     let text = text.trim_start_matches('\u{feff}');
     let mut warnings = Vec::new();
     let table: toml::Table =
@@ -227,7 +254,7 @@ pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
     let mut ignored = Vec::new();
     let de = toml::Deserializer::parse(text)
         .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
-    let state: AppState = serde_ignored::deserialize(de, |path| ignored.push(path.to_string()))
+    let mut state: AppState = serde_ignored::deserialize(de, |path| ignored.push(path.to_string()))
         .map_err(|e| SceneError::Syntax(e.to_string().trim().to_string()))?;
     for key in ignored {
         if key == "format" || key == "generator" {
@@ -237,10 +264,144 @@ pub fn from_toml(text: &str) -> Result<Loaded, SceneError> {
     }
 
     validate(&state, &mut warnings)?;
+    if let Some(base) = base {
+        map_paths(&mut state, &|p| resolve_in(base, p));
+    }
+    // Every BRDF must build: a MERL table that cannot be read would
+    // otherwise vanish from the figure without a word.
+    for (i, b) in state.brdfs.iter().enumerate() {
+        if let Err(e) = b.spec.build() {
+            let reason = format!("the `{}` BRDF cannot be built: {e}", b.spec.model);
+            match builds {
+                Builds::Required => {
+                    return Err(SceneError::BadValue {
+                        key: format!("brdfs[{i}]"),
+                        reason,
+                    });
+                }
+                Builds::Warn => {
+                    warnings.push(format!("`brdfs[{i}]`: {reason}; it draws nothing"));
+                }
+            }
+        }
+    }
+    let clean = state.clone().sanitised();
+    warnings.extend(clamp_warnings(&state, &clean));
     Ok(Loaded {
-        state: state.sanitised(),
+        state: clean,
         warnings,
     })
+}
+
+/// One warning per value that sanitising changed (a number out of its range
+/// clamped, an angle wrapped): a scene must not be "ok" and then show
+/// something else than it says.
+fn clamp_warnings(raw: &AppState, clean: &AppState) -> Vec<String> {
+    fn walk(key: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+        use serde_json::Value;
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                for (k, va) in x {
+                    if let Some(vb) = y.get(k) {
+                        let sub = if key.is_empty() {
+                            k.clone()
+                        } else {
+                            format!("{key}.{k}")
+                        };
+                        walk(&sub, va, vb, out);
+                    }
+                }
+            }
+            (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+                for (i, (va, vb)) in x.iter().zip(y).enumerate() {
+                    walk(&format!("{key}[{i}]"), va, vb, out);
+                }
+            }
+            _ if a != b => out.push(format!("`{key} = {a}` is out of range; using {b}")),
+            _ => {}
+        }
+    }
+    let (Ok(mut a), Ok(mut b)) = (serde_json::to_value(raw), serde_json::to_value(clean)) else {
+        return Vec::new();
+    };
+    // Bookkeeping that sanitising fills in, not values the file chose
+    // (`selected` and `solo` are reported by `validate`).
+    for v in [&mut a, &mut b] {
+        if let serde_json::Value::Object(m) = v {
+            for k in ["version", "next_id", "selected", "solo"] {
+                m.remove(k);
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk("", &a, &b, &mut out);
+    out
+}
+
+/// Applies `f` to every file path of the state: the path parameters of
+/// every BRDF (mix components included) and the environment map.
+fn map_paths(state: &mut AppState, f: &dyn Fn(&str) -> String) {
+    fn spec_paths(spec: &mut ModelSpec, f: &dyn Fn(&str) -> String) {
+        let Ok(info) = bv_core::find(&spec.model) else {
+            return;
+        };
+        for d in info.params {
+            match (&d.kind, spec.params.0.get_mut(d.id)) {
+                (ParamKind::Path { .. }, Some(ParamValue::Text(t))) if !t.trim().is_empty() => {
+                    *t = f(t);
+                }
+                (ParamKind::Components { .. }, Some(ParamValue::Components(cs))) => {
+                    for c in cs {
+                        spec_paths(&mut c.spec, f);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    for b in &mut state.brdfs {
+        spec_paths(&mut b.spec, f);
+    }
+    if let Some(m) = &mut state.lighting.env.map
+        && !m.trim().is_empty()
+    {
+        *m = f(m);
+    }
+}
+
+/// `p` (from a scene file in `base`) as a path usable from here.
+fn resolve_in(base: &Path, p: &str) -> String {
+    let path = Path::new(p);
+    if path.is_absolute() || base.as_os_str().is_empty() {
+        return p.to_string();
+    }
+    base.join(path).display().to_string()
+}
+
+/// `p` (relative to the current directory, or absolute) as it is written
+/// into a scene file in `dir`: relative to `dir` when it lies inside it, so
+/// that a folder of a scene and its tables can be moved as a whole.
+fn portable_in(dir: &Path, p: &str) -> String {
+    let (Ok(abs), Ok(dir)) = (std::path::absolute(p), std::path::absolute(dir)) else {
+        return p.to_string();
+    };
+    match abs.strip_prefix(&dir) {
+        Ok(rel) if !rel.as_os_str().is_empty() => rel.display().to_string(),
+        _ => abs.display().to_string(),
+    }
+}
+
+/// The scene text [`save`] writes to `path`: file paths relative to the
+/// scene's folder where they lie inside it, absolute otherwise (so that
+/// [`load`] finds them whatever the current directory).
+pub fn to_toml_for(path: &Path, state: &AppState) -> Result<String, SceneError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut state = state.clone();
+    map_paths(&mut state, &|p| portable_in(&dir, p));
+    to_toml(&state)
 }
 
 fn ends_with_marker(text: &str) -> bool {
@@ -264,7 +425,13 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         if x.is_finite() && (lo..=hi).contains(&x) {
             Ok(())
         } else {
-            bad(key, format!("{x} is outside {lo}..={hi}{unit}"))
+            bad(
+                key,
+                format!(
+                    "{} is outside {lo}..={hi}{unit}",
+                    bv_core::error::fmt_num(x)
+                ),
+            )
         }
     };
     range(
@@ -279,7 +446,10 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     if !c.yaw_deg.is_finite() {
         return bad(
             "camera.yaw_deg",
-            format!("{} is not a finite angle", c.yaw_deg),
+            format!(
+                "{} is not a finite angle",
+                bv_core::error::fmt_num(f64::from(c.yaw_deg))
+            ),
         );
     }
     range(
@@ -299,7 +469,10 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     if !(c.fixed_scale.is_finite() && c.fixed_scale > 0.0) {
         return bad(
             "camera.fixed_scale",
-            format!("{} is not a positive number", c.fixed_scale),
+            format!(
+                "{} is not a positive number",
+                bv_core::error::fmt_num(f64::from(c.fixed_scale))
+            ),
         );
     }
     range(
@@ -338,64 +511,46 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     Ok(())
 }
 
-/// Reads a scene file.
+/// Reads a scene file: a regular file of at most
+/// [`fsio::MAX_SCENE_BYTES`] (a FIFO or device is refused, never waited
+/// on); relative paths in it are relative to its folder. A BRDF that cannot
+/// be built refuses the scene ([`Builds::Required`]).
 pub fn load(path: &Path) -> Result<Loaded, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    load_with(path, Builds::Required)
+}
+
+/// [`load`] with the given treatment of BRDFs that cannot be built (the
+/// window opens such a scene with a warning: [`Builds::Warn`]).
+pub fn load_with(path: &Path, builds: Builds) -> Result<Loaded, SceneError> {
+    let bytes = fsio::read_capped(path, fsio::MAX_SCENE_BYTES, "a scene file")?;
     let text = String::from_utf8(bytes).map_err(|e| {
         SceneError::Syntax(format!(
             "the file is not UTF-8 text (invalid byte at offset {})",
             e.utf8_error().valid_up_to()
         ))
     })?;
-    from_toml(&text)
+    from_toml_in(&text, path.parent(), builds)
 }
 
-/// Writes a scene file atomically (see [`write_atomic`]).
+/// Writes a scene file atomically (see [`write_atomic`]), with its file
+/// paths as [`to_toml_for`] writes them.
 pub fn save(path: &Path, state: &AppState) -> Result<(), SceneError> {
-    let text = to_toml(state)?;
+    let text = to_toml_for(path, state)?;
     write_atomic(path, |f| f.write_all(text.as_bytes()))
 }
 
 /// Writes `path` through a temporary file in the same directory, synced and
 /// then renamed over `path` (rename is atomic within a file system), so that
 /// readers see either the old file or the whole new one. If `write` fails,
-/// the temporary file is removed and `path` is untouched.
+/// the temporary file is removed and `path` is untouched. FIFOs, devices,
+/// directories and read-only files are refused, a symlink is written
+/// through to its target, and an existing file keeps its permissions
+/// ([`fsio::write_atomic`]).
 pub fn write_atomic(
     path: &Path,
-    write: impl FnOnce(&mut std::fs::File) -> std::io::Result<()>,
+    write: impl FnOnce(&mut dyn std::io::Write) -> std::io::Result<()>,
 ) -> Result<(), SceneError> {
-    let io = |source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "scene".to_string());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        write(&mut f)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(e));
-    }
-    // Make the rename itself durable where the platform allows.
-    if let Ok(d) = std::fs::File::open(&dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
+    Ok(fsio::write_atomic(path, write)?)
 }
 
 #[cfg(test)]
@@ -439,6 +594,50 @@ mod tests {
         assert_eq!(back.warnings.len(), 1, "{:?}", back.warnings);
         assert!(back.warnings[0].contains("incident.shininess"));
         assert_eq!(back.state, sample());
+    }
+
+    #[test]
+    fn file_paths_are_relative_to_the_scene_file() {
+        use bv_core::measured::merl::{MerlDims, MerlTable};
+        let dir = std::env::temp_dir().join(format!("bv-scene-paths-{}", std::process::id()));
+        let sub = dir.join("scenes");
+        std::fs::create_dir_all(&sub).unwrap();
+        let dims = MerlDims::new(1, 1, 2).unwrap();
+        let table = MerlTable::from_values(dims, vec![0.1; 6]).unwrap();
+        table.write(sub.join("t.binary")).unwrap();
+        table.write(dir.join("outside.binary")).unwrap();
+        let merl = |p: &Path| {
+            ModelSpec::from_json(
+                "merl",
+                &serde_json::json!({"path": p.display().to_string()}),
+            )
+            .unwrap()
+        };
+        let mut s = AppState::default();
+        // Paths as the window holds them: usable from the current directory.
+        s.add(merl(&sub.join("t.binary")));
+        s.add(merl(&dir.join("outside.binary")));
+        s.lighting.env.map = Some(sub.join("env.hdr").display().to_string());
+        let file = sub.join("s.toml");
+        save(&file, &s).unwrap();
+        let text = std::fs::read_to_string(&file).unwrap();
+        // Inside the scene's folder: relative; outside: absolute.
+        assert!(text.contains("path = \"t.binary\""), "{text}");
+        assert!(text.contains("map = \"env.hdr\""), "{text}");
+        let abs = std::path::absolute(dir.join("outside.binary")).unwrap();
+        assert!(text.contains(&abs.display().to_string()), "{text}");
+        // Loading resolves them against the folder again, wherever bv runs.
+        let back = load(&file).unwrap();
+        let p = back.state.brdfs[0].spec.params.text("path").unwrap();
+        assert_eq!(Path::new(&p), sub.join("t.binary"));
+        // A table that is not there refuses the scene, or warns in the window.
+        std::fs::remove_file(sub.join("t.binary")).unwrap();
+        let e = load(&file).unwrap_err().to_string();
+        assert!(e.contains("brdfs[0]") && e.contains("t.binary"), "{e}");
+        let lenient = load_with(&file, Builds::Warn).unwrap();
+        assert_eq!(lenient.state.brdfs.len(), 2);
+        assert!(lenient.warnings.iter().any(|w| w.contains("brdfs[0]")));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -111,7 +111,9 @@ impl Viewer {
     /// Opens a scene file; returns its warnings. On error the state is
     /// unchanged.
     pub fn open_scene(&mut self, path: &Path) -> Result<Vec<String>, scene::SceneError> {
-        let loaded = scene::load(path)?;
+        // A BRDF whose table is missing opens with a warning (its panel
+        // shows the error) rather than refusing the user's whole scene.
+        let loaded = scene::load_with(path, scene::Builds::Warn)?;
         // Keep the theme the user chose for the window.
         let theme = self.state.theme;
         self.replace_state(AppState {

@@ -23,8 +23,14 @@ pub const SEED: u64 = 0x6276_6265_6e63_6801;
 /// and scheduling, small enough to balance the work across threads.
 pub const CHUNK: usize = 4096;
 
-/// Most pairs accepted (each costs 72 bytes: two directions and a result).
+/// Most pairs accepted per pass.
 pub const MAX_PAIRS: usize = 50_000_000;
+
+/// Most distinct pairs held in memory (48 bytes each: 48 MiB). A larger
+/// `--pairs` evaluates this pool over again, so memory stays bounded
+/// whatever the count; a pool far larger than the caches already measures
+/// the rate of out-of-cache evaluation.
+pub const POOL: usize = 1 << 20;
 
 /// Shortest total timed duration; passes repeat until it is reached.
 pub const MIN_TIMED: Duration = Duration::from_millis(200);
@@ -36,7 +42,8 @@ pub struct BenchArgs {
     #[command(flatten)]
     pub model: ModelArgs,
 
-    /// Number of random direction pairs (an integer, or e.g. 1e6).
+    /// Direction pairs per pass (an integer, or e.g. 1e6), 1 to 50000000;
+    /// at most 1048576 distinct pairs are held, larger counts reuse them.
     #[arg(long, value_name = "N", default_value = "1e6", value_parser = parse_count)]
     pub pairs: usize,
 
@@ -52,8 +59,18 @@ pub struct BenchArgs {
 /// Parses a pair count: `1000`, `1e6` or `2.5e5` (a whole number from 1 to
 /// [`MAX_PAIRS`]).
 pub fn parse_count(s: &str) -> Result<usize, String> {
+    let n = parse_whole(s)?;
+    if n < 1.0 || n > MAX_PAIRS as f64 {
+        return Err(format!("{} is outside 1..={MAX_PAIRS}", s.trim()));
+    }
+    Ok(n as usize)
+}
+
+/// A whole number typed as `1000`, `1_000`, `1e6` or `2.5e5` (any size; the
+/// caller checks the range).
+pub fn parse_whole(s: &str) -> Result<f64, String> {
     let s = s.trim().replace('_', "");
-    let n = match s.parse::<usize>() {
+    let n = match s.parse::<u64>() {
         Ok(n) => n as f64,
         Err(_) => s
             .parse::<f64>()
@@ -62,10 +79,7 @@ pub fn parse_count(s: &str) -> Result<usize, String> {
     if !(n.is_finite() && n.fract() == 0.0) {
         return Err(format!("`{s}` is not a whole number"));
     }
-    if n < 1.0 || n > MAX_PAIRS as f64 {
-        return Err(format!("{s} is outside 1..={MAX_PAIRS}"));
-    }
-    Ok(n as usize)
+    Ok(n)
 }
 
 /// What one benchmark measured.
@@ -103,41 +117,64 @@ pub fn random_pairs(n: usize) -> Vec<(DVec3, DVec3)> {
         .collect()
 }
 
-/// Times batch evaluation of `brdf` on `pairs` with `threads` workers.
+/// Times batch evaluation of `brdf` on `count` pairs taken in turn from
+/// `pairs` (over again when `count` is larger) with `threads` workers. Each
+/// worker writes into its own [`CHUNK`]-sized buffer, so memory does not
+/// grow with `count`.
 pub fn measure(
     brdf: &dyn Brdf,
     pairs: &[(DVec3, DVec3)],
+    count: usize,
     threads: usize,
     min_timed: Duration,
 ) -> anyhow::Result<BenchResult> {
+    anyhow::ensure!(!pairs.is_empty(), "no direction pairs to evaluate");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .context("could not start the worker threads")?;
-    let mut out = vec![Rgb::ZERO; pairs.len()];
-    let pass = |out: &mut [Rgb]| {
+    // Chunk k covers evaluations k·CHUNK.. of the pass, pool entries from
+    // (k·CHUNK) mod pool length on, wrapping around at the pool's end.
+    let chunks = count.div_ceil(CHUNK);
+    let pass = || -> usize {
         pool.install(|| {
-            pairs
-                .par_chunks(CHUNK)
-                .zip(out.par_chunks_mut(CHUNK))
-                .for_each(|(p, o)| brdf.eval_batch(p, o));
-        });
-        std::hint::black_box(&*out);
+            (0..chunks)
+                .into_par_iter()
+                .map_init(
+                    || vec![Rgb::ZERO; CHUNK],
+                    |out, k| {
+                        let first = k * CHUNK;
+                        let len = CHUNK.min(count - first);
+                        let mut done = 0;
+                        while done < len {
+                            let start = (first + done) % pairs.len();
+                            let end = (start + len - done).min(pairs.len());
+                            let n = end - start;
+                            brdf.eval_batch(&pairs[start..end], &mut out[done..done + n]);
+                            done += n;
+                        }
+                        let o = &out[..len];
+                        std::hint::black_box(o);
+                        o.iter().filter(|f| !f.is_finite()).count()
+                    },
+                )
+                .sum()
+        })
     };
-    pass(&mut out);
+    pass();
     let start = Instant::now();
     let mut passes = 0;
+    let mut non_finite;
     loop {
-        pass(&mut out);
+        non_finite = pass();
         passes += 1;
         if start.elapsed() >= min_timed {
             break;
         }
     }
     let seconds = start.elapsed().as_secs_f64();
-    let non_finite = out.iter().filter(|f| !f.is_finite()).count();
     Ok(BenchResult {
-        pairs: pairs.len(),
+        pairs: count,
         threads,
         passes,
         seconds,
@@ -155,13 +192,13 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Some(t) => usize::from(t),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
-    let pairs = random_pairs(args.pairs);
-    let r = measure(brdf.as_ref(), &pairs, threads, MIN_TIMED)?;
+    let pairs = random_pairs(args.pairs.min(POOL));
+    let r = measure(brdf.as_ref(), &pairs, args.pairs, threads, MIN_TIMED)?;
     if r.non_finite > 0 {
-        eprintln!(
-            "bv bench: warning: {} of {} results were not finite (a bug in model `{}`)",
+        super::output::eprint(&format!(
+            "bv bench: warning: {} of {} results were not finite (a bug in model `{}`)\n",
             r.non_finite, r.pairs, spec.model
-        );
+        ));
     }
     let rate = r.rate();
     let text = if args.json {
@@ -227,11 +264,40 @@ mod tests {
     fn measure_evaluates_every_pair() {
         let brdf = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
         let pairs = random_pairs(10_000);
-        let r = measure(brdf.as_ref(), &pairs, 2, Duration::ZERO).unwrap();
+        let r = measure(brdf.as_ref(), &pairs, pairs.len(), 2, Duration::ZERO).unwrap();
         assert_eq!(
             (r.pairs, r.threads, r.passes, r.non_finite),
             (10_000, 2, 1, 0)
         );
         assert!(r.rate() > 0.0 && r.rate().is_finite());
+    }
+
+    /// A model that is NaN everywhere, so that every evaluation is counted.
+    #[derive(Debug)]
+    struct Nan;
+    impl Brdf for Nan {
+        fn id(&self) -> &'static str {
+            "nan"
+        }
+        fn eval(&self, _: DVec3, _: DVec3) -> Rgb {
+            Rgb::NAN
+        }
+        fn claims(&self) -> bv_core::Claims {
+            bv_core::ModelSpec::new("lambert")
+                .unwrap()
+                .build()
+                .unwrap()
+                .claims()
+        }
+    }
+
+    #[test]
+    fn a_count_above_the_pool_reuses_it_and_evaluates_every_pair() {
+        // Chunks wrap around a pool that is not a multiple of CHUNK, and
+        // the last chunk is short.
+        let pairs = random_pairs(2 * CHUNK + 3);
+        let count = 7 * CHUNK + 5;
+        let r = measure(&Nan, &pairs, count, 3, Duration::ZERO).unwrap();
+        assert_eq!((r.pairs, r.non_finite), (count, count));
     }
 }

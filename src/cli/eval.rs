@@ -6,6 +6,7 @@
 //! `{"error": "..."}`. Blank lines are skipped and get no answer. The run goes
 //! on after a bad query; the exit status is 1 if any query failed, 0 otherwise.
 
+use super::output::{eprint, stdin_error, stdout_error};
 use bv_core::{Brdf, ModelSpec, Rgb, frame};
 use serde_json::{Map, Value};
 use std::io::{self, BufRead, BufReader, BufWriter, IsTerminal, Read, Write};
@@ -40,7 +41,7 @@ pub struct EvalArgs {}
 pub fn run(_args: &EvalArgs) -> anyhow::Result<ExitCode> {
     let stdin = io::stdin();
     if stdin.is_terminal() {
-        eprintln!("bv eval: reading JSON Lines queries from stdin (end with Ctrl-D)");
+        eprint("bv eval: reading JSON Lines queries from stdin (end with Ctrl-D)\n");
     }
     let stdout = io::stdout();
     // On a terminal every answer is shown at once; in a pipe answers are
@@ -50,10 +51,10 @@ pub fn run(_args: &EvalArgs) -> anyhow::Result<ExitCode> {
     let mut out = BufWriter::with_capacity(64 * 1024, stdout.lock());
     let summary = eval_stream(input, &mut out, flush_each)?;
     if summary.failed > 0 {
-        eprintln!(
-            "bv eval: {} of {} queries failed",
+        eprint(&format!(
+            "bv eval: {} of {} queries failed\n",
             summary.failed, summary.answered
-        );
+        ));
         Ok(ExitCode::from(1))
     } else {
         Ok(ExitCode::SUCCESS)
@@ -75,21 +76,22 @@ pub struct Summary {
 /// buffered for speed, and flushed whenever `input` has no buffered bytes left
 /// (the next read may block, so a program that writes one query and waits for
 /// its answer is not left waiting), after every line when `flush_each`, and at
-/// the end. Only I/O errors end the run early.
+/// the end. Only I/O errors end the run early (reported as a failed read of
+/// stdin or write of stdout).
 pub fn eval_stream<R: Read, W: Write>(
     mut input: BufReader<R>,
     out: &mut W,
     flush_each: bool,
-) -> io::Result<Summary> {
+) -> anyhow::Result<Summary> {
     let mut evaluator = Evaluator::default();
     let mut summary = Summary::default();
     let mut line = Vec::new();
     let mut lines_read = 0usize;
     loop {
         if input.buffer().is_empty() {
-            out.flush()?;
+            out.flush().map_err(stdout_error)?;
         }
-        let read = read_line_limited(&mut input, &mut line)?;
+        let read = read_line_limited(&mut input, &mut line).map_err(stdin_error)?;
         lines_read += 1;
         let answer = match read {
             Line::End => break,
@@ -118,13 +120,13 @@ pub fn eval_stream<R: Read, W: Write>(
                 serde_json::json!({ "error": msg })
             }
         };
-        serde_json::to_writer(&mut *out, &json)?;
-        out.write_all(b"\n")?;
-        if flush_each {
-            out.flush()?;
-        }
+        serde_json::to_writer(&mut *out, &json)
+            .map_err(io::Error::from)
+            .and_then(|()| out.write_all(b"\n"))
+            .and_then(|()| if flush_each { out.flush() } else { Ok(()) })
+            .map_err(stdout_error)?;
     }
-    out.flush()?;
+    out.flush().map_err(stdout_error)?;
     Ok(summary)
 }
 
@@ -197,7 +199,10 @@ struct Built {
 impl Evaluator {
     /// Answers one query line: `f(wi, wo)` or a message saying what is wrong.
     pub fn answer(&mut self, line: &str) -> Result<Rgb, String> {
-        let v: Value = serde_json::from_str(line).map_err(|e| format!("invalid JSON: {e}"))?;
+        // Duplicate keys are refused: JSON leaves them undefined, and
+        // silently taking the last `wi` evaluates something else than asked.
+        let StrictValue(v) =
+            serde_json::from_str(line).map_err(|e| format!("invalid JSON: {e}"))?;
         let Value::Object(obj) = v else {
             return Err(format!(
                 "a query must be a JSON object {{\"model\", \"params\", \"wi\", \"wo\"}}, found {}",
@@ -273,6 +278,71 @@ fn direction(obj: &Map<String, Value>, name: &str) -> Result<glam::DVec3, String
         *x = item.as_f64().ok_or_else(bad)?;
     }
     frame::checked_direction(name, xyz).map_err(|e| e.to_string())
+}
+
+/// A JSON value parsed with every object's keys unique (serde_json's own
+/// `Value` keeps the last of repeated keys without a word).
+struct StrictValue(Value);
+
+impl<'de> serde::Deserialize<'de> for StrictValue {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(StrictVisitor).map(StrictValue)
+    }
+}
+
+struct StrictVisitor;
+
+impl<'de> serde::de::Visitor<'de> for StrictVisitor {
+    type Value = Value;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, v: bool) -> Result<Value, E> {
+        Ok(Value::Bool(v))
+    }
+    fn visit_i64<E>(self, v: i64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_u64<E>(self, v: u64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_f64<E>(self, v: f64) -> Result<Value, E> {
+        Ok(Value::from(v))
+    }
+    fn visit_str<E>(self, v: &str) -> Result<Value, E> {
+        Ok(Value::String(v.to_string()))
+    }
+    fn visit_string<E>(self, v: String) -> Result<Value, E> {
+        Ok(Value::String(v))
+    }
+    fn visit_unit<E>(self) -> Result<Value, E> {
+        Ok(Value::Null)
+    }
+    fn visit_none<E>(self) -> Result<Value, E> {
+        Ok(Value::Null)
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Value, A::Error> {
+        let mut items = Vec::new();
+        while let Some(StrictValue(v)) = seq.next_element()? {
+            items.push(v);
+        }
+        Ok(Value::Array(items))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Value, A::Error> {
+        let mut out = Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if out.contains_key(&key) {
+                return Err(serde::de::Error::custom(format!(
+                    "duplicate key `{}`",
+                    quote(&Value::String(key)).trim_matches('"')
+                )));
+            }
+            let StrictValue(v) = map.next_value()?;
+            out.insert(key, v);
+        }
+        Ok(Value::Object(out))
+    }
 }
 
 /// A JSON value for an error message, cut short if it is long.
@@ -374,6 +444,14 @@ mod tests {
             (
                 r#"{"model":"lambert","wi":[0,0,"1"],"wo":[0,0,1]}"#,
                 "`wi` must be",
+            ),
+            (
+                r#"{"model":"lambert","wi":[0,0,1],"wo":[0,0,1],"wi":[1,0,0]}"#,
+                "duplicate key `wi`",
+            ),
+            (
+                r#"{"model":"lambert","params":{"albedo":0.1,"albedo":0.9},"wi":[0,0,1],"wo":[0,0,1]}"#,
+                "duplicate key `albedo`",
             ),
         ];
         let good = r#"{"model":"lambert","wi":[0,0,1],"wo":[0,0,1]}"#;

@@ -12,6 +12,14 @@ use std::time::Instant;
 /// Incident angles (degrees) at which `bv info` estimates ρhd.
 pub const THETA_I_DEG: [f64; 5] = [0.0, 30.0, 60.0, 75.0, 85.0];
 
+/// Most Monte Carlo samples per ρhd estimate (`--samples`): the estimates
+/// stream, so this bounds time (about a second per million), not memory.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Most reciprocity pairs (`--pairs`): the pairs are held in memory, 48
+/// bytes each (96 MB at the cap).
+pub const MAX_PAIRS: usize = 2_000_000;
+
 /// Arguments of `bv info`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct InfoArgs {
@@ -20,15 +28,32 @@ pub struct InfoArgs {
     /// Print one JSON object instead of the report.
     #[arg(long)]
     pub json: bool,
-    /// Monte Carlo samples per ρhd estimate (bv_core::analysis, fixed seed).
-    #[arg(long, default_value_t = 65536)]
+    /// Monte Carlo samples per ρhd estimate (bv_core::analysis, fixed seed),
+    /// 1 to 10000000.
+    #[arg(long, default_value_t = 65536, value_parser = samples_count)]
     pub samples: usize,
-    /// Direction pairs for the reciprocity check.
-    #[arg(long, default_value_t = 100_000)]
+    /// Direction pairs for the reciprocity check, 1 to 2000000.
+    #[arg(long, default_value_t = 100_000, value_parser = pairs_count)]
     pub pairs: usize,
     /// Lookup used for ρhd and reciprocity: trilinear or nearest.
     #[arg(long, default_value = "trilinear")]
     pub interpolation: String,
+}
+
+fn count_in(s: &str, max: usize) -> Result<usize, String> {
+    let n = super::bench::parse_whole(s)?;
+    if n < 1.0 || n > max as f64 {
+        return Err(format!("{s} is outside 1..={max}"));
+    }
+    Ok(n as usize)
+}
+
+fn samples_count(s: &str) -> Result<usize, String> {
+    count_in(s, MAX_SAMPLES)
+}
+
+fn pairs_count(s: &str) -> Result<usize, String> {
+    count_in(s, MAX_PAIRS)
 }
 
 /// Runs `bv info`.
@@ -39,11 +64,10 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let report = report(&table, args, mode, load_ms);
     if args.json {
-        println!("{report}");
+        super::output::print(&format!("{report}\n"))
     } else {
-        print_text(&report);
+        super::output::print(&text(&report))
     }
-    Ok(())
 }
 
 fn report(table: &Arc<MerlTable>, args: &InfoArgs, mode: Interpolation, load_ms: f64) -> Value {
@@ -53,11 +77,13 @@ fn report(table: &Arc<MerlTable>, args: &InfoArgs, mode: Interpolation, load_ms:
     let channels: Vec<Value> = (0..3)
         .map(|c| {
             let r = table.ranges()[c];
+            // No valid sample: no statistics (null), and a warning says why.
+            let stat = |x: f64| if r.valid == 0 { Value::Null } else { json!(x) };
             json!({
                 "name": names[c],
-                "min": r.min,
-                "max": r.max,
-                "mean": r.mean,
+                "min": stat(r.min),
+                "max": stat(r.max),
+                "mean": stat(r.mean),
                 "valid": r.valid,
                 "unmeasured": table.warnings().unmeasured[c],
                 "non_finite": table.warnings().non_finite[c],
@@ -100,40 +126,65 @@ fn num(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
+/// `x` with `prec` decimals, in exponent form when it is large (a table of
+/// absurd values must not print 40-digit numbers).
+fn fixed(x: f64, prec: usize) -> String {
+    if x.abs() < 1e6 || !x.is_finite() {
+        format!("{x:.prec$}")
+    } else {
+        format!("{x:.prec$e}")
+    }
+}
+
+/// A statistic of the report, `-` where there is none (no valid sample).
+fn stat(v: &Value) -> String {
+    v.as_f64().map_or_else(|| "-".to_string(), |x| fixed(x, 6))
+}
+
 fn int(v: &Value) -> u64 {
     v.as_u64().unwrap_or(0)
 }
 
-fn print_text(r: &Value) {
+fn text(r: &Value) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
     let d = &r["dims"];
-    println!("file:        {}", r["file"].as_str().unwrap_or(""));
-    println!(
+    let _ = writeln!(out, "file:        {}", r["file"].as_str().unwrap_or(""));
+    let _ = writeln!(
+        out,
         "size:        {} bytes, read in {:.0} ms",
         r["bytes"],
         num(&r["load_ms"])
     );
-    println!(
+    let _ = writeln!(
+        out,
         "dimensions:  θh {} × θd {} × φd {} ({} cells per channel)",
         d[0], d[1], d[2], r["cells_per_channel"]
     );
-    println!("values (f in 1/sr, channel scales applied; over valid samples):");
-    println!(
+    let _ = writeln!(
+        out,
+        "values (f in 1/sr, channel scales applied; over valid samples):"
+    );
+    let _ = writeln!(
+        out,
         "  {:<6} {:>12} {:>12} {:>12} {:>10} {:>11} {:>10}",
         "", "min", "max", "mean", "valid", "unmeasured", "NaN/Inf"
     );
     for c in r["channels"].as_array().into_iter().flatten() {
-        println!(
-            "  {:<6} {:>12.6} {:>12.6} {:>12.6} {:>10} {:>11} {:>10}",
+        let _ = writeln!(
+            out,
+            "  {:<6} {:>12} {:>12} {:>12} {:>10} {:>11} {:>10}",
             c["name"].as_str().unwrap_or(""),
-            num(&c["min"]),
-            num(&c["max"]),
-            num(&c["mean"]),
+            stat(&c["min"]),
+            stat(&c["max"]),
+            stat(&c["mean"]),
             int(&c["valid"]),
             int(&c["unmeasured"]),
             int(&c["non_finite"])
         );
     }
-    println!(
+    let _ = writeln!(
+        out,
         "ρhd(θi) = ∫ f cosθo dωo ({} lookup, Monte Carlo ± standard error, {} samples each):",
         r["reciprocity"]["interpolation"].as_str().unwrap_or(""),
         int(&r["rho_hd"][0]["samples"])
@@ -152,24 +203,27 @@ fn print_text(r: &Value) {
             .map(num)
             .collect();
         if v.len() == 3 && e.len() == 3 {
-            println!(
-                "  θi = {:>4.0}°  r {:.4} ± {:.4}  g {:.4} ± {:.4}  b {:.4} ± {:.4}",
+            let _ = writeln!(
+                out,
+                "  θi = {:>4.0}°  r {} ± {}  g {} ± {}  b {} ± {}",
                 num(&x["theta_i_deg"]),
-                v[0],
-                e[0],
-                v[1],
-                e[1],
-                v[2],
-                e[2]
+                fixed(v[0], 4),
+                fixed(e[0], 4),
+                fixed(v[1], 4),
+                fixed(e[1], 4),
+                fixed(v[2], 4),
+                fixed(e[2], 4)
             );
         }
     }
-    println!(
+    let _ = writeln!(
+        out,
         "reciprocity: max |f(wi,wo) − f(wo,wi)| / max f = {:.3e} over {} pairs (the table folds φd by reciprocity, so this checks the lookup path)",
         num(&r["reciprocity"]["max_rel_error"]),
         r["reciprocity"]["pairs"]
     );
     for w in r["warnings"].as_array().into_iter().flatten() {
-        println!("warning:     {}", w.as_str().unwrap_or(""));
+        let _ = writeln!(out, "warning:     {}", w.as_str().unwrap_or(""));
     }
+    out
 }

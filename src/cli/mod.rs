@@ -78,7 +78,12 @@ pub enum Command {
 
 /// Entry point of the binary.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // `Cli::parse` would print help, version or a usage error itself and
+    // exit 0 even when that print fails (`bv --help > /dev/full`).
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     let result = match &cli.command {
         None => crate::app::run(&cli.viewer).map(|()| ExitCode::SUCCESS),
         Some(Command::Eval(a)) => eval::run(a),
@@ -99,9 +104,41 @@ pub fn main() -> ExitCode {
         // A reader that went away (`bv models | head`) is not an error worth a message.
         Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("bv: {e:#}");
+            // Best effort: with stderr gone too, the exit status still says it.
+            output::eprint(&format!("bv: {}\n", output::message(&e)));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Shows clap's help, version or usage error: help and version on stdout (a
+/// failed write of them is an error, status 1), usage errors on stderr
+/// (status 2).
+fn clap_exit(e: &clap::Error) -> ExitCode {
+    use std::io::IsTerminal as _;
+    let to_stdout = !e.use_stderr();
+    let styled = if to_stdout {
+        std::io::stdout().is_terminal()
+    } else {
+        std::io::stderr().is_terminal()
+    };
+    let text = if styled {
+        e.render().ansi().to_string()
+    } else {
+        e.render().to_string()
+    };
+    if to_stdout {
+        match output::print(&text) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(err) if output::is_broken_pipe(&err) => ExitCode::SUCCESS,
+            Err(err) => {
+                output::eprint(&format!("bv: {}\n", output::message(&err)));
+                ExitCode::FAILURE
+            }
+        }
+    } else {
+        output::eprint(&text);
+        ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(2))
     }
 }
 

@@ -2,9 +2,10 @@
 //! (the viewer opens them with `bv --scene FILE` or Ctrl+O; `bv render
 //! --scene FILE` draws them).
 
+use super::output::eprint;
 use crate::app::scene;
 use crate::app::state::AppState;
-use anyhow::{Context as _, Result};
+use anyhow::{Context as _, Result, bail};
 use std::path::PathBuf;
 
 /// Options of `bv scene`.
@@ -35,8 +36,8 @@ pub enum SceneAction {
         /// The scene's contents.
         #[command(flatten)]
         opts: NewScene,
-        /// Where to write it (atomically).
-        #[arg(short, long, value_name = "FILE")]
+        /// Where to write it (see --help for what happens to an existing file).
+        #[arg(short, long, value_name = "FILE", long_help = super::output::OUT_HELP)]
         out: PathBuf,
     },
 }
@@ -102,7 +103,7 @@ pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
         SceneAction::Check { file } => {
             let loaded = scene::load(file).with_context(|| format!("{}", file.display()))?;
             for w in &loaded.warnings {
-                eprintln!("bv scene: {}: warning: {w}", file.display());
+                eprint(&format!("bv scene: {}: warning: {w}\n", file.display()));
             }
             super::output::print(&format!(
                 "{}: ok ({} warning{}): {}\n",
@@ -115,14 +116,19 @@ pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
         SceneAction::Print { file } => {
             let loaded = scene::load(file).with_context(|| format!("{}", file.display()))?;
             for w in &loaded.warnings {
-                eprintln!("bv scene: {}: warning: {w}", file.display());
+                eprint(&format!("bv scene: {}: warning: {w}\n", file.display()));
             }
-            super::output::print(&scene::to_toml(&loaded.state)?)
+            // Paths as they would be saved in this file (relative to its folder).
+            super::output::print(&scene::to_toml_for(file, &loaded.state)?)
         }
         SceneAction::New { opts, out } => {
             let state = new_state(opts, argv)?;
             scene::save(out, &state)?;
-            eprintln!("bv scene: wrote {}: {}", out.display(), summary(&state));
+            eprint(&format!(
+                "bv scene: wrote {}: {}\n",
+                out.display(),
+                summary(&state)
+            ));
             Ok(())
         }
     }
@@ -132,7 +138,16 @@ pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
 /// --model before it on the command line.
 pub fn new_state(o: &NewScene, argv: &[String]) -> Result<AppState> {
     let mut state = AppState::default();
-    let groups = group_params(argv);
+    let groups = group_params(argv)?;
+    let grouped: usize = groups.iter().map(Vec::len).sum();
+    if groups.len() != o.model.len() || grouped != o.params.len() {
+        // The command line has a form the pairing below does not read; refuse
+        // rather than give a parameter to the wrong model or drop it.
+        bail!(
+            "cannot tell which --model each --param belongs to; write each as \
+             `--param NAME=VALUE` after its `--model ID`"
+        );
+    }
     if o.model.is_empty() {
         state = AppState::first_run();
     }
@@ -155,37 +170,65 @@ pub fn new_state(o: &NewScene, argv: &[String]) -> Result<AppState> {
     if o.light {
         state.theme = crate::app::state::Theme::Light;
     }
-    // The same checks a scene file gets.
+    // The same checks a scene file gets; what it would clamp is refused here,
+    // where the user can say it again.
     let text = scene::to_toml(&state)?;
-    Ok(scene::from_toml(&text)?.state)
+    let loaded = scene::from_toml(&text)?;
+    if let Some(w) = loaded.warnings.first() {
+        bail!("{w}");
+    }
+    Ok(loaded.state)
 }
 
 /// The `--param` values after each `--model` (index k: the k-th model).
-fn group_params(argv: &[String]) -> Vec<Vec<String>> {
+/// A `--param` before any `--model` is an error (there is no model for it).
+fn group_params(argv: &[String]) -> Result<Vec<Vec<String>>> {
     let mut groups: Vec<Vec<String>> = Vec::new();
-    let mut it = argv.iter().peekable();
+    let mut it = argv.iter().skip(1);
     while let Some(a) = it.next() {
-        let (flag, inline) = match a.split_once('=') {
-            Some((f, v)) if f.starts_with("--") => (f, Some(v.to_string())),
-            _ => (a.as_str(), None),
+        if a == "--" {
+            break;
+        }
+        // `--name=value`, `-xvalue`, `-x=value`, or a flag whose value follows.
+        let (flag, inline) = if let Some(rest) = a.strip_prefix("--") {
+            match rest.split_once('=') {
+                Some((f, v)) => (format!("--{f}"), Some(v.to_string())),
+                None => (a.clone(), None),
+            }
+        } else if a.len() > 2 && a.starts_with('-') && a.is_char_boundary(2) {
+            let v = &a[2..];
+            (
+                a[..2].to_string(),
+                Some(v.strip_prefix('=').unwrap_or(v).to_string()),
+            )
+        } else {
+            (a.clone(), None)
         };
-        match flag {
+        let mut value = || inline.clone().or_else(|| it.next().cloned());
+        match flag.as_str() {
             "--model" | "-m" => {
+                let _ = value();
                 groups.push(Vec::new());
-                if inline.is_none() {
-                    it.next();
-                }
             }
             "--param" | "-p" => {
-                let v = inline.or_else(|| it.next().cloned());
-                if let (Some(v), Some(g)) = (v, groups.last_mut()) {
-                    g.push(v);
+                let v = value().unwrap_or_default();
+                match groups.last_mut() {
+                    Some(g) => g.push(v),
+                    None => bail!(
+                        "{flag} {v} comes before any --model: each --param sets the \
+                         --model before it, e.g. `--model lambert --param albedo=0.3`"
+                    ),
                 }
+            }
+            // Options that take a value: skip it, so that a value is never
+            // read as a flag.
+            "--out" | "-o" | "--theta-i" | "--phi-i" => {
+                let _ = value();
             }
             _ => {}
         }
     }
-    groups
+    Ok(groups)
 }
 
 #[cfg(test)]
@@ -212,11 +255,39 @@ mod tests {
         .map(|s| s.to_string())
         .collect();
         assert_eq!(
-            group_params(&argv),
+            group_params(&argv).unwrap(),
             vec![
                 vec!["albedo=0.2".to_string()],
                 vec!["alpha_x=0.1".to_string()]
             ]
         );
+    }
+
+    fn args(v: &[&str]) -> Vec<String> {
+        v.iter().map(|s| s.to_string()).collect()
+    }
+
+    #[test]
+    fn attached_short_values_are_paired_too() {
+        let argv = args(&[
+            "bv",
+            "scene",
+            "new",
+            "-mlambert",
+            "-palbedo=0.2",
+            "-o",
+            "-p",
+        ]);
+        assert_eq!(
+            group_params(&argv).unwrap(),
+            vec![vec!["albedo=0.2".to_string()]]
+        );
+    }
+
+    #[test]
+    fn a_param_before_any_model_is_an_error() {
+        let argv = args(&["bv", "scene", "new", "-p", "albedo=0.2", "-m", "lambert"]);
+        let e = group_params(&argv).unwrap_err().to_string();
+        assert!(e.contains("-p albedo=0.2 comes before any --model"), "{e}");
     }
 }

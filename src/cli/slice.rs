@@ -14,6 +14,7 @@
 use super::params::ModelArgs;
 use crate::views::{albedo, curves};
 use anyhow::{Result, bail};
+use bv_core::error::fmt_num;
 use bv_core::mean_rgb;
 use std::fmt::Write as _;
 use std::sync::atomic::{AtomicBool, AtomicUsize};
@@ -77,7 +78,7 @@ pub struct SliceArgs {
     #[arg(long, value_name = "DEG", default_value_t = 30.0)]
     pub fixed: f64,
 
-    /// Intervals along the curve (rows = N + 1; albedo uses its own 45 angles).
+    /// Intervals along the curve, 2 to 1000000 (rows = N + 1; albedo uses its own 45 angles).
     #[arg(long, value_name = "N", default_value_t = 180)]
     pub samples: usize,
 
@@ -91,13 +92,13 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
     let spec = a.model.spec()?;
     let brdf = spec.build()?;
     if !(a.theta_i.is_finite() && (0.0..=90.0).contains(&a.theta_i)) {
-        bail!("--theta-i {}: out of range 0..=90°", a.theta_i);
+        bail!("--theta-i {}: out of range 0..=90°", fmt_num(a.theta_i));
     }
     if !a.phi_i.is_finite() {
-        bail!("--phi-i {}: not a finite angle", a.phi_i);
+        bail!("--phi-i {}: not a finite angle", fmt_num(a.phi_i));
     }
     if !(a.fixed.is_finite() && (0.0..=90.0).contains(&a.fixed)) {
-        bail!("--fixed {}: out of range 0..=90°", a.fixed);
+        bail!("--fixed {}: out of range 0..=90°", fmt_num(a.fixed));
     }
     if !(2..=1_000_000).contains(&a.samples) {
         bail!("--samples {}: expected 2..=1000000", a.samples);

@@ -2,7 +2,8 @@
 //! (issue 5, item 3), so that users can build tables and tests can build
 //! realistic full-size files.
 
-use anyhow::{Context, Result};
+use super::output::{print, warn};
+use anyhow::{Context as _, Result};
 use bv_core::ModelSpec;
 use bv_core::measured::merl::{self, MerlDims};
 use std::path::PathBuf;
@@ -17,24 +18,19 @@ pub struct TabulateArgs {
     /// A parameter as NAME=VALUE (repeatable); a colour as `kd=0.2,0.5,0.8`.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
-    /// Output file (written atomically).
-    #[arg(long, value_name = "FILE.binary")]
+    /// Output file (see --help for what happens to an existing one).
+    #[arg(long, value_name = "FILE.binary", long_help = super::output::OUT_HELP)]
     pub out: PathBuf,
-    /// Cells along θh, θd, φd.
+    /// Cells along θh, θd, φd: each 1 to 4096, at most 16777216 cells (a
+    /// 384 MiB file).
     #[arg(long, default_value = "90,90,180", value_name = "NθH,NθD,NΦD")]
     pub dims: String,
 }
 
-/// Builds the model from `--model` and `--param`s.
+/// Builds the model from `--model` and `--param`s (the same parsing and
+/// messages as every other command).
 pub fn model_spec(model: &str, params: &[String]) -> Result<ModelSpec> {
-    let mut spec = ModelSpec::new(model)?;
-    for p in params {
-        let (name, value) = p
-            .split_once('=')
-            .with_context(|| format!("--param `{p}`: expected NAME=VALUE"))?;
-        spec.set_str(name.trim(), value.trim())?;
-    }
-    Ok(spec)
+    super::params::spec_from_cli(model, params)
 }
 
 /// Runs `bv tabulate`.
@@ -43,32 +39,31 @@ pub fn run(args: &TabulateArgs) -> Result<()> {
     let spec = model_spec(&args.model, &args.params)?;
     let brdf = spec.build()?;
     if !brdf.claims().isotropic {
-        eprintln!(
-            "bv: warning: `{}` is anisotropic; the MERL layout has no φh axis, so the table holds its φh = 0 slice",
+        warn(&format!(
+            "`{}` is anisotropic; the MERL layout has no φh axis, so the table holds its φh = 0 slice",
             args.model
-        );
+        ));
     }
     if !brdf.deltas(glam::DVec3::Z).is_empty() {
-        eprintln!(
-            "bv: warning: `{}` has delta lobes, which a table cannot hold (they tabulate as 0)",
+        warn(&format!(
+            "`{}` has delta lobes, which a table cannot hold (they tabulate as 0)",
             args.model
-        );
+        ));
     }
     let start = Instant::now();
     let table = merl::tabulate(brdf.as_ref(), dims)?;
     let tab_s = start.elapsed().as_secs_f64();
     for w in table.warnings().messages() {
-        eprintln!("bv: warning: {w}");
+        warn(&w);
     }
     table.write(&args.out)?;
-    println!(
-        "wrote {}: {} {}, dims {} ({} bytes), tabulated in {:.2} s",
+    print(&format!(
+        "wrote {}: {} {}, dims {} ({} bytes), tabulated in {:.2} s\n",
         args.out.display(),
         spec.model,
         spec.params.to_json(),
         dims,
         dims.file_len(),
         tab_s
-    );
-    Ok(())
+    ))
 }

@@ -13,7 +13,7 @@ use crate::app::runtime::Runtime;
 use crate::app::state::{AppState, Theme};
 use crate::app::viewer::{Viewer, build_scene};
 use crate::views::{Scene, ViewEntry};
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Context as _, Result};
 use eframe::egui;
 pub use offscreen::{Frame, Offscreen};
 use std::path::Path;
@@ -108,20 +108,14 @@ pub fn save_png(img: &image::RgbaImage, path: &Path) -> Result<()> {
     write_file(path, &bytes)
 }
 
-/// Writes a file atomically, creating missing parent folders.
+/// Writes a file atomically, creating missing parent folders. FIFOs,
+/// devices, directories and read-only files are refused and a symlink is
+/// written through to its target ([`bv_core::fsio::write_atomic`]); the
+/// error names the file once and says why.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    use std::io::Write as _;
-    if let Some(dir) = path.parent()
-        && !dir.as_os_str().is_empty()
-    {
-        std::fs::create_dir_all(dir)
-            .with_context(|| format!("cannot create the folder {}", dir.display()))?;
-    }
-    if path.is_dir() {
-        bail!("{} is a folder", path.display());
-    }
-    crate::app::scene::write_atomic(path, |f| f.write_all(bytes))
-        .with_context(|| format!("cannot write {}", path.display()))
+    bv_core::fsio::create_parent_dirs(path)?;
+    bv_core::fsio::write_atomic(path, |f| f.write_all(bytes))?;
+    Ok(())
 }
 
 /// Whether an image has more than one colour (a blank render is one colour).

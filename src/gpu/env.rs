@@ -41,36 +41,16 @@ impl EnvironmentMap {
         }
     }
 
-    /// Loads a Radiance `.hdr` or OpenEXR file (equirectangular).
+    /// Loads a Radiance `.hdr` or OpenEXR file (equirectangular): a regular
+    /// file of at most [`bv_core::fsio::MAX_ENV_MAP_BYTES`] (a FIFO or a
+    /// device is refused, not waited on).
     pub fn load(path: &Path) -> Result<Self> {
-        let reader = image::ImageReader::open(path)
-            .with_context(|| format!("opening {}", path.display()))?
-            .with_guessed_format()
-            .with_context(|| format!("reading {}", path.display()))?;
-        let (w, h) = reader
-            .into_dimensions()
-            .with_context(|| format!("reading the size of {}", path.display()))?;
-        if w == 0 || h == 0 || w > MAX_ENV_SIDE || h > MAX_ENV_SIDE {
-            bail!(
-                "{}: {w}×{h} is not a usable environment (1..={MAX_ENV_SIDE} per side)",
-                path.display()
-            );
-        }
-        let img = image::open(path)
-            .with_context(|| format!("decoding {}", path.display()))?
-            .into_rgb32f();
-        let texels = img
-            .pixels()
-            .map(|p| {
-                let c = p.0.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
-                [c[0], c[1], c[2]]
-            })
-            .collect();
-        Ok(Self {
-            width: img.width(),
-            height: img.height(),
-            texels,
-        })
+        let bytes = bv_core::fsio::read_capped(
+            path,
+            bv_core::fsio::MAX_ENV_MAP_BYTES,
+            "an environment map",
+        )?;
+        Self::decode(&bytes, &path.display().to_string())
     }
 
     /// Writes the map as a Radiance `.hdr` file.

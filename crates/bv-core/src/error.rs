@@ -25,7 +25,12 @@ pub enum BvError {
         known: String,
     },
     /// A numeric value outside the declared range.
-    #[error("parameter `{param}` = {value} is out of range [{min}, {max}]")]
+    #[error(
+        "parameter `{param}` = {} is out of range [{}, {}]",
+        fmt_num(*.value),
+        fmt_num(*.min),
+        fmt_num(*.max)
+    )]
     OutOfRange {
         /// Parameter name.
         param: String,
@@ -67,3 +72,38 @@ pub enum BvError {
 
 /// Result alias used across the core.
 pub type Result<T, E = BvError> = std::result::Result<T, E>;
+
+/// A number for messages: the shortest digits that read back as `x`, in
+/// exponent form when very large or very small (`1e300`, not 301 digits).
+pub fn fmt_num(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-5..1e16).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(fmt_num(0.25), "0.25");
+        assert_eq!(fmt_num(2.0), "2");
+        assert_eq!(fmt_num(1e300), "1e300");
+        assert_eq!(fmt_num(-1e-300), "-1e-300");
+        assert_eq!(fmt_num(f64::NAN), "NaN");
+        let e = BvError::OutOfRange {
+            param: "albedo".into(),
+            value: 1e300,
+            min: 0.0,
+            max: 1.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "parameter `albedo` = 1e300 is out of range [0, 1]"
+        );
+    }
+}

@@ -187,7 +187,14 @@ pub fn checked_direction(name: &str, v: [f64; 3]) -> crate::Result<DVec3> {
     if (len - 1.0).abs() > 1e-3 {
         return Err(crate::BvError::BadDirection {
             name: name.to_string(),
-            reason: format!("{v:?} has length {len:.6}, not 1 (tolerance 1e-3)"),
+            reason: format!(
+                "{v:?} has length {}, not 1 (tolerance 1e-3)",
+                if len < 1e6 {
+                    format!("{len:.6}")
+                } else {
+                    crate::error::fmt_num(len)
+                }
+            ),
         });
     }
     Ok(w / len)

@@ -16,6 +16,7 @@ pub mod brdf;
 pub mod error;
 pub mod frame;
 pub mod fresnel;
+pub mod fsio;
 pub mod lobe;
 pub mod measured;
 pub mod microfacet;

@@ -447,7 +447,16 @@ impl ModelSpec {
         } else {
             id
         };
-        let decl = info.param(key)?;
+        // A refusal names what the user typed (`alpha`), not the axis it
+        // stands for on models that have one.
+        let decl = info.param(key).map_err(|e| match e {
+            BvError::UnknownParam { model, known, .. } => BvError::UnknownParam {
+                model,
+                param: id.to_string(),
+                known,
+            },
+            other => other,
+        })?;
         let value = cli_text_to_json(decl, text).map_err(|e| rename(e, id))?;
         self.set_json(id, &value)
     }

@@ -40,11 +40,11 @@
 //! index coordinates (θh in its square-root space), clamping at the θh and
 //! θd ends and wrapping around in φd (period π, by the reciprocity fold).
 
-use crate::{Brdf, BvError, Result, Rgb, frame};
+use crate::{Brdf, BvError, Result, Rgb, frame, fsio};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::io::{BufWriter, Read, Write};
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
@@ -52,6 +52,8 @@ use std::sync::{Arc, Mutex};
 pub const HEADER_BYTES: u64 = 12;
 /// Largest accepted value of any one dimension.
 pub const MAX_DIM: usize = 4096;
+/// Largest accepted file: the header and [`MAX_CELLS`] cells of 3 `float64`.
+pub const MAX_FILE_BYTES: u64 = HEADER_BYTES + 24 * MAX_CELLS;
 /// Largest accepted number of cells per channel (`nθh · nθd · nφd`):
 /// 2²⁴ = 16,777,216, 11.5 times the public resolution (a 192 MiB `f32` table,
 /// a 384 MiB file). Anything larger is refused before allocation.
@@ -321,12 +323,15 @@ pub struct MerlWarnings {
     /// NaN or infinite samples (or finite ones beyond the `f32` range after
     /// scaling) per channel.
     pub non_finite: [usize; 3],
+    /// Channels without a single valid sample (every value unmeasured or
+    /// non-finite): their statistics are over nothing and they read as 0.
+    pub no_valid: [bool; 3],
 }
 
 impl MerlWarnings {
     /// Whether nothing was found.
     pub fn is_empty(&self) -> bool {
-        self.unmeasured == [0; 3] && self.non_finite == [0; 3]
+        self.unmeasured == [0; 3] && self.non_finite == [0; 3] && self.no_valid == [false; 3]
     }
 
     /// Human-readable warnings, one per kind that occurred.
@@ -347,6 +352,20 @@ impl MerlWarnings {
         if self.non_finite != [0; 3] {
             let (n, detail) = per(self.non_finite);
             out.push(format!("{n} NaN or infinite samples set to 0 ({detail})"));
+        }
+        let empty: Vec<&str> = CHANNEL_NAMES
+            .iter()
+            .zip(self.no_valid)
+            .filter(|(_, e)| *e)
+            .map(|(n, _)| *n)
+            .collect();
+        if !empty.is_empty() {
+            out.push(format!(
+                "no valid sample at all in channel{} {}: every value is unmeasured or NaN, \
+                 so the table reads as 0 there and its statistics cover 0 samples",
+                if empty.len() == 1 { "" } else { "s" },
+                empty.join(", ")
+            ));
         }
         out
     }
@@ -434,6 +453,7 @@ impl MerlTable {
                 classify(v, c, &mut warnings, &mut acc);
             }
             ranges[c] = acc.range();
+            warnings.no_valid[c] = acc.valid == 0;
         }
         Ok(Self {
             dims,
@@ -459,14 +479,12 @@ impl MerlTable {
     ) -> Result<Self> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let file = std::fs::File::open(path).map_err(|e| file_err(&name, e.to_string()))?;
-        let meta = file
-            .metadata()
-            .map_err(|e| file_err(&name, e.to_string()))?;
-        if !meta.is_file() {
-            return Err(file_err(&name, "not a regular file"));
-        }
-        Self::read_from_with_progress(file, meta.len(), &name, progress)
+        // A regular file no larger than the largest table: a FIFO, a device
+        // or a directory is refused before it is read (see `crate::fsio`).
+        let (file, len) = fsio::open_regular(path, MAX_FILE_BYTES, "a MERL .binary table")?;
+        // The size must then match the header exactly (checked next); `take`
+        // stops a file that grows meanwhile one byte past it.
+        Self::read_from_with_progress(file.take(len + 1), len, &name, progress)
     }
 
     /// Reads a table from a stream of `len` bytes (`name` is used in errors).
@@ -562,6 +580,7 @@ impl MerlTable {
                 left -= k;
             }
             *range = acc.range();
+            warnings.no_valid[c] = acc.valid == 0;
         }
         let mut extra = [0u8; 1];
         match reader.read(&mut extra) {
@@ -584,28 +603,10 @@ impl MerlTable {
 
     /// Writes the table as a `.binary` file, atomically: to a temporary file
     /// beside `path`, then renamed over it, so a reader never sees half a file.
+    /// What is refused (FIFOs, devices, read-only files, …) and how symlinks
+    /// and permissions are treated is [`fsio::write_atomic`]'s.
     pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
-        let path = path.as_ref();
-        let name = path.display().to_string();
-        let file_name = path
-            .file_name()
-            .ok_or_else(|| file_err(&name, "not a file path"))?;
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(file_name);
-        tmp_name.push(format!(".tmp-{}", std::process::id()));
-        let tmp: PathBuf = path.with_file_name(tmp_name);
-        let result = (|| -> std::io::Result<()> {
-            let file = std::fs::File::create(&tmp)?;
-            let mut w = BufWriter::with_capacity(1 << 16, file);
-            self.write_to(&mut w)?;
-            let file = w.into_inner().map_err(|e| e.into_error())?;
-            file.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        result.map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            file_err(&name, e.to_string())
-        })
+        fsio::write_atomic(path.as_ref(), |mut w| self.write_to(&mut w))
     }
 
     /// Writes the `.binary` bytes (header, then `f / scale` as `float64`).

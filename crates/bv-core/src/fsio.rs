@@ -1,0 +1,579 @@
+//! Reading and writing user-named files without surprises: the one place
+//! where bv opens a file it did not create, and where it replaces one.
+//!
+//! # Reading ([`open_regular`], [`read_capped`])
+//! A path a user types may name anything: a FIFO (opening it blocks until a
+//! writer appears, possibly forever), a device (`/dev/zero` never ends), a
+//! directory, or a regular file far larger than anything bv reads. So every
+//! read checks the file's kind with `stat` before opening; opens with
+//! `O_NONBLOCK` on unix, so that a FIFO swapped in after the check still
+//! cannot block; checks the opened file again with `fstat` (same kind, same
+//! inode); refuses a size above the caller's cap; and reads through
+//! `Read::take(cap + 1)`, so a file that grows while it is read cannot make
+//! bv hold more than the cap.
+//!
+//! # Writing ([`write_atomic`])
+//! The new contents go to a temporary file beside the target (created with
+//! `O_EXCL`, never over an existing file), are synced, and the temporary is
+//! renamed over the target: readers see the old file or the whole new one,
+//! and a failed write (full disk, killed process) leaves the old file intact.
+//! Before anything is written the target is checked:
+//! - a symlink is written **through**: its final target is replaced and the
+//!   link stays a link (a dangling link is refused, nothing is created at
+//!   its target);
+//! - a directory, FIFO, socket or device is refused (renaming over it would
+//!   silently replace it by a regular file);
+//! - a read-only file (no write permission bit, or not writable by this
+//!   user) is refused, also when running as root, who could write it anyway;
+//! - an existing file's permission bits (and, where allowed, owner) are
+//!   copied to the new file.
+//!
+//! Errors are [`BvError::File`]: the path as given once, then one reason that
+//! includes the system's message once.
+
+use crate::{BvError, Result};
+use std::fs::{File, Metadata};
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// Largest scene file read (1 MiB; bv writes them in a few KiB).
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
+/// Largest environment map file read (1 GiB: a 16k × 8k float EXR).
+pub const MAX_ENV_MAP_BYTES: u64 = 1 << 30;
+
+/// Most symlinks followed when resolving a write target (as Linux's `ELOOP`).
+const MAX_LINK_HOPS: usize = 40;
+
+fn file_err(path: &Path, reason: impl Into<String>) -> BvError {
+    BvError::File {
+        path: path.display().to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// What kind of thing `t` is, for messages: "a directory", "a FIFO (named
+/// pipe)", "a character device", ….
+pub fn kind_name(t: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_file() {
+        "a regular file"
+    } else {
+        "not a regular file"
+    }
+}
+
+/// A byte count for messages: `104857600 bytes (100.0 MiB)`.
+pub fn human_bytes(n: u64) -> String {
+    const UNITS: [(&str, u64); 3] = [("GiB", 1 << 30), ("MiB", 1 << 20), ("KiB", 1 << 10)];
+    for (unit, size) in UNITS {
+        if n >= size {
+            let x = n as f64 / size as f64;
+            let shown = if n.is_multiple_of(size) {
+                format!("{}", n / size)
+            } else {
+                format!("{x:.1}")
+            };
+            return format!("{n} bytes ({shown} {unit})");
+        }
+    }
+    format!("{n} bytes")
+}
+
+/// The cap as it is stated in messages: `1 MiB`.
+fn cap_text(cap: u64) -> String {
+    match human_bytes(cap).split_once('(') {
+        Some((_, rest)) => rest.trim_end_matches(')').to_string(),
+        None => human_bytes(cap),
+    }
+}
+
+/// Why `stat` of `path` failed, saying so when `path` is a dangling symlink.
+fn stat_reason(path: &Path, e: &io::Error) -> String {
+    if e.kind() == io::ErrorKind::NotFound
+        && let Ok(m) = std::fs::symlink_metadata(path)
+        && m.file_type().is_symlink()
+    {
+        let to = std::fs::read_link(path)
+            .map(|t| t.display().to_string())
+            .unwrap_or_else(|_| "?".into());
+        return format!("a symbolic link to {to}, which does not exist");
+    }
+    e.to_string()
+}
+
+/// Opens `path` for reading, which must be (or link to) a regular file of at
+/// most `cap` bytes; `what` names the expected content in messages ("a scene
+/// file"). Returns the file and its length. Never blocks on a FIFO.
+pub fn open_regular(path: &Path, cap: u64, what: &str) -> Result<(File, u64)> {
+    if path.as_os_str().is_empty() {
+        return Err(BvError::Invalid(format!(
+            "an empty path where {what} was expected"
+        )));
+    }
+    let before = std::fs::metadata(path).map_err(|e| file_err(path, stat_reason(path, &e)))?;
+    check_regular(path, &before, cap, what)?;
+    let file = open_nonblocking(path).map_err(|e| file_err(path, e.to_string()))?;
+    let after = file.metadata().map_err(|e| file_err(path, e.to_string()))?;
+    check_regular(path, &after, cap, what)?;
+    if !same_file(&before, &after) {
+        return Err(file_err(
+            path,
+            "the file was replaced while bv opened it; try again",
+        ));
+    }
+    Ok((file, after.len()))
+}
+
+/// Reads all of `path` (see [`open_regular`]) into memory, holding at most
+/// `cap` bytes even if the file grows meanwhile.
+pub fn read_capped(path: &Path, cap: u64, what: &str) -> Result<Vec<u8>> {
+    let (file, len) = open_regular(path, cap, what)?;
+    let mut bytes = Vec::new();
+    // `len` is at most `cap`; reserve what the file says, not more.
+    bytes
+        .try_reserve_exact(len as usize)
+        .map_err(|e| file_err(path, format!("cannot allocate {}: {e}", human_bytes(len))))?;
+    file.take(cap + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| file_err(path, e.to_string()))?;
+    if bytes.len() as u64 > cap {
+        return Err(too_big(path, None, cap, what));
+    }
+    Ok(bytes)
+}
+
+fn too_big(path: &Path, len: Option<u64>, cap: u64, what: &str) -> BvError {
+    let size = match len {
+        Some(n) => format!("{} is", human_bytes(n)),
+        None => "grew while being read and is".to_string(),
+    };
+    file_err(
+        path,
+        format!("{size} over the {} limit for {what}", cap_text(cap)),
+    )
+}
+
+fn check_regular(path: &Path, m: &Metadata, cap: u64, what: &str) -> Result<()> {
+    let t = m.file_type();
+    if !t.is_file() {
+        let hint = if t.is_dir() {
+            format!("; give the path of {what} inside it")
+        } else {
+            String::new()
+        };
+        return Err(file_err(
+            path,
+            format!("{}, not a regular file{hint}", kind_name(&t)),
+        ));
+    }
+    if m.len() > cap {
+        return Err(too_big(path, Some(m.len()), cap, what));
+    }
+    Ok(())
+}
+
+#[cfg(unix)]
+fn open_nonblocking(path: &Path) -> io::Result<File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    // O_NONBLOCK: opening a FIFO for reading returns at once instead of
+    // waiting for a writer (regular files ignore the flag for reads).
+    std::fs::OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_NONBLOCK)
+        .open(path)
+}
+
+#[cfg(not(unix))]
+fn open_nonblocking(path: &Path) -> io::Result<File> {
+    File::open(path)
+}
+
+#[cfg(unix)]
+fn same_file(a: &Metadata, b: &Metadata) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    a.dev() == b.dev() && a.ino() == b.ino()
+}
+
+#[cfg(not(unix))]
+fn same_file(_: &Metadata, _: &Metadata) -> bool {
+    true
+}
+
+/// Creates the missing folders above `path` (for figures written into a new
+/// folder).
+pub fn create_parent_dirs(path: &Path) -> Result<()> {
+    if let Some(dir) = path.parent()
+        && !dir.as_os_str().is_empty()
+    {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            file_err(
+                dir,
+                if e.kind() == io::ErrorKind::AlreadyExists {
+                    "exists and is not a directory".to_string()
+                } else {
+                    format!("cannot create the folder: {e}")
+                },
+            )
+        })?;
+    }
+    Ok(())
+}
+
+/// The file a write to `path` replaces: `path` itself, or the final target
+/// of the symlink chain starting at `path` (see the module docs).
+fn resolve_target(path: &Path) -> Result<PathBuf> {
+    let mut p = path.to_path_buf();
+    for _ in 0..MAX_LINK_HOPS {
+        match std::fs::symlink_metadata(&p) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let to = std::fs::read_link(&p).map_err(|e| file_err(path, e.to_string()))?;
+                p = match p.parent() {
+                    Some(dir) if to.is_relative() => dir.join(to),
+                    _ => to,
+                };
+            }
+            Ok(_) => return Ok(p),
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                if p != path {
+                    return Err(file_err(
+                        path,
+                        format!(
+                            "a symbolic link to {}, which does not exist; bv writes through \
+                             symbolic links but does not create their targets",
+                            p.display()
+                        ),
+                    ));
+                }
+                return Ok(p);
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotADirectory => {
+                let parent = p.parent().map(|d| d.display().to_string());
+                return Err(file_err(
+                    path,
+                    format!(
+                        "a part of the folder {} is a file, not a directory",
+                        parent.unwrap_or_default()
+                    ),
+                ));
+            }
+            Err(e) => return Err(file_err(path, e.to_string())),
+        }
+    }
+    Err(file_err(
+        path,
+        format!("more than {MAX_LINK_HOPS} levels of symbolic links"),
+    ))
+}
+
+/// Whether this process may write `path` (the permission bits alone say
+/// nothing for root; `access(2)` says nothing for root either, so both the
+/// bits and `access` are asked).
+fn is_read_only(path: &Path, m: &Metadata) -> bool {
+    if m.permissions().readonly() {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        if let Ok(c) = std::ffi::CString::new(path.as_os_str().as_bytes()) {
+            // SAFETY: `c` is a valid NUL-terminated string for the call.
+            return unsafe { libc::access(c.as_ptr(), libc::W_OK) } != 0;
+        }
+    }
+    false
+}
+
+#[cfg(unix)]
+fn mode_text(m: &Metadata) -> String {
+    use std::os::unix::fs::PermissionsExt;
+    format!(" (mode {:04o})", m.permissions().mode() & 0o7777)
+}
+
+#[cfg(not(unix))]
+fn mode_text(_: &Metadata) -> String {
+    String::new()
+}
+
+/// Writes `path` atomically with what `write` produces (see the module docs
+/// for what is refused and how symlinks and permissions are treated). The
+/// parent folder must exist ([`create_parent_dirs`] makes it).
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> io::Result<()>,
+) -> Result<()> {
+    if path.as_os_str().is_empty() {
+        return Err(BvError::Invalid("an empty output path".to_string()));
+    }
+    if path.as_os_str().to_string_lossy().ends_with(['/', '\\']) {
+        return Err(file_err(
+            path,
+            "ends with a path separator, so it names a folder; give a file name",
+        ));
+    }
+    let target = resolve_target(path)?;
+    let existing = match std::fs::metadata(&target) {
+        Ok(m) => Some(m),
+        Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+        Err(e) => return Err(file_err(path, e.to_string())),
+    };
+    if let Some(m) = &existing {
+        let t = m.file_type();
+        if t.is_dir() {
+            return Err(file_err(
+                path,
+                "a directory, not a file; give a file name inside it",
+            ));
+        }
+        if !t.is_file() {
+            return Err(file_err(
+                path,
+                format!(
+                    "{}, not a regular file; bv replaces only regular files",
+                    kind_name(&t)
+                ),
+            ));
+        }
+        if is_read_only(&target, m) {
+            let what = if m.permissions().readonly() {
+                "read-only"
+            } else {
+                "not writable by this user"
+            };
+            return Err(file_err(
+                path,
+                format!(
+                    "the file is {what}{}; bv does not overwrite it (make it writable \
+                     or choose another name)",
+                    mode_text(m)
+                ),
+            ));
+        }
+    }
+    let dir = match target.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    match std::fs::metadata(&dir) {
+        Ok(m) if m.is_dir() => {}
+        Ok(m) => {
+            return Err(file_err(
+                path,
+                format!(
+                    "its folder {} is {}, not a directory",
+                    dir.display(),
+                    kind_name(&m.file_type())
+                ),
+            ));
+        }
+        Err(e) => {
+            return Err(file_err(
+                path,
+                format!("its folder {} cannot be used: {e}", dir.display()),
+            ));
+        }
+    }
+    let name = target
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .ok_or_else(|| file_err(path, "not a file name"))?;
+    let (tmp, file) = create_temp(&dir, &name, existing.as_ref()).map_err(|e| {
+        file_err(
+            path,
+            format!("cannot create a file in {}: {e}", dir.display()),
+        )
+    })?;
+    let result = (|| {
+        let mut w = io::BufWriter::with_capacity(1 << 16, file);
+        write(&mut w)?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        if let Some(m) = &existing {
+            copy_metadata(&file, m);
+        }
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&tmp, &target)
+    })();
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(file_err(path, format!("cannot write: {e}")));
+    }
+    // Make the rename itself durable where the platform allows.
+    if let Ok(d) = File::open(&dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+/// A new temporary file beside the target, never over an existing file.
+fn create_temp(dir: &Path, name: &str, existing: Option<&Metadata>) -> io::Result<(PathBuf, File)> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let mut last = io::Error::other("no temporary name was free");
+    for _ in 0..100 {
+        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        let mut opts = std::fs::OpenOptions::new();
+        opts.write(true).create_new(true);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::OpenOptionsExt;
+            // A new file gets the usual 0666 less the umask; a replacement
+            // starts private and gets the old file's mode once written.
+            opts.mode(if existing.is_some() { 0o600 } else { 0o666 });
+        }
+        #[cfg(not(unix))]
+        let _ = existing;
+        match opts.open(&tmp) {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = e,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last)
+}
+
+/// Gives the new file the old one's permission bits and, where allowed, its
+/// owner (best effort: a failure leaves the new file with the defaults).
+fn copy_metadata(file: &File, old: &Metadata) {
+    let _ = file.set_permissions(old.permissions());
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let Ok(now) = file.metadata()
+            && (now.uid() != old.uid() || now.gid() != old.gid())
+        {
+            let _ = std::os::unix::fs::fchown(file, Some(old.uid()), Some(old.gid()));
+            // A change of owner clears set-id bits; set the mode again.
+            let _ = file.set_permissions(old.permissions());
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("bv-fsio-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
+        write_atomic(path, |w| w.write_all(bytes))
+    }
+
+    #[test]
+    fn reads_regular_files_and_refuses_the_rest() {
+        let d = temp_dir("read");
+        let f = d.join("a.txt");
+        std::fs::write(&f, b"hello").unwrap();
+        assert_eq!(read_capped(&f, 5, "a test file").unwrap(), b"hello");
+        let e = read_capped(&f, 4, "a test file").unwrap_err().to_string();
+        assert!(
+            e.contains("5 bytes is over the 4 bytes limit for a test file"),
+            "{e}"
+        );
+        let e = read_capped(&d, 100, "a test file").unwrap_err().to_string();
+        assert!(e.contains("a directory, not a regular file"), "{e}");
+        let e = read_capped(Path::new("/dev/zero"), 100, "x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a character device, not a regular file"), "{e}");
+        let e = read_capped(&d.join("missing"), 100, "x")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e.matches("No such file").count(), 1, "{e}");
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn writes_through_symlinks_and_keeps_modes() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = temp_dir("write");
+        let real = d.join("real.txt");
+        std::fs::write(&real, b"old").unwrap();
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).unwrap();
+        let link = d.join("link.txt");
+        std::os::unix::fs::symlink("real.txt", &link).unwrap();
+        write_bytes(&link, b"new").unwrap();
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(std::fs::read(&real).unwrap(), b"new");
+        let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o640);
+
+        let ro = d.join("ro.txt");
+        std::fs::write(&ro, b"keep").unwrap();
+        std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o444)).unwrap();
+        let e = write_bytes(&ro, b"lost").unwrap_err().to_string();
+        assert!(e.contains("read-only (mode 0444)"), "{e}");
+        assert_eq!(std::fs::read(&ro).unwrap(), b"keep");
+
+        let dangling = d.join("dangling.txt");
+        std::os::unix::fs::symlink("nowhere/x.txt", &dangling).unwrap();
+        let e = write_bytes(&dangling, b"x").unwrap_err().to_string();
+        assert!(e.contains("does not exist"), "{e}");
+
+        let e = write_bytes(&d, b"x").unwrap_err().to_string();
+        assert!(e.contains("a directory"), "{e}");
+        let e = write_bytes(Path::new("/dev/null"), b"x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a character device, not a regular file"), "{e}");
+        // Only the files made above: no temporary is left behind.
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 4);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn failed_write_keeps_the_old_file() {
+        let d = temp_dir("fail");
+        let f = d.join("f.txt");
+        std::fs::write(&f, b"old").unwrap();
+        let e = write_atomic(&f, |w| {
+            w.write_all(b"half")?;
+            Err(io::Error::other("disk on fire"))
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("disk on fire"), "{e}");
+        assert_eq!(std::fs::read(&f).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn sizes_read_well() {
+        assert_eq!(human_bytes(12), "12 bytes");
+        assert_eq!(human_bytes(1 << 20), "1048576 bytes (1 MiB)");
+        assert_eq!(cap_text(1 << 20), "1 MiB");
+        assert_eq!(human_bytes(100_000_000), "100000000 bytes (95.4 MiB)");
+    }
+}
