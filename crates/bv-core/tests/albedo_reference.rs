@@ -457,3 +457,49 @@ fn monte_carlo_error_bars_are_calibrated() {
         "{in2:.4} within 2σ over {n} runs"
     );
 }
+
+/// A measured model (a MERL-layout table tabulated from Cook-Torrance, read
+/// with trilinear interpolation) is estimated by Monte Carlo, the method
+/// `Auto` picks for it; its error bars are calibrated against the quadrature
+/// of the same tabulated function (the table is continuous, so the
+/// quadrature converges; its error is far below the Monte Carlo σ).
+#[test]
+fn measured_models_use_calibrated_monte_carlo() {
+    use bv_core::analysis::albedo::{AlbedoOptions, rho_hd_auto};
+    use bv_core::measured::merl::tabulate;
+    use bv_core::measured::{Interpolation, MerlDims};
+    use bv_core::models::merl::Merl;
+    use std::sync::Arc;
+    let ct = build(
+        "cook-torrance",
+        &json!({"distribution": "ggx", "alpha": 0.4, "geometry": "smith"}),
+    );
+    let dims = MerlDims {
+        theta_h: 24,
+        theta_d: 24,
+        phi_d: 48,
+    };
+    let table = tabulate(ct.as_ref(), dims).unwrap_or_else(|e| panic!("{e}"));
+    let m = Merl::from_table(Arc::new(table), Interpolation::Trilinear);
+    assert!(!m.is_analytic());
+    let opts = QuadratureOptions {
+        abs_tol: 1e-5,
+        ..QuadratureOptions::default()
+    };
+    let mut zs = Vec::new();
+    for deg in [0.0f64, 50.0, 80.0] {
+        let truth = quadrature::rho_hd(&m, deg.to_radians(), 0.0, &opts);
+        let auto = rho_hd_auto(&m, deg.to_radians(), 0.0, &AlbedoOptions::default());
+        assert_eq!(auto.method.name(), "monte carlo");
+        let first = zs.len();
+        for s in 0..80u64 {
+            let e = albedo::rho_hd(&m, deg.to_radians(), 0.0, 512, 500 + s + 977 * deg as u64);
+            zs.push((e.value.x - truth.value.x) / e.std_error.x);
+        }
+        let mean = zs[first..].iter().sum::<f64>() / 80.0;
+        // Std of a mean of 80 t15 values is ≈ 0.12.
+        assert!(mean.abs() < 0.6, "θi={deg}: mean z {mean:.2}");
+    }
+    let inside = zs.iter().filter(|z| z.abs() <= 3.0).count() as f64 / zs.len() as f64;
+    assert!(inside >= 0.975, "{inside} within 3σ over {} runs", zs.len());
+}
