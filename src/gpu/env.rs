@@ -7,6 +7,7 @@
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
+use super::errors;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Context, Result, bail};
@@ -400,6 +401,13 @@ fn compute_pipeline(
 impl EnvRenderer {
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
+        let device = gpu.device.clone();
+        errors::scoped(&device, "building the environment renderer", || {
+            Self::build(gpu, library, map)
+        })
+    }
+
+    fn build(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
         // params, tiles, accumulation, environment map and MERL tables.
         let have = gpu.device.limits().max_storage_buffers_per_shader_stage;
         if have < 5 {
@@ -481,13 +489,23 @@ impl EnvRenderer {
         data.extend_from_slice(&marginal);
         let c = u32::try_from(data.len())?;
         data.extend_from_slice(&conditional);
-        let buffer = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("env data"),
-                contents: bytemuck::cast_slice(&data),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let what = format!("an environment map of {}×{}", map.width, map.height);
+        errors::check_buffer(
+            &gpu.device,
+            &what,
+            4 * data.len() as u64,
+            true,
+            "use a smaller map",
+        )?;
+        let buffer = gpu.scoped(&format!("uploading {what}"), || {
+            Ok(gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("env data"),
+                    contents: bytemuck::cast_slice(&data),
+                    usage: wgpu::BufferUsages::STORAGE,
+                }))
+        })?;
         Ok(EnvBuffers {
             data: buffer,
             marginal: m,
@@ -526,7 +544,7 @@ impl EnvRenderer {
         if self
             .accum
             .as_ref()
-            .is_none_or(|a| a.size() != 16 * u64::from(width) * u64::from(height))
+            .is_none_or(|a| a.size() != accumulation_bytes(width, height))
         {
             bail!("nothing accumulated at {width}×{height}");
         }
@@ -598,16 +616,18 @@ impl EnvRenderer {
         self.accumulate_to(models, settings, width, height, spp)?;
         let accum = self.accum.as_ref().context("no accumulation buffer")?;
         let size = accum.size();
-        let rb = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accum readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(accum, 0, &rb, 0, size);
-        self.gpu.queue.submit([enc.finish()]);
-        let bytes = self.gpu.read_buffer(&rb, size)?;
+        let bytes = self.gpu.scoped("reading the environment back", || {
+            let rb = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("accum readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            enc.copy_buffer_to_buffer(accum, 0, &rb, 0, size);
+            self.gpu.queue.submit([enc.finish()]);
+            self.gpu.read_buffer(&rb, size)
+        })?;
         let v: &[f32] = bytemuck::cast_slice(&bytes);
         Ok(v.chunks_exact(4)
             .map(|c| {
@@ -670,17 +690,49 @@ impl EnvRenderer {
         height: u32,
         spp: u32,
     ) -> Result<()> {
+        let device = self.gpu.device.clone();
+        let result = errors::scoped(&device, "rendering the environment", || {
+            self.accumulate_pass_unscoped(models, settings, width, height, spp)
+        });
+        if result.is_err() {
+            // Whatever was accumulated is not to be trusted: the next pass
+            // starts afresh.
+            self.key = None;
+            self.accum = None;
+        }
+        result
+    }
+
+    fn accumulate_pass_unscoped(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<()> {
         if models.is_empty() {
             bail!("the environment view needs at least one model");
         }
         let key = self.key(models, settings, width, height);
         let d = self.gpu.device.clone();
         if self.key.as_ref() != Some(&key) || self.accum.is_none() {
-            // Restart: a fresh, zeroed accumulation buffer.
-            let size = 16 * u64::from(width) * u64::from(height);
+            // Restart: a fresh, zeroed accumulation buffer (rgb sum and
+            // sample count, four f32 per pixel).
+            self.accum = None;
+            self.key = None;
+            let size = accumulation_bytes(width, height);
             if size == 0 {
                 bail!("image size {width}×{height} is empty");
             }
+            errors::check_texture(&d, "an environment image", width, height)?;
+            errors::check_buffer(
+                &d,
+                &format!("an environment image of {width}×{height} pixels"),
+                size,
+                true,
+                "use a smaller --width/--height",
+            )?;
             self.accum = Some(d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("env accum"),
                 size,
@@ -796,6 +848,22 @@ impl EnvRenderer {
     }
 
     fn show(&mut self, settings: &EnvSettings, width: u32, height: u32) -> Result<&wgpu::Texture> {
+        let device = self.gpu.device.clone();
+        errors::scoped(&device, "displaying the environment", || {
+            self.show_unscoped(settings, width, height).map(|_| ())
+        })?;
+        self.target
+            .as_ref()
+            .map(|t| &t.texture)
+            .context("no environment image")
+    }
+
+    fn show_unscoped(
+        &mut self,
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Texture> {
         let accum = self.accum.as_ref().context("nothing rendered yet")?;
         let d = &self.gpu.device;
         let u = ShowUniform {
@@ -839,6 +907,12 @@ impl EnvRenderer {
         self.gpu.queue.submit([enc.finish()]);
         Ok(&target.texture)
     }
+}
+
+/// Bytes of the accumulation buffer of a `width`×`height` image: four f32
+/// (rgb sum and sample count) per pixel.
+pub fn accumulation_bytes(width: u32, height: u32) -> u64 {
+    16 * u64::from(width) * u64::from(height)
 }
 
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
