@@ -112,6 +112,12 @@ pub fn render_window(
         let mut runtime = Runtime::default();
         runtime.sync(state);
         check_brdfs(state, &runtime)?;
+        // The window may show the environment view too small to draw, but
+        // a scene naming a map that cannot be read is wrong all the same.
+        if let Some(map) = &state.lighting.env.map {
+            crate::gpu::EnvironmentMap::load(Path::new(map))
+                .with_context(|| "the scene's environment map")?;
+        }
         let scene = figure_scene(state, &runtime, false);
         for b in &scene.brdfs {
             crate::views::albedo::curve_now(&scene, b);

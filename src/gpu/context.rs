@@ -94,14 +94,19 @@ impl Gpu {
 }
 
 /// What a headless device asks for: the downlevel defaults (so that what
-/// works here works on modest hardware), with the adapter's texture sizes and
-/// up to 8 storage buffers per shader stage. The environment pass binds 5
+/// works here works on modest hardware), with the adapter's texture and
+/// buffer sizes (a figure's size is what the user asks for, and every buffer
+/// or texture sized from an image is checked against the device's limits,
+/// so a larger figure on a larger GPU is drawn, not refused) and up to 8
+/// storage buffers per shader stage. The environment pass binds 5
 /// (parameters, tiles, accumulation, environment map, MERL tables); downlevel
 /// promises only 4, while every Vulkan, Metal and DX12 device has at least 8,
 /// which is also what egui-wgpu's window device requests (`Limits::default()`).
 pub fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
     let have = adapter.limits();
     let mut l = wgpu::Limits::downlevel_defaults().using_resolution(have.clone());
+    l.max_buffer_size = have.max_buffer_size;
+    l.max_storage_buffer_binding_size = have.max_storage_buffer_binding_size;
     l.max_storage_buffers_per_shader_stage = have
         .max_storage_buffers_per_shader_stage
         .min(8)

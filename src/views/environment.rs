@@ -369,12 +369,9 @@ impl EnvironmentView {
         };
         match loaded {
             Ok(m) => self.install_map(map.clone(), &m),
-            Err(e) => {
-                self.map_error = Some(format!(
-                    "{e:#} (showing {})",
-                    self.map_in_use.as_deref().unwrap_or("the studio")
-                ))
-            }
+            // A figure with another map than asked for is wrong: the error
+            // alone (`bv render` fails with it).
+            Err(e) => self.map_error = Some(format!("{e:#}")),
         }
     }
 
