@@ -52,18 +52,23 @@ pub fn check_brdfs(state: &AppState, runtime: &Runtime) -> Result<()> {
     Ok(())
 }
 
-/// The error a rendered view showed in its image (an environment map that
-/// did not load, a renderer that failed), if any: a figure must not carry
-/// an error message in its pixels.
+/// The errors a rendered view showed in its image (an environment map that
+/// did not load, a renderer that failed, a BRDF the GPU cannot draw), if
+/// any: a figure must not carry an error message in its pixels.
 fn view_error(view: &dyn crate::views::View) -> Option<String> {
     let any = view.as_any();
-    if let Some(v) = any.downcast_ref::<crate::views::environment::EnvironmentView>() {
-        return v.error();
+    let (messages, error) =
+        if let Some(v) = any.downcast_ref::<crate::views::environment::EnvironmentView>() {
+            (v.messages().to_vec(), v.error())
+        } else if let Some(v) = any.downcast_ref::<crate::views::lit_sphere::LitSphereView>() {
+            (v.messages().to_vec(), v.error().map(str::to_string))
+        } else {
+            return None;
+        };
+    match (messages.is_empty(), error) {
+        (false, _) => Some(messages.join("; ")),
+        (true, e) => e,
     }
-    if let Some(v) = any.downcast_ref::<crate::views::lit_sphere::LitSphereView>() {
-        return v.error().map(str::to_string);
-    }
-    None
 }
 
 /// Draws one view of `state` alone, filling a `frame.size` image (no title
@@ -129,10 +134,10 @@ pub fn render_window(
     let errors = [
         viewer
             .view::<crate::views::environment::EnvironmentView>()
-            .and_then(|v| v.error()),
+            .and_then(|v| view_error(v)),
         viewer
             .view::<crate::views::lit_sphere::LitSphereView>()
-            .and_then(|v| v.error().map(str::to_string)),
+            .and_then(|v| view_error(v)),
     ];
     if let Some(e) = errors.into_iter().flatten().next() {
         bail!("{e}");
