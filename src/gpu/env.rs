@@ -997,7 +997,7 @@ fn band_rows(device: &wgpu::Device, width: u32, height: u32, cap: Option<u64>) -
     let l = device.limits();
     let limit = l
         .max_buffer_size
-        .min(u64::from(l.max_storage_buffer_binding_size))
+        .min(l.max_storage_buffer_binding_size)
         .min(cap.unwrap_or(u64::MAX));
     let row = accumulation_bytes(width, 1);
     if row > limit {

@@ -144,8 +144,7 @@ pub fn check_buffer(
 ) -> Result<()> {
     let l = device.limits();
     let max = if storage {
-        l.max_buffer_size
-            .min(u64::from(l.max_storage_buffer_binding_size))
+        l.max_buffer_size.min(l.max_storage_buffer_binding_size)
     } else {
         l.max_buffer_size
     };
