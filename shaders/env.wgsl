@@ -33,7 +33,11 @@ struct Frame {
     // pipeline specialised for its model (the dispatch starts at x0).
     x0: u32,
     x1: u32,
-    pad: vec2<u32>,
+    // The rows of this dispatch, [y0, y1): the accumulation buffer bound
+    // holds only them (a large image is split into bands that each fit the
+    // device's storage binding limit; the dispatch starts at y0).
+    y0: u32,
+    y1: u32,
 }
 
 // Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
@@ -210,11 +214,14 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let w = u32(view.size.x);
     let h = u32(view.size.y);
     let px = id.x + view.x0;
-    if (px >= min(view.x1, w) || id.y >= h) {
+    let py = id.y + view.y0;
+    if (px >= min(view.x1, w) || py >= min(view.y1, h)) {
         return;
     }
-    let pixel = id.y * w + px;
-    let p = vec2<f32>(f32(px), f32(id.y)) + vec2<f32>(0.5);
+    // The whole image's pixel index seeds the sequences, so the image does
+    // not depend on the split into bands.
+    let pixel = py * w + px;
+    let p = vec2<f32>(f32(px), f32(py)) + vec2<f32>(0.5);
     let on_torus = view.object == 1u;
     var s: SpherePoint;
     var x = vec3<f32>(0.0);
@@ -281,5 +288,5 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         sum += delta_radiance(model, m.y, s, x, on_torus) * f32(view.spp);
     }
-    accum[pixel] += vec4<f32>(sum, f32(view.spp));
+    accum[(py - view.y0) * w + px] += vec4<f32>(sum, f32(view.spp));
 }

@@ -4,6 +4,7 @@
 //! per view into a folder, with a progress bar on stderr.
 
 use super::params::spec_from_cli;
+use crate::app::lighting::MAX_TARGET_SPP;
 use crate::app::scene;
 use crate::app::state::{AppState, Incident, Theme};
 use crate::export::{self, Frame, Offscreen};
@@ -70,6 +71,11 @@ pub struct RenderArgs {
     /// on a 2× screen).
     #[arg(long, value_name = "S")]
     pub scale: Option<f32>,
+
+    /// Samples per pixel of the environment view (default: the scene's
+    /// target, at most 256 on a software renderer such as lavapipe).
+    #[arg(long, value_name = "N")]
+    pub spp: Option<u32>,
 
     /// Transparent background (PNG and SVG).
     #[arg(long)]
@@ -181,6 +187,12 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
     if a.dark {
         state.theme = Theme::Dark;
     }
+    if let Some(n) = a.spp {
+        if !(1..=MAX_TARGET_SPP).contains(&n) {
+            bail!("--spp {n}: expected 1..={MAX_TARGET_SPP} samples per pixel");
+        }
+        state.lighting.env.target_spp = n;
+    }
     state.display.log |= a.log;
     state.display.cosine |= a.cosine;
     state.maximised = None;
@@ -251,14 +263,19 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         views_for(&a.view)?
     };
     let all = !window && (views.len() > 1 || a.view.trim().eq_ignore_ascii_case("all"));
-    if a.width == 0
-        || a.height == 0
-        || a.width > export::offscreen::MAX_SIDE
-        || a.height > export::offscreen::MAX_SIDE
-    {
+    if a.width == 0 || a.height == 0 {
         bail!(
-            "--width/--height must be 1..={} pixels",
-            export::offscreen::MAX_SIDE
+            "--width {} --height {}: an image needs at least one pixel each way",
+            a.width,
+            a.height
+        );
+    }
+    let max = export::offscreen::MAX_SIDE;
+    if a.width > max || a.height > max {
+        bail!(
+            "--width {} --height {}: at most {max} pixels on a side",
+            a.width,
+            a.height
         );
     }
     let scale = a
@@ -279,7 +296,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         if kind_of(&a.out)? != Kind::Png {
             bail!("--view window: only PNG (--out FILE.png)");
         }
-        let mut off = Offscreen::headless()?;
+        let mut off = open_device(frame)?;
         let img = export::render_window(&mut off, &state, frame)?;
         return export::save_png(&img, &a.out);
     }
@@ -288,7 +305,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         let kind = kind_of(&a.out)?;
         return match kind {
             Kind::Png => {
-                let mut off = Offscreen::headless()?;
+                let mut off = open_device(frame)?;
                 write_png(&mut off, &state, e, frame, &a.out)
             }
             Kind::Svg => write_svg(&state, e, frame, &a.out),
@@ -326,7 +343,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         total: views.len() + svg_views.len(),
         tty: std::io::stderr().is_terminal(),
     };
-    let mut off = Offscreen::headless()?;
+    let mut off = open_device(frame)?;
     let mut done = 0;
     progress.step(done, "starting");
     for e in &views {
@@ -342,6 +359,22 @@ pub fn run(a: &RenderArgs) -> Result<()> {
         progress.step(done, &path.display().to_string());
     }
     Ok(())
+}
+
+/// Opens the headless device and checks that it can draw images of
+/// `frame`'s size (its largest texture side), naming the options to change.
+fn open_device(frame: Frame) -> Result<Offscreen> {
+    let off = Offscreen::headless()?;
+    let [w, h] = frame.pixels();
+    let max = off.max_side();
+    if w > max || h > max {
+        bail!(
+            "an image of {w}×{h} pixels: this device ({}) draws at most {max} pixels on a side; \
+             use a smaller --width/--height (or --scale)",
+            off.describe()
+        );
+    }
+    Ok(off)
 }
 
 fn write_png(

@@ -34,8 +34,47 @@ pub fn is_dark(state: &AppState) -> bool {
     state.theme == Theme::Dark
 }
 
+/// Fails when a drawn BRDF of `state` could not be built (a missing or
+/// unreadable MERL file, a bad parameter in a scene): a figure without it
+/// would be wrong, not merely incomplete.
+pub fn check_brdfs(state: &AppState, runtime: &Runtime) -> Result<()> {
+    for e in state.brdfs.iter().filter(|e| state.is_drawn(e)) {
+        let name = crate::app::panel::display_name(state, e);
+        match runtime.get(e.id) {
+            Some(b) if b.brdf.is_some() => {}
+            Some(b) => bail!(
+                "BRDF {name}: {}",
+                b.error.as_deref().unwrap_or("it could not be built")
+            ),
+            None => bail!("BRDF {name}: it could not be built"),
+        }
+    }
+    Ok(())
+}
+
+/// The errors a rendered view showed in its image (an environment map that
+/// did not load, a renderer that failed, a BRDF the GPU cannot draw), if
+/// any: a figure must not carry an error message in its pixels.
+fn view_error(view: &dyn crate::views::View) -> Option<String> {
+    let any = view.as_any();
+    let (messages, error) =
+        if let Some(v) = any.downcast_ref::<crate::views::environment::EnvironmentView>() {
+            (v.messages().to_vec(), v.error())
+        } else if let Some(v) = any.downcast_ref::<crate::views::lit_sphere::LitSphereView>() {
+            (v.messages().to_vec(), v.error().map(str::to_string))
+        } else {
+            return None;
+        };
+    match (messages.is_empty(), error) {
+        (false, _) => Some(messages.join("; ")),
+        (true, e) => e,
+    }
+}
+
 /// Draws one view of `state` alone, filling a `frame.size` image (no title
-/// bar or toolbar, no hover readouts).
+/// bar or toolbar, no hover readouts). Fails, rather than drawing an
+/// incomplete figure, when a drawn BRDF could not be built or the view met
+/// an error (see [`check_brdfs`]).
 pub fn render_view(
     off: &mut Offscreen,
     state: &AppState,
@@ -44,8 +83,9 @@ pub fn render_view(
 ) -> Result<image::RgbaImage> {
     let mut runtime = Runtime::default();
     runtime.sync(state);
+    check_brdfs(state, &runtime)?;
     let mut view = (entry.make)();
-    off.render(frame, |ui| {
+    let img = off.render(frame, |ui| {
         let scene = figure_scene(state, &runtime, frame.transparent);
         let fill = if frame.transparent {
             egui::Color32::TRANSPARENT
@@ -58,7 +98,11 @@ pub fn render_view(
                 let mut ignored = Vec::new();
                 view.ui(ui, &scene, &mut ignored);
             });
-    })
+    })?;
+    if let Some(e) = view_error(view.as_ref()) {
+        bail!("{e}");
+    }
+    Ok(img)
 }
 
 /// Draws the whole viewer window showing `state`.
@@ -72,6 +116,13 @@ pub fn render_window(
     {
         let mut runtime = Runtime::default();
         runtime.sync(state);
+        check_brdfs(state, &runtime)?;
+        // The window may show the environment view too small to draw, but
+        // a scene naming a map that cannot be read is wrong all the same.
+        if let Some(map) = &state.lighting.env.map {
+            crate::gpu::EnvironmentMap::load(Path::new(map))
+                .with_context(|| "the scene's environment map")?;
+        }
         let scene = figure_scene(state, &runtime, false);
         for b in &scene.brdfs {
             crate::views::albedo::curve_now(&scene, b);
@@ -79,7 +130,19 @@ pub fn render_window(
     }
     let mut viewer = Viewer::new(state.clone());
     viewer.figure = true;
-    off.render(frame, |ui| viewer.ui(ui))
+    let img = off.render(frame, |ui| viewer.ui(ui))?;
+    let errors = [
+        viewer
+            .view::<crate::views::environment::EnvironmentView>()
+            .and_then(|v| view_error(v)),
+        viewer
+            .view::<crate::views::lit_sphere::LitSphereView>()
+            .and_then(|v| view_error(v)),
+    ];
+    if let Some(e) = errors.into_iter().flatten().next() {
+        bail!("{e}");
+    }
+    Ok(img)
 }
 
 /// One view of `state` as SVG (`None` if the view has no vector form).

@@ -8,6 +8,7 @@
 //! and rasterised at that resolution (text, lines and the lobe's own target),
 //! never upscaled.
 
+use crate::gpu::errors::{self, ErrorLog};
 use anyhow::{Context as _, Result, anyhow, bail};
 use eframe::egui::{self, Vec2};
 use eframe::egui_wgpu::{self, ScreenDescriptor};
@@ -21,8 +22,9 @@ pub const FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 /// it stands after this many.
 pub const MAX_PASSES: usize = 16;
 
-/// Largest image side accepted (wgpu's default texture limit).
-pub const MAX_SIDE: u32 = 8192;
+/// Largest image side accepted whatever the device allows: a 16384-pixel
+/// square is already 1 GiB of pixels to lay out, paint and read back.
+pub const MAX_SIDE: u32 = 16384;
 
 /// An egui-wgpu renderer of its own on a device (the GUI's, or one opened
 /// headless), with every view's GPU resources installed. It is held as an
@@ -31,6 +33,7 @@ pub const MAX_SIDE: u32 = 8192;
 /// with its renderer) draw offscreen as they do in the window.
 pub struct Offscreen {
     rs: egui_wgpu::RenderState,
+    errors: ErrorLog,
 }
 
 /// How an image is drawn.
@@ -93,6 +96,8 @@ impl Offscreen {
         device: wgpu::Device,
         queue: wgpu::Queue,
     ) -> Self {
+        // A GPU error must become a message, never wgpu's default panic.
+        let errors = errors::watch(&device);
         let mut renderer =
             egui_wgpu::Renderer::new(&device, FORMAT, egui_wgpu::RendererOptions::PREDICTABLE);
         crate::views::install_gpu(
@@ -111,6 +116,7 @@ impl Offscreen {
                 target_format: FORMAT,
                 renderer: std::sync::Arc::new(eframe::egui::mutex::RwLock::new(renderer)),
             },
+            errors,
         }
     }
 
@@ -129,6 +135,16 @@ impl Offscreen {
         &self.rs
     }
 
+    /// The largest image side this device can draw (its texture limit, at
+    /// most [`MAX_SIDE`]).
+    pub fn max_side(&self) -> u32 {
+        self.rs
+            .device
+            .limits()
+            .max_texture_dimension_2d
+            .min(MAX_SIDE)
+    }
+
     /// One line naming the adapter.
     pub fn describe(&self) -> String {
         let i = self.rs.adapter.get_info();
@@ -145,9 +161,29 @@ impl Offscreen {
         mut ui: impl FnMut(&mut egui::Ui),
     ) -> Result<image::RgbaImage> {
         let [w, h] = frame.pixels();
-        if w > MAX_SIDE || h > MAX_SIDE {
-            bail!("image of {w}×{h} pixels is larger than {MAX_SIDE} on a side");
+        let max = self.max_side();
+        if w > max || h > max {
+            bail!("an image of {w}×{h} pixels: this device draws at most {max} pixels on a side");
         }
+        let before = self.errors.count();
+        let device = self.rs.device.clone();
+        let image = errors::scoped(&device, "drawing the figure", || {
+            self.render_unscoped(frame, [w, h], &mut ui)
+        });
+        // Errors of work on other threads (a renderer built in the
+        // background) reach the uncaptured-error handler instead.
+        if let Some(e) = self.errors.since(before) {
+            bail!("drawing the figure: GPU error: {e}");
+        }
+        image
+    }
+
+    fn render_unscoped(
+        &mut self,
+        frame: Frame,
+        [w, h]: [u32; 2],
+        ui: &mut impl FnMut(&mut egui::Ui),
+    ) -> Result<image::RgbaImage> {
         let ctx = egui::Context::default();
         ctx.set_theme(if frame.dark {
             egui::Theme::Dark
@@ -170,10 +206,16 @@ impl Offscreen {
             max_texture_side: Some(self.rs.device.limits().max_texture_dimension_2d as usize),
             ..Default::default()
         };
-        if let Some(v) = input.viewports.get_mut(&egui::ViewportId::ROOT) {
-            v.native_pixels_per_point = Some(frame.pixels_per_point);
-        }
-        ctx.set_pixels_per_point(frame.pixels_per_point);
+        // The scale is the viewport's native pixels per point, zoom staying 1.
+        // (Setting a zoom as well multiplies the two, and egui then replaces
+        // the first pass's screen by its default 10 000-point one, scaled:
+        // the environment view sized its buffers from that, 20 000 pixels a
+        // side at 2×.)
+        input
+            .viewports
+            .entry(egui::ViewportId::ROOT)
+            .or_default()
+            .native_pixels_per_point = Some(frame.pixels_per_point);
         crate::views::install_context(&ctx, &self.rs);
 
         let mut output = None;
@@ -266,54 +308,10 @@ impl Offscreen {
             renderer.render(&mut pass, &jobs, &screen);
         }
         drop(renderer);
-        let unpadded = w as usize * 4;
-        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
-        let padded = unpadded.div_ceil(align) * align;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("bv offscreen readback"),
-            size: (padded * h as usize) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            texture.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded as u32),
-                    rows_per_image: None,
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
         queue.submit(user.into_iter().chain(std::iter::once(encoder.finish())));
-        let slice = buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
-        rx.recv()
-            .context("the GPU dropped the readback")?
-            .map_err(|e| anyhow!("GPU readback failed: {e}"))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| anyhow!("GPU readback failed: {e:?}"))?;
-        let mut pixels = Vec::with_capacity(unpadded * h as usize);
-        for row in data.chunks_exact(padded) {
-            pixels.extend_from_slice(&row[..unpadded]);
-        }
-        drop(data);
-        buffer.unmap();
+        let image = crate::gpu::context::read_rgba8(device, queue, &texture);
         texture.destroy();
-        image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
+        image
     }
 }
 

@@ -1,7 +1,8 @@
 //! The device the renderers share: opened headless here, or handed over by the
 //! GUI's egui-wgpu render state.
 
-use anyhow::{Context, Result, anyhow};
+use super::errors::{self, ErrorLog};
+use anyhow::{Context, Result, anyhow, bail};
 
 /// Environment variable that lets GPU tests pass without an adapter (for
 /// machines that cannot install lavapipe); CI installs it and must not skip.
@@ -16,6 +17,8 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// What the adapter is (name, backend, device type), for reports.
     pub info: wgpu::AdapterInfo,
+    /// The device's uncaptured errors (recorded, never a panic).
+    pub errors: ErrorLog,
 }
 
 impl Gpu {
@@ -46,20 +49,26 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .with_context(|| format!("opening a device on {}", info.name))?;
-        Ok(Self {
-            device,
-            queue,
-            info,
-        })
+        Ok(Self::from_parts(device, queue, info))
     }
 
-    /// Wraps a device opened elsewhere (the GUI's render state).
+    /// Wraps a device opened elsewhere (the GUI's render state); its
+    /// uncaptured errors are recorded from now on instead of panicking.
     pub fn from_parts(device: wgpu::Device, queue: wgpu::Queue, info: wgpu::AdapterInfo) -> Self {
+        let errors = errors::watch(&device);
         Self {
             device,
             queue,
             info,
+            errors,
         }
+    }
+
+    /// Runs `work` inside error scopes of this device (see
+    /// [`errors::scoped`]): a validation or out-of-memory error becomes an
+    /// `Err` naming `what`.
+    pub fn scoped<T>(&self, what: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+        errors::scoped(&self.device, what, work)
     }
 
     /// One line naming the adapter: `llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)`.
@@ -80,34 +89,24 @@ impl Gpu {
 
     /// Copies a `MAP_READ` buffer's first `len` bytes back to the CPU.
     pub fn read_buffer(&self, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>> {
-        let slice = buffer.slice(..len);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            // The receiver lives until recv() below returns.
-            let _ = tx.send(r);
-        });
-        self.wait()?;
-        rx.recv()
-            .context("the GPU dropped a buffer mapping")?
-            .map_err(|e| anyhow!("mapping a readback buffer: {e}"))?;
-        let bytes = slice
-            .get_mapped_range()
-            .map_err(|e| anyhow!("reading a mapped buffer: {e:?}"))?
-            .to_vec();
-        buffer.unmap();
-        Ok(bytes)
+        read_back(&self.device, buffer, len)
     }
 }
 
 /// What a headless device asks for: the downlevel defaults (so that what
-/// works here works on modest hardware), with the adapter's texture sizes and
-/// up to 8 storage buffers per shader stage. The environment pass binds 5
+/// works here works on modest hardware), with the adapter's texture and
+/// buffer sizes (a figure's size is what the user asks for, and every buffer
+/// or texture sized from an image is checked against the device's limits,
+/// so a larger figure on a larger GPU is drawn, not refused) and up to 8
+/// storage buffers per shader stage. The environment pass binds 5
 /// (parameters, tiles, accumulation, environment map, MERL tables); downlevel
 /// promises only 4, while every Vulkan, Metal and DX12 device has at least 8,
 /// which is also what egui-wgpu's window device requests (`Limits::default()`).
 pub fn limits(adapter: &wgpu::Adapter) -> wgpu::Limits {
     let have = adapter.limits();
     let mut l = wgpu::Limits::downlevel_defaults().using_resolution(have.clone());
+    l.max_buffer_size = have.max_buffer_size;
+    l.max_storage_buffer_binding_size = have.max_storage_buffer_binding_size;
     l.max_storage_buffers_per_shader_stage = have
         .max_storage_buffers_per_shader_stage
         .min(8)
@@ -148,48 +147,97 @@ impl Gpu {
 
     /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image.
     pub fn read_rgba8(&self, texture: &wgpu::Texture) -> Result<image::RgbaImage> {
-        let (w, h) = (texture.width(), texture.height());
-        let row = 4 * w;
-        let padded =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let size = u64::from(padded) * u64::from(h);
-        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(h),
-                },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
+        read_rgba8(&self.device, &self.queue, texture)
+    }
+}
+
+/// Waits for `device` and copies a `MAP_READ` buffer's first `len` bytes back.
+fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>> {
+    let slice = buffer.slice(..len);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        // The receiver lives until recv() below returns.
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
+    rx.recv()
+        .context("the GPU dropped a buffer mapping")?
+        .map_err(|e| anyhow!("mapping a readback buffer: {e}"))?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| anyhow!("reading a mapped buffer: {e:?}"))?
+        .to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}
+
+/// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image, in
+/// bands of rows that each fit the device's largest buffer (a 16384-pixel
+/// square is 1 GiB, four times what lavapipe allows in one buffer). Work
+/// already submitted that renders into the texture is waited for.
+pub fn read_rgba8(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<image::RgbaImage> {
+    let (w, h) = (texture.width(), texture.height());
+    let row = 4 * w as usize;
+    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
+    let padded = row.div_ceil(align) * align;
+    let max = device.limits().max_buffer_size;
+    let band = (max / padded as u64).clamp(1, u64::from(h.max(1))) as u32;
+    if padded as u64 > max {
+        bail!(
+            "reading back an image {w} pixels wide needs rows of {padded} bytes; this device's \
+             buffers hold at most {max} bytes"
         );
-        self.queue.submit([enc.finish()]);
-        let bytes = self.read_buffer(&buffer, size)?;
-        let mut pixels = Vec::with_capacity((row * h) as usize);
-        for y in 0..h as usize {
-            let start = y * padded as usize;
-            pixels.extend_from_slice(&bytes[start..start + row as usize]);
+    }
+    errors::scoped(device, "reading the image back", || {
+        let mut pixels = Vec::with_capacity(row * h as usize);
+        let mut y = 0;
+        while y < h {
+            let rows = band.min(h - y);
+            let size = padded as u64 * u64::from(rows);
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("bv readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut enc = device.create_command_encoder(&Default::default());
+            enc.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(padded as u32),
+                        rows_per_image: Some(rows),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: w,
+                    height: rows,
+                    depth_or_array_layers: 1,
+                },
+            );
+            queue.submit([enc.finish()]);
+            let bytes = read_back(device, &buffer, size)?;
+            for r in bytes.chunks_exact(padded) {
+                pixels.extend_from_slice(&r[..row]);
+            }
+            buffer.destroy();
+            y += rows;
         }
         image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
-    }
+    })
 }
 
 /// An offscreen colour target that is re-created only when its size changes.
@@ -208,28 +256,32 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 impl Target {
     /// A target of the given size (at least 1×1, at most the device's limit).
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Result<Self> {
-        let max = gpu.device.limits().max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max || height > max {
-            anyhow::bail!("image size {width}×{height} is outside 1..={max} on this device");
-        }
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("bv target"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: TARGET_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            // A GUI that samples through an sRGB view (decoding to linear) may
-            // create one of the same texture.
-            view_formats: &[wgpu::TextureFormat::Rgba8UnormSrgb],
-        });
+        errors::check_texture(&gpu.device, "an image", width, height)?;
+        let texture = gpu.scoped("creating an image", || {
+            Ok(gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("bv target"),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: TARGET_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::COPY_SRC,
+                // A GUI that samples through an sRGB view (decoding to linear) may
+                // create one of the same texture, where the device can (OpenGL
+                // cannot reinterpret a texture's format).
+                view_formats: if gpu.info.backend != wgpu::Backend::Gl {
+                    &[wgpu::TextureFormat::Rgba8UnormSrgb]
+                } else {
+                    &[]
+                },
+            }))
+        })?;
         let view = texture.create_view(&Default::default());
         Ok(Self { texture, view })
     }

@@ -7,6 +7,7 @@
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
+use super::errors;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Context, Result, bail};
@@ -253,7 +254,8 @@ struct FrameUniform {
     base: u32,
     x0: u32,
     x1: u32,
-    pad: [u32; 2],
+    y0: u32,
+    y1: u32,
 }
 
 #[repr(C)]
@@ -274,7 +276,23 @@ struct ShowUniform {
     size: [f32; 2],
     exposure: f32,
     tone: u32,
+    y0: u32,
+    pad: [u32; 3],
 }
+
+/// Rows `[y0, y0 + rows)` of the accumulation: rgb sum and sample count, four
+/// f32 per pixel. A large image is split into bands so that each buffer fits
+/// the device's storage binding limit (128 MiB on OpenGL, a 2900 × 2900
+/// image).
+struct Band {
+    y0: u32,
+    rows: u32,
+    buffer: wgpu::Buffer,
+}
+
+/// Most GPU memory the accumulation of one image may take, however many
+/// bands it is split into (an 8192 × 8192 image).
+pub const MAX_ACCUMULATION_BYTES: u64 = 1 << 30;
 
 struct EnvBuffers {
     /// Texels (rgb), marginal CDF, conditional CDFs, one after the other.
@@ -310,7 +328,13 @@ pub struct EnvRenderer {
     specialised: std::collections::HashMap<u32, Option<wgpu::ComputePipeline>>,
     show: wgpu::RenderPipeline,
     env: EnvBuffers,
-    accum: Option<wgpu::Buffer>,
+    /// The accumulation, band by band (empty before the first pass).
+    accum: Vec<Band>,
+    /// The image size the bands cover.
+    accum_size: Option<(u32, u32)>,
+    /// Largest band in bytes, below the device's limit (tests force
+    /// several bands on small images).
+    max_band_bytes: Option<u64>,
     key: Option<Key>,
     frame: u32,
     samples: u64,
@@ -380,6 +404,13 @@ fn compute_pipeline(
 impl EnvRenderer {
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
+        let device = gpu.device.clone();
+        errors::scoped(&device, "building the environment renderer", || {
+            Self::build(gpu, library, map)
+        })
+    }
+
+    fn build(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
         // params, tiles, accumulation, environment map and MERL tables.
         let have = gpu.device.limits().max_storage_buffers_per_shader_stage;
         if have < 5 {
@@ -433,7 +464,9 @@ impl EnvRenderer {
             specialised: std::collections::HashMap::new(),
             show,
             env,
-            accum: None,
+            accum: Vec::new(),
+            accum_size: None,
+            max_band_bytes: None,
             key: None,
             frame: 0,
             samples: 0,
@@ -461,13 +494,23 @@ impl EnvRenderer {
         data.extend_from_slice(&marginal);
         let c = u32::try_from(data.len())?;
         data.extend_from_slice(&conditional);
-        let buffer = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("env data"),
-                contents: bytemuck::cast_slice(&data),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+        let what = format!("an environment map of {}×{}", map.width, map.height);
+        errors::check_buffer(
+            &gpu.device,
+            &what,
+            4 * data.len() as u64,
+            true,
+            "use a smaller map",
+        )?;
+        let buffer = gpu.scoped(&format!("uploading {what}"), || {
+            Ok(gpu
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("env data"),
+                    contents: bytemuck::cast_slice(&data),
+                    usage: wgpu::BufferUsages::STORAGE,
+                }))
+        })?;
         Ok(EnvBuffers {
             data: buffer,
             marginal: m,
@@ -503,11 +546,7 @@ impl EnvRenderer {
         width: u32,
         height: u32,
     ) -> Result<&wgpu::Texture> {
-        if self
-            .accum
-            .as_ref()
-            .is_none_or(|a| a.size() != 16 * u64::from(width) * u64::from(height))
-        {
+        if self.accum.is_empty() || self.accum_size != Some((width, height)) {
             bail!("nothing accumulated at {width}×{height}");
         }
         self.show(settings, width, height)
@@ -534,6 +573,20 @@ impl EnvRenderer {
     /// The device it renders on.
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
+    }
+
+    /// Caps each band of the accumulation at `bytes` (at most the device's
+    /// limit; `None`: the limit). The image is the same whatever the split:
+    /// tests use it to check the bands on small images.
+    pub fn set_max_band_bytes(&mut self, bytes: Option<u64>) {
+        self.max_band_bytes = bytes;
+        // The next pass restarts with the new split.
+        self.key = None;
+    }
+
+    /// How many bands the accumulation is split into (0 before a pass).
+    pub fn band_count(&self) -> usize {
+        self.accum.len()
     }
 
     /// Adds one pass of `spp` samples per pixel (restarting first if anything
@@ -576,25 +629,31 @@ impl EnvRenderer {
         spp: u32,
     ) -> Result<Vec<[f32; 3]>> {
         self.accumulate_to(models, settings, width, height, spp)?;
-        let accum = self.accum.as_ref().context("no accumulation buffer")?;
-        let size = accum.size();
-        let rb = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accum readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(accum, 0, &rb, 0, size);
-        self.gpu.queue.submit([enc.finish()]);
-        let bytes = self.gpu.read_buffer(&rb, size)?;
-        let v: &[f32] = bytemuck::cast_slice(&bytes);
-        Ok(v.chunks_exact(4)
-            .map(|c| {
+        if self.accum.is_empty() {
+            bail!("no accumulation buffer");
+        }
+        let mut out = Vec::with_capacity(width as usize * height as usize);
+        for band in &self.accum {
+            let size = band.buffer.size();
+            let bytes = self.gpu.scoped("reading the environment back", || {
+                let rb = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("accum readback"),
+                    size,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+                enc.copy_buffer_to_buffer(&band.buffer, 0, &rb, 0, size);
+                self.gpu.queue.submit([enc.finish()]);
+                self.gpu.read_buffer(&rb, size)
+            })?;
+            let v: &[f32] = bytemuck::cast_slice(&bytes);
+            out.extend(v.chunks_exact(4).map(|c| {
                 let n = c[3].max(1.0);
                 [c[0] / n, c[1] / n, c[2] / n]
-            })
-            .collect())
+            }));
+        }
+        Ok(out)
     }
 
     fn accumulate_to(
@@ -650,23 +709,55 @@ impl EnvRenderer {
         height: u32,
         spp: u32,
     ) -> Result<()> {
+        let device = self.gpu.device.clone();
+        let result = errors::scoped(&device, "rendering the environment", || {
+            self.accumulate_pass_unscoped(models, settings, width, height, spp)
+        });
+        if result.is_err() {
+            // Whatever was accumulated is not to be trusted: the next pass
+            // starts afresh.
+            self.key = None;
+            self.accum.clear();
+            self.accum_size = None;
+        }
+        result
+    }
+
+    fn accumulate_pass_unscoped(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+        spp: u32,
+    ) -> Result<()> {
         if models.is_empty() {
             bail!("the environment view needs at least one model");
         }
         let key = self.key(models, settings, width, height);
         let d = self.gpu.device.clone();
-        if self.key.as_ref() != Some(&key) || self.accum.is_none() {
-            // Restart: a fresh, zeroed accumulation buffer.
-            let size = 16 * u64::from(width) * u64::from(height);
-            if size == 0 {
-                bail!("image size {width}×{height} is empty");
+        if self.key.as_ref() != Some(&key) || self.accum.is_empty() {
+            // Restart: fresh, zeroed accumulation bands.
+            self.accum.clear();
+            self.accum_size = None;
+            self.key = None;
+            let rows = band_rows(&d, width, height, self.max_band_bytes)?;
+            let mut y0 = 0;
+            while y0 < height {
+                let n = rows.min(height - y0);
+                self.accum.push(Band {
+                    y0,
+                    rows: n,
+                    buffer: d.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("env accum"),
+                        size: accumulation_bytes(width, n),
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    }),
+                });
+                y0 += n;
             }
-            self.accum = Some(d.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("env accum"),
-                size,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }));
+            self.accum_size = Some((width, height));
             self.key = Some(key);
             self.frame = 0;
             self.samples = 0;
@@ -682,7 +773,9 @@ impl EnvRenderer {
                 self.specialised.insert(r.model, built);
             }
         }
-        let accum = self.accum.as_ref().context("accumulation buffer")?;
+        if self.accum.is_empty() {
+            bail!("no accumulation buffer");
+        }
         let tbuf = self.tables.get(&self.gpu, &tables)?;
         let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
         let frame = FrameUniform {
@@ -696,7 +789,8 @@ impl EnvRenderer {
             base: self.samples as u32,
             x0: 0,
             x1: width,
-            pad: [0; 2],
+            y0: 0,
+            y1: height,
         };
         let env = EnvUniform {
             width: self.env.size.0,
@@ -732,41 +826,50 @@ impl EnvRenderer {
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_bind_group(1, &g1, &[]);
-            // One dispatch per tile, over its columns, with its model's
-            // pipeline.
-            for (k, r) in refs.iter().enumerate() {
-                let x0 = super::lit_sphere::tile_start(k, refs.len(), width);
-                let x1 = super::lit_sphere::tile_start(k + 1, refs.len(), width);
-                if x1 <= x0 {
-                    continue;
+            // One dispatch per band and tile, over the tile's columns and
+            // the band's rows, with the tile's model's pipeline.
+            for band in &self.accum {
+                for (k, r) in refs.iter().enumerate() {
+                    let x0 = super::lit_sphere::tile_start(k, refs.len(), width);
+                    let x1 = super::lit_sphere::tile_start(k + 1, refs.len(), width);
+                    if x1 <= x0 {
+                        continue;
+                    }
+                    let (y0, y1) = (band.y0, band.y0 + band.rows);
+                    let fbuf = init(
+                        "frame",
+                        bytemuck::bytes_of(&FrameUniform {
+                            x0,
+                            x1,
+                            y0,
+                            y1,
+                            ..frame
+                        }),
+                        wgpu::BufferUsages::UNIFORM,
+                    );
+                    let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("env frame"),
+                        layout: &self.frame_layout,
+                        entries: &[
+                            entry(0, &pbuf),
+                            entry(1, &fbuf),
+                            entry(2, &mbuf),
+                            entry(3, &band.buffer),
+                            entry(8, tbuf),
+                        ],
+                    });
+                    let p = match self.specialised.get(&r.model) {
+                        Some(Some(p)) => p,
+                        _ => &self.accumulate,
+                    };
+                    pass.set_pipeline(p);
+                    pass.set_bind_group(0, &g0, &[]);
+                    pass.dispatch_workgroups(
+                        (x1 - x0).div_ceil(WORKGROUP),
+                        band.rows.div_ceil(WORKGROUP),
+                        1,
+                    );
                 }
-                let fbuf = init(
-                    "frame",
-                    bytemuck::bytes_of(&FrameUniform { x0, x1, ..frame }),
-                    wgpu::BufferUsages::UNIFORM,
-                );
-                let g0 = d.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("env frame"),
-                    layout: &self.frame_layout,
-                    entries: &[
-                        entry(0, &pbuf),
-                        entry(1, &fbuf),
-                        entry(2, &mbuf),
-                        entry(3, accum),
-                        entry(8, tbuf),
-                    ],
-                });
-                let p = match self.specialised.get(&r.model) {
-                    Some(Some(p)) => p,
-                    _ => &self.accumulate,
-                };
-                pass.set_pipeline(p);
-                pass.set_bind_group(0, &g0, &[]);
-                pass.dispatch_workgroups(
-                    (x1 - x0).div_ceil(WORKGROUP),
-                    height.div_ceil(WORKGROUP),
-                    1,
-                );
             }
         }
         self.gpu.queue.submit([enc.finish()]);
@@ -776,23 +879,51 @@ impl EnvRenderer {
     }
 
     fn show(&mut self, settings: &EnvSettings, width: u32, height: u32) -> Result<&wgpu::Texture> {
-        let accum = self.accum.as_ref().context("nothing rendered yet")?;
+        let device = self.gpu.device.clone();
+        errors::scoped(&device, "displaying the environment", || {
+            self.show_unscoped(settings, width, height).map(|_| ())
+        })?;
+        self.target
+            .as_ref()
+            .map(|t| &t.texture)
+            .context("no environment image")
+    }
+
+    fn show_unscoped(
+        &mut self,
+        settings: &EnvSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Texture> {
+        if self.accum.is_empty() || self.accum_size != Some((width, height)) {
+            bail!("nothing rendered yet at {width}×{height}");
+        }
         let d = &self.gpu.device;
-        let u = ShowUniform {
-            size: [width as f32, height as f32],
-            exposure: settings.exposure_ev.exp2() as f32,
-            tone: settings.tone_map.index(),
-        };
-        let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("show"),
-            contents: bytemuck::bytes_of(&u),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("env display"),
-            layout: &self.show.get_bind_group_layout(0),
-            entries: &[entry(0, &ubuf), entry(1, accum)],
-        });
+        let layout = self.show.get_bind_group_layout(0);
+        let binds: Vec<(&Band, wgpu::BindGroup)> = self
+            .accum
+            .iter()
+            .map(|band| {
+                let u = ShowUniform {
+                    size: [width as f32, height as f32],
+                    exposure: settings.exposure_ev.exp2() as f32,
+                    tone: settings.tone_map.index(),
+                    y0: band.y0,
+                    pad: [0; 3],
+                };
+                let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("show"),
+                    contents: bytemuck::bytes_of(&u),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("env display"),
+                    layout: &layout,
+                    entries: &[entry(0, &ubuf), entry(1, &band.buffer)],
+                });
+                (band, bind)
+            })
+            .collect();
         let target = Target::ensure(&mut self.target, &self.gpu, width, height)?;
         let mut enc = d.create_command_encoder(&Default::default());
         {
@@ -813,12 +944,57 @@ impl EnvRenderer {
                 multiview_mask: None,
             });
             pass.set_pipeline(&self.show);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..3, 0..1);
+            // Each band draws its rows only (the shader indexes its buffer
+            // from the band's first row).
+            for (band, bind) in &binds {
+                pass.set_scissor_rect(0, band.y0, width, band.rows);
+                pass.set_bind_group(0, bind, &[]);
+                pass.draw(0..3, 0..1);
+            }
         }
         self.gpu.queue.submit([enc.finish()]);
         Ok(&target.texture)
     }
+}
+
+/// Rows per band of a `width`×`height` accumulation: as many as one storage
+/// binding of the device holds (at most `cap` bytes), after checking the
+/// image against the device's texture size and [`MAX_ACCUMULATION_BYTES`].
+fn band_rows(device: &wgpu::Device, width: u32, height: u32, cap: Option<u64>) -> Result<u32> {
+    if width == 0 || height == 0 {
+        bail!("image size {width}×{height} is empty");
+    }
+    errors::check_texture(device, "an environment image", width, height)?;
+    let total = accumulation_bytes(width, height);
+    if total > MAX_ACCUMULATION_BYTES {
+        bail!(
+            "an environment image of {width}×{height} pixels needs {} MiB for its samples, \
+             bv allows at most {} MiB; use a smaller --width/--height",
+            total >> 20,
+            MAX_ACCUMULATION_BYTES >> 20
+        );
+    }
+    let l = device.limits();
+    let limit = l
+        .max_buffer_size
+        .min(l.max_storage_buffer_binding_size)
+        .min(cap.unwrap_or(u64::MAX));
+    let row = accumulation_bytes(width, 1);
+    if row > limit {
+        bail!(
+            "an environment image {width} pixels wide needs {row} bytes per row, this device \
+             binds at most {limit} bytes; use a smaller --width"
+        );
+    }
+    Ok(u32::try_from(limit / row)
+        .unwrap_or(u32::MAX)
+        .clamp(1, height))
+}
+
+/// Bytes of the accumulation buffer of a `width`×`height` image: four f32
+/// (rgb sum and sample count) per pixel.
+pub fn accumulation_bytes(width: u32, height: u32) -> u64 {
+    16 * u64::from(width) * u64::from(height)
 }
 
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {

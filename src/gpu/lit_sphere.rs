@@ -6,6 +6,7 @@
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
+use super::errors;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Result, bail};
@@ -181,6 +182,13 @@ pub fn tile_start(k: usize, tiles: usize, width: u32) -> u32 {
 impl LitSphereRenderer {
     /// Builds the generic pipeline on `gpu` (specialised ones follow on use).
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary) -> Result<Self> {
+        let device = gpu.device.clone();
+        errors::scoped(&device, "building the lit sphere renderer", || {
+            Self::build(gpu, library)
+        })
+    }
+
+    fn build(gpu: Gpu, library: &mut ShaderLibrary) -> Result<Self> {
         let module = library.shader_module(&gpu.device, "lit_sphere")?;
         let bind_layout = bind_group_layout(&gpu.device);
         let layout = gpu
@@ -231,6 +239,24 @@ impl LitSphereRenderer {
     /// texture (kept between calls of the same size) and returns it; the work
     /// is submitted, not waited for.
     pub fn render(
+        &mut self,
+        models: &[ModelSpec],
+        settings: &LitSphereSettings,
+        width: u32,
+        height: u32,
+    ) -> Result<&wgpu::Texture> {
+        let device = self.gpu.device.clone();
+        errors::scoped(&device, "rendering the lit sphere", || {
+            self.render_unscoped(models, settings, width, height)
+                .map(|_| ())
+        })?;
+        match &self.target {
+            Some(t) => Ok(&t.texture),
+            None => bail!("no lit sphere image"),
+        }
+    }
+
+    fn render_unscoped(
         &mut self,
         models: &[ModelSpec],
         settings: &LitSphereSettings,

@@ -9,6 +9,7 @@
 pub mod context;
 pub mod display;
 pub mod env;
+pub mod errors;
 pub mod eval;
 pub mod layout;
 pub mod lit_sphere;

@@ -118,6 +118,11 @@ pub struct EnvironmentView {
     loading: Option<Loading>,
     map_error: Option<String>,
     render_error: Option<String>,
+    /// An error the device reported outside any error scope since the view
+    /// last restarted (recorded by the device's handler instead of a panic).
+    gpu_error: Option<String>,
+    /// The device's uncaptured-error count already looked at.
+    gpu_errors_seen: Option<u64>,
     shown: Option<Shown>,
     pass_spp: u32,
     /// Measured device seconds per sample per pixel (running average).
@@ -154,6 +159,8 @@ impl EnvironmentView {
             loading: None,
             map_error: None,
             render_error: None,
+            gpu_error: None,
+            gpu_errors_seen: None,
             shown: None,
             pass_spp: 1,
             spp_cost: None,
@@ -196,10 +203,25 @@ impl EnvironmentView {
 
     /// The current error (map loading or rendering), if any.
     pub fn error(&self) -> Option<String> {
-        match (&self.map_error, &self.render_error) {
-            (Some(a), Some(b)) => Some(format!("{a}\n{b}")),
-            (Some(a), None) | (None, Some(a)) => Some(a.clone()),
-            (None, None) => None,
+        let all: Vec<&str> = [&self.map_error, &self.render_error, &self.gpu_error]
+            .into_iter()
+            .flatten()
+            .map(String::as_str)
+            .collect();
+        (!all.is_empty()).then(|| all.join("\n"))
+    }
+
+    /// Takes note of errors the device reported outside error scopes (by
+    /// any code drawing on it) since the last look.
+    fn check_device_errors(&mut self) {
+        let Some(r) = self.renderer.ready() else {
+            return;
+        };
+        let log = &r.gpu().errors;
+        let seen = *self.gpu_errors_seen.get_or_insert(log.count());
+        if let Some(e) = log.since(seen) {
+            self.gpu_error = Some(format!("GPU error: {e}"));
+            self.gpu_errors_seen = Some(log.count());
         }
     }
 
@@ -347,12 +369,9 @@ impl EnvironmentView {
         };
         match loaded {
             Ok(m) => self.install_map(map.clone(), &m),
-            Err(e) => {
-                self.map_error = Some(format!(
-                    "{e:#} (showing {})",
-                    self.map_in_use.as_deref().unwrap_or("the studio")
-                ))
-            }
+            // A figure with another map than asked for is wrong: the error
+            // alone (`bv render` fails with it).
+            Err(e) => self.map_error = Some(format!("{e:#}")),
         }
     }
 
@@ -414,6 +433,7 @@ impl EnvironmentView {
         } else {
             self.sync_map(ui.ctx(), &env.map);
         }
+        self.check_device_errors();
         let Some(renderer) = self.renderer.ready_mut() else {
             return (None, false);
         };
@@ -466,6 +486,7 @@ impl EnvironmentView {
         let done = renderer.samples_per_pixel();
         let texture = if restart || done < target {
             if restart {
+                self.gpu_error = None;
                 self.restarts += 1;
                 self.restarted_at = Some(Instant::now());
                 self.converged_after = None;

@@ -533,8 +533,10 @@ impl LobeRenderer {
         frame: &LobeFrame,
         pixels: PixelSize,
     ) {
-        let PixelSize { size, ppp } = pixels;
-        let size = [size[0].max(1), size[1].max(1)];
+        let PixelSize { size: asked, ppp } = pixels;
+        let size = fit_texture(asked, device.limits().max_texture_dimension_2d);
+        // Line widths follow a target made smaller than asked.
+        let ppp = ppp * size[0] as f32 / asked[0].max(1) as f32;
         let set = match self.sets.get(1) {
             Some(fast) if frame.interacting => fast,
             _ => &self.sets[0],
@@ -758,74 +760,47 @@ impl LobeRenderer {
     ) -> Result<image::RgbaImage, String> {
         // A view key of its own, so a window's targets are left alone.
         const HEADLESS: u64 = u64::MAX;
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("bv lobe headless"),
-        });
-        self.prepare(
-            device,
-            queue,
-            &mut encoder,
-            HEADLESS,
-            frame,
-            PixelSize {
-                size: [width, height],
-                ppp,
-            },
-        );
-        let target = self
-            .views
-            .get(&HEADLESS)
-            .and_then(|v| v.target.as_ref())
-            .ok_or("no target")?;
-        let (w, h) = (target.size[0], target.size[1]);
-        let unpadded = w as usize * 4;
-        let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
-        let padded = unpadded.div_ceil(align) * align;
-        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("bv lobe readback"),
-            size: (padded * h as usize) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        encoder.copy_texture_to_buffer(
-            target.resolve.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded as u32),
-                    rows_per_image: None,
+        crate::gpu::errors::scoped(device, "drawing the lobe", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("bv lobe headless"),
+            });
+            self.prepare(
+                device,
+                queue,
+                &mut encoder,
+                HEADLESS,
+                frame,
+                PixelSize {
+                    size: [width, height],
+                    ppp,
                 },
-            },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-        );
-        queue.submit(std::iter::once(encoder.finish()));
-        let slice = buffer.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| format!("GPU wait failed: {e}"))?;
-        rx.recv()
-            .map_err(|e| e.to_string())?
-            .map_err(|e| format!("GPU readback failed: {e}"))?;
-        let data = slice
-            .get_mapped_range()
-            .map_err(|e| format!("GPU readback failed: {e}"))?;
-        let mut pixels = Vec::with_capacity(unpadded * h as usize);
-        for row in data.chunks_exact(padded) {
-            pixels.extend_from_slice(&row[..unpadded]);
-        }
-        drop(data);
-        buffer.unmap();
-        image::RgbaImage::from_raw(w, h, pixels).ok_or_else(|| "bad image size".to_string())
+            );
+            queue.submit(std::iter::once(encoder.finish()));
+            let target = self
+                .views
+                .get(&HEADLESS)
+                .and_then(|v| v.target.as_ref())
+                .ok_or_else(|| anyhow::anyhow!("no target"))?;
+            crate::gpu::context::read_rgba8(device, queue, &target.resolve)
+        })
+        .map_err(|e| format!("{e:#}"))
     }
+}
+
+/// The largest size within `max` pixels per side with the aspect of `size`
+/// (the lobe's offscreen target is stretched over the callback rectangle,
+/// so a window or figure wider than the device's textures still draws).
+pub fn fit_texture(size: [u32; 2], max: u32) -> [u32; 2] {
+    let [w, h] = [size[0].max(1), size[1].max(1)];
+    let max = max.max(1);
+    if w <= max && h <= max {
+        return [w, h];
+    }
+    let s = f64::from(max) / f64::from(w.max(h));
+    [
+        ((f64::from(w) * s).floor() as u32).clamp(1, max),
+        ((f64::from(h) * s).floor() as u32).clamp(1, max),
+    ]
 }
 
 fn create_target(
@@ -1090,6 +1065,14 @@ impl CallbackTrait for LobeCallback {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn targets_fit_the_device_keeping_the_aspect() {
+        assert_eq!(fit_texture([800, 600], 8192), [800, 600]);
+        assert_eq!(fit_texture([0, 0], 8192), [1, 1]);
+        assert_eq!(fit_texture([20000, 10000], 8192), [8192, 4096]);
+        assert_eq!(fit_texture([100, 40000], 8192), [20, 8192]);
+    }
 
     #[test]
     fn wireframe_indices_stay_in_range() {

@@ -206,6 +206,9 @@ pub fn install_gpu(
     adapter: Option<&eframe::wgpu::Adapter>,
     target_format: eframe::wgpu::TextureFormat,
 ) {
+    // wgpu's default answer to an error outside an error scope is a panic;
+    // bv records it and shows it instead.
+    crate::gpu::errors::watch(device);
     lobe_gpu::install_into(resources, device, adapter, target_format);
 }
 
