@@ -380,7 +380,8 @@ impl View for ImageSliceView {
                 egui::Slider::new(&mut s.phi_d_deg, 0.0..=180.0)
                     .text("φd")
                     .suffix("°")
-                    .fixed_decimals(0),
+                    .fixed_decimals(0)
+                    .update_while_editing(false),
             )
             .on_hover_text("Difference azimuth φd of the slice (φh = 0)");
         if r.double_clicked() {
@@ -400,7 +401,8 @@ impl View for ImageSliceView {
                     .range(-20.0..=20.0)
                     .speed(0.05)
                     .fixed_decimals(1)
-                    .prefix("EV "),
+                    .prefix("EV ")
+                    .update_while_editing(false),
             )
             .on_hover_text("Exposure: f × 2^EV before the gamma");
         r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "Exposure EV"));
@@ -410,7 +412,8 @@ impl View for ImageSliceView {
                     .range(1.0..=4.0)
                     .speed(0.01)
                     .fixed_decimals(2)
-                    .prefix("γ "),
+                    .prefix("γ ")
+                    .update_while_editing(false),
             )
             .on_hover_text("Display gamma: level = (2^EV f)^(1/γ)");
         r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "Gamma"));
