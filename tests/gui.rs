@@ -791,8 +791,10 @@ fn a_bad_entry_stays_red_until_fixed_and_escape_reverts() {
     assert!(f.is_focused());
     // The range is said next to it.
     assert!(
-        h.query_by_label_contains("Not a number in 0.001 … 2")
-            .is_some()
+        h.query_by_label_contains(
+            "Not a number in 0.001 … 2: type one and press Enter, or Esc to keep 0.3"
+        )
+        .is_some()
     );
     // Escape: the value stays 0.3 and the field shows it again.
     h.key_press(egui::Key::Escape);

@@ -73,6 +73,9 @@ struct Pending<T> {
     dialog: FileDialog,
     /// A save over this existing file waits for the user's yes.
     confirm: Option<PathBuf>,
+    /// Frames the question has been drawn (a new window is laid out
+    /// unseen in its first frame, so a few frames are asked for).
+    confirm_frames: u32,
 }
 
 /// The answer to "X exists. Replace?".
@@ -176,6 +179,7 @@ impl<T> Files<T> {
             filter,
             dialog: d,
             confirm: None,
+            confirm_frames: 0,
         });
     }
 
@@ -192,6 +196,7 @@ impl<T> Files<T> {
             filter,
             dialog: d,
             confirm: None,
+            confirm_frames: 0,
         });
     }
 
@@ -206,6 +211,10 @@ impl<T> Files<T> {
     pub fn show(&mut self, ctx: &egui::Context) -> Option<(T, PathBuf)> {
         let p = self.pending.as_mut()?;
         if let Some(path) = p.confirm.clone() {
+            if p.confirm_frames < 3 {
+                p.confirm_frames += 1;
+                ctx.request_repaint();
+            }
             return match confirm_window(ctx, &path)? {
                 Answer::Replace => self.finish(path),
                 Answer::Back => {
@@ -225,6 +234,7 @@ impl<T> Files<T> {
                     let path = p.filter.with_extension(&path);
                     if path.exists() {
                         p.confirm = Some(path);
+                        p.confirm_frames = 0;
                         ctx.request_repaint();
                         return None;
                     }

@@ -211,8 +211,9 @@ pub fn number_field(
     }
     let r = if invalid {
         let tip = format!(
-            "Not a number in {}: Enter a value in range, Esc to undo",
-            range_text(&range)
+            "Not a number in {}: type one and press Enter, or Esc to keep {}",
+            range_text(&range),
+            format_number(value)
         );
         if r.has_focus() {
             r.show_tooltip_text(RichText::new(&tip).color(ui.visuals().error_fg_color));

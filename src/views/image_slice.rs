@@ -375,16 +375,19 @@ impl View for ImageSliceView {
     fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let s = &mut self.settings;
         ui.spacing_mut().slider_width = 90.0;
-        let r = ui
-            .add(
-                egui::Slider::new(&mut s.phi_d_deg, 0.0..=180.0)
-                    .text("φd")
-                    .suffix("°")
-                    .fixed_decimals(0)
-                    .update_while_editing(false),
-            )
+        let row = crate::app::params_ui::slider_row(
+            ui,
+            super::view_id("image_slice").with("phi_d"),
+            &mut s.phi_d_deg,
+            0.0..=180.0,
+            0.0..=180.0,
+            false,
+            "°",
+            "φd",
+        );
+        row.track
             .on_hover_text("Difference azimuth φd of the slice (φh = 0)");
-        if r.double_clicked() {
+        if row.reset {
             s.phi_d_deg = SliceSettings::default().phi_d_deg;
         }
         if super::toolbar_toggle(
