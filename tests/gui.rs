@@ -1129,3 +1129,35 @@ fn the_log_plot_reaches_down_to_what_the_data_reach() {
         assert_eq!(*label, bv::views::decade_label(*at as i32));
     }
 }
+
+#[test]
+fn tab_and_a_click_elsewhere_commit_a_typed_value() {
+    let mut h = viewer(AppState::first_run());
+    let albedo = |h: &Harness<'_, Viewer>| {
+        h.state().state().brdfs[0]
+            .spec
+            .params
+            .color("albedo")
+            .unwrap()
+    };
+    h.get_by_role_and_label(Role::TextInput, "albedo R").click();
+    h.run();
+    type_fast(&mut h, "0.9");
+    assert_eq!(albedo(&h).x, 0.5);
+    // Tab: committed, the focus on G.
+    h.key_press(egui::Key::Tab);
+    h.run();
+    assert_eq!(albedo(&h).x, 0.9);
+    assert!(
+        h.get_by_role_and_label(Role::TextInput, "albedo G")
+            .is_focused()
+    );
+    type_fast(&mut h, "0.2");
+    // A click on an empty part of the panel, below the parameters.
+    let p = egui::pos2(150.0, SIZE[1] - 30.0);
+    h.hover_at(p);
+    h.drag_at(p);
+    h.drop_at(p);
+    h.run();
+    assert_eq!(albedo(&h).y, 0.2);
+}

@@ -175,6 +175,22 @@ pub fn number_field(
         state.store(ui.ctx(), edit_id);
     }
     let draft_key = edit_id.with("draft");
+    if r.has_focus()
+        && ui.input(|i| {
+            i.events.iter().any(|e| {
+                matches!(
+                    e,
+                    egui::Event::Key { pressed: true, .. }
+                        | egui::Event::PointerButton { pressed: true, .. }
+                )
+            })
+        })
+    {
+        // Tab or a click elsewhere moves the focus at the end of this frame;
+        // the field sees that it lost it (and commits) only in the next one,
+        // which nothing else may ask for.
+        ui.ctx().request_repaint();
+    }
     let mut committed = None;
     if r.lost_focus() {
         let (enter, escape) = ui.input(|i| (i.key_pressed(Key::Enter), i.key_pressed(Key::Escape)));
@@ -351,7 +367,14 @@ fn value_ui(
                     );
                     let name = format!("{} colour", decl.label);
                     r.widget_info(|| WidgetInfo::labeled(Role::ColorWell, true, &name));
-                    if rgba != before {
+                    // The picker hands back its colour through an f32 HSV
+                    // round trip, a few ulps off the value it was given: only
+                    // a real pick replaces the (f64) channels, or a typed 0.2
+                    // would become 0.19999998807907104.
+                    let picked = (rgba.to_array().iter())
+                        .zip(before.to_array())
+                        .any(|(a, b)| (a - b).abs() > 1e-5);
+                    if picked {
                         c = [rgba.r() as f64, rgba.g() as f64, rgba.b() as f64];
                     }
                 }
