@@ -231,6 +231,16 @@ fn help_overlay_lists_the_shortcuts() {
     assert!(h.state().help_open());
     assert!(h.get_all_by_label("Keyboard shortcuts").count() >= 1);
     assert!(h.get_all_by_label("reset the camera").count() >= 1);
+    // Each row is drawn from the shortcut's own declaration.
+    for sc in bv::app::shortcuts::SHORTCUTS {
+        assert!(h.query_all_by_label(sc.help).count() >= 1, "{}", sc.help);
+        assert!(
+            h.query_all_by_label(&sc.keys_text(&h.ctx)).count() >= 1,
+            "{}",
+            sc.keys_text(&h.ctx)
+        );
+    }
+    assert!(h.query_by_label("1 … 9").is_some());
     h.key_press(egui::Key::F1);
     h.run();
     assert!(!h.state().help_open());
