@@ -231,6 +231,16 @@ fn help_overlay_lists_the_shortcuts() {
     assert!(h.state().help_open());
     assert!(h.get_all_by_label("Keyboard shortcuts").count() >= 1);
     assert!(h.get_all_by_label("reset the camera").count() >= 1);
+    // Each row is drawn from the shortcut's own declaration.
+    for sc in bv::app::shortcuts::SHORTCUTS {
+        assert!(h.query_all_by_label(sc.help).count() >= 1, "{}", sc.help);
+        assert!(
+            h.query_all_by_label(&sc.keys_text(&h.ctx)).count() >= 1,
+            "{}",
+            sc.keys_text(&h.ctx)
+        );
+    }
+    assert!(h.query_by_label("1 … 9").is_some());
     h.key_press(egui::Key::F1);
     h.run();
     assert!(!h.state().help_open());
@@ -673,4 +683,491 @@ fn lobe_view_shaders_validate() {
         .validate(&module)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
     }
+}
+
+// ---- Typing into fields, shortcuts, double-click reset, save dialog, log plot ----
+
+/// The key a character is typed with (as winit reports it), if it has one.
+fn key_of(c: char) -> Option<egui::Key> {
+    match c {
+        '.' => Some(egui::Key::Period),
+        '-' => Some(egui::Key::Minus),
+        ',' => Some(egui::Key::Comma),
+        _ => egui::Key::from_name(&c.to_string()),
+    }
+}
+
+/// The events of typing `text` on a keyboard: each character's key down,
+/// its text, its key up.
+fn typing(text: &str) -> Vec<egui::Event> {
+    let mut out = Vec::new();
+    for c in text.chars() {
+        let key = key_of(c);
+        let ev = |pressed| egui::Event::Key {
+            key: key.unwrap(),
+            physical_key: None,
+            pressed,
+            repeat: false,
+            modifiers: egui::Modifiers::NONE,
+        };
+        if key.is_some() {
+            out.push(ev(true));
+        }
+        out.push(egui::Event::Text(c.to_string()));
+        if key.is_some() {
+            out.push(ev(false));
+        }
+    }
+    out
+}
+
+/// Types `text` one event per frame (a slow typist).
+fn type_slowly(h: &mut Harness<'_, Viewer>, text: &str) {
+    for e in typing(text) {
+        h.event(e);
+        h.run();
+    }
+}
+
+/// Types `text` with all its events in one frame (a fast typist on a slow
+/// renderer).
+fn type_fast<S>(h: &mut Harness<'_, S>, text: &str) {
+    h.input_mut().events.extend(typing(text));
+    h.step();
+    h.run();
+}
+
+fn alpha_x(h: &Harness<'_, Viewer>) -> f64 {
+    h.state().state().brdfs[0]
+        .spec
+        .params
+        .float("alpha_x")
+        .unwrap()
+}
+
+fn cook_torrance() -> AppState {
+    let mut s = AppState::default();
+    s.add(bv_core::ModelSpec::new("cook-torrance").unwrap());
+    s
+}
+
+fn field_text(h: &Harness<'_, Viewer>, label: &str) -> String {
+    h.get_by_role_and_label(Role::TextInput, label)
+        .value()
+        .unwrap_or_default()
+}
+
+#[test]
+fn a_typed_value_is_not_clamped_until_enter() {
+    // α x accepts 0.001 … 2: the "0" typed first is below the minimum, and
+    // must not become 0.001 while the user is still typing "0.4".
+    for fast in [false, true] {
+        let mut h = viewer(cook_torrance());
+        assert_eq!(alpha_x(&h), 0.3);
+        h.get_by_role_and_label(Role::TextInput, "α x value")
+            .click();
+        h.run();
+        assert!(
+            h.get_by_role_and_label(Role::TextInput, "α x value")
+                .is_focused()
+        );
+        if fast {
+            type_fast(&mut h, "0.4");
+        } else {
+            type_slowly(&mut h, "0.4");
+        }
+        assert_eq!(field_text(&h, "α x value"), "0.4", "fast: {fast}");
+        assert_eq!(alpha_x(&h), 0.3, "nothing is applied before Enter");
+        h.key_press(egui::Key::Enter);
+        h.run();
+        assert_eq!(alpha_x(&h), 0.4, "fast: {fast}");
+        assert_eq!(field_text(&h, "α x value"), "0.4");
+    }
+}
+
+#[test]
+fn a_bad_entry_stays_red_until_fixed_and_escape_reverts() {
+    let mut h = viewer(cook_torrance());
+    h.get_by_role_and_label(Role::TextInput, "α x value")
+        .click();
+    h.run();
+    type_slowly(&mut h, "5");
+    h.key_press(egui::Key::Enter);
+    h.run();
+    // 5 is outside 0.001 … 2: refused, kept for fixing, still focused.
+    assert_eq!(alpha_x(&h), 0.3);
+    let f = h.get_by_role_and_label(Role::TextInput, "α x value");
+    assert_eq!(f.value().as_deref(), Some("5"));
+    assert!(f.is_focused());
+    // The range is said next to it.
+    assert!(
+        h.query_by_label_contains(
+            "Not a number in 0.001 … 2: type one and press Enter, or Esc to keep 0.3"
+        )
+        .is_some()
+    );
+    // Escape: the value stays 0.3 and the field shows it again.
+    h.key_press(egui::Key::Escape);
+    h.run();
+    assert_eq!(alpha_x(&h), 0.3);
+    assert_eq!(field_text(&h, "α x value"), "0.3");
+    assert_eq!(h.state().state().maximised, None, "Esc was the field's");
+}
+
+#[test]
+fn digits_typed_into_a_field_maximise_no_view() {
+    for fast in [false, true] {
+        let mut h = viewer(cook_torrance());
+        h.get_by_role_and_label(Role::TextInput, "α x value")
+            .click();
+        h.run();
+        if fast {
+            type_fast(&mut h, "123456789");
+        } else {
+            type_slowly(&mut h, "123456789");
+        }
+        assert_eq!(h.state().state().maximised, None, "fast: {fast}");
+        // Letters are the field's too (L would toggle the log scale).
+        type_slowly(&mut h, "lctw");
+        let s = h.state().state();
+        assert!(!s.display.log && !s.display.cosine && !s.display.wireframe);
+        assert_eq!(s.theme, AppState::default().theme);
+        assert_eq!(field_text(&h, "α x value"), "123456789lctw");
+        // Escape gives the keyboard back; then 2 maximises view 2.
+        h.key_press(egui::Key::Escape);
+        h.run();
+        assert_eq!(alpha_x(&h), 0.3);
+        h.key_press(egui::Key::Num2);
+        h.run();
+        assert_eq!(
+            h.state().state().maximised.as_deref(),
+            Some(bv::views::REGISTRY[1].id)
+        );
+    }
+}
+
+#[test]
+fn enter_then_digits_in_one_frame_stay_with_the_field() {
+    // A fast typist: "0.5", Enter and "3" arrive in one frame; the 3 must not
+    // maximise view 3.
+    let mut h = viewer(cook_torrance());
+    h.get_by_role_and_label(Role::TextInput, "α x value")
+        .click();
+    h.run();
+    let mut events = typing("0.5");
+    events.push(egui::Event::Key {
+        key: egui::Key::Enter,
+        physical_key: None,
+        pressed: true,
+        repeat: false,
+        modifiers: egui::Modifiers::NONE,
+    });
+    events.extend(typing("3"));
+    h.input_mut().events.extend(events);
+    h.step();
+    h.run();
+    assert_eq!(alpha_x(&h), 0.5);
+    assert_eq!(h.state().state().maximised, None);
+}
+
+/// Double-clicks at `pos` (the harness's steps must be short enough for
+/// egui to see a double click: see `viewer_quick`).
+fn double_click(h: &mut Harness<'_, Viewer>, pos: egui::Pos2) {
+    // Half a second after any earlier click, so that this one is not
+    // counted as the second of a pair.
+    h.run_steps(25);
+    h.hover_at(pos);
+    h.run();
+    for pressed in [true, false, true, false] {
+        h.event(egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::NONE,
+        });
+    }
+    h.run();
+}
+
+/// A viewer harness whose frames are 20 ms apart (a double click is two
+/// clicks within 0.3 s; the default step is 0.25 s).
+fn viewer_quick(state: AppState) -> Harness<'static, Viewer> {
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .with_max_steps(60)
+        .with_step_dt(0.02)
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state));
+    h.run();
+    h
+}
+
+#[test]
+fn double_clicking_a_slider_resets_it() {
+    let mut h = viewer_quick(cook_torrance());
+    let id = first_id(&h);
+    h.state_mut().push(Command::SetParam {
+        brdf: id,
+        param: "alpha_x".into(),
+        value: bv_core::ParamValue::Float(0.05),
+    });
+    h.state_mut()
+        .push(Command::SetIncident(bv::app::state::Incident {
+            theta_deg: 12.0,
+            phi_deg: 34.0,
+        }));
+    h.run();
+    assert_eq!(alpha_x(&h), 0.05);
+    // Off-centre, so that the click's own move of the slider is not the default.
+    let r = h.get_by_role_and_label(Role::Slider, "α x").rect();
+    double_click(&mut h, r.left_center() + egui::vec2(r.width() * 0.2, 0.0));
+    assert_eq!(alpha_x(&h), 0.3, "α x back to its default");
+    // A single click moves it, and does not reset.
+    let p = r.left_center() + egui::vec2(r.width() * 0.8, 0.0);
+    h.hover_at(p);
+    h.run();
+    h.drag_at(p);
+    h.run();
+    h.drop_at(p);
+    h.run();
+    assert!(alpha_x(&h) > 0.3, "{}", alpha_x(&h));
+
+    // The light's sliders too.
+    let r = h.get_by_role_and_label(Role::Slider, "θi").rect();
+    double_click(&mut h, r.left_center() + egui::vec2(r.width() * 0.9, 0.0));
+    let inc = h.state().state().incident;
+    assert_eq!(inc.theta_deg, bv::app::state::Incident::default().theta_deg);
+    let r = h.get_by_role_and_label(Role::Slider, "φi").rect();
+    double_click(&mut h, r.left_center() + egui::vec2(r.width() * 0.1, 0.0));
+    let inc = h.state().state().incident;
+    assert_eq!(inc, bv::app::state::Incident::default());
+}
+
+/// A save dialog alone, in a folder of its own.
+struct SaveDialog {
+    files: bv::app::files::Files<()>,
+    chosen: Option<std::path::PathBuf>,
+}
+
+impl SaveDialog {
+    fn ui(&mut self, ui: &mut egui::Ui) {
+        if let Some(((), p)) = self.files.show(ui.ctx()) {
+            self.chosen = Some(p);
+        }
+    }
+}
+
+fn name_field<'a>(h: &'a Harness<'_, SaveDialog>, name: &str) -> egui_kittest::Node<'a> {
+    h.query_all(by().role(Role::TextInput))
+        .find(|n| n.value().as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no text field holding `{name}`"))
+}
+
+#[test]
+fn the_save_dialog_types_digits_and_asks_before_replacing() {
+    let dir = std::env::temp_dir().join(format!("bv-gui-save-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for name in ["1.toml", "12.toml", "2.toml", "scene.toml"] {
+        std::fs::write(dir.join(name), format!("# {name}\n")).unwrap();
+    }
+    let mut files = bv::app::files::Files::default();
+    files.set_start_dir(&dir);
+    // egui_file's text fields have no accessible names; its title starts
+    // with an emoji that egui's fonts lack.
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .with_accessibility_check(false)
+        .build_ui_state(
+            |ui, s: &mut SaveDialog| s.ui(ui),
+            SaveDialog {
+                files,
+                chosen: None,
+            },
+        );
+    h.ctx
+        .set_missing_glyph_policy(egui::MissingGlyphPolicy::Tofu);
+    h.state_mut()
+        .files
+        .save((), "Save the scene", bv::app::files::SCENE, "talk");
+    h.run();
+    name_field(&h, "talk").click();
+    h.run();
+    // Typed digits only type: the name reads "talk12", no listed file is
+    // picked up as the name.
+    type_fast(&mut h, "12");
+    name_field(&h, "talk12");
+    assert!(h.state().chosen.is_none());
+    // Saving under a new name needs no question.
+    h.key_press(egui::Key::Enter);
+    h.run();
+    assert_eq!(
+        h.state().chosen.as_deref(),
+        Some(dir.join("talk12.toml").as_path())
+    );
+
+    // Over an existing file: asked first; Cancel goes back with the name kept.
+    h.state_mut().chosen = None;
+    h.state_mut()
+        .files
+        .save((), "Save the scene", bv::app::files::SCENE, "");
+    h.run();
+    name_field(&h, "").click();
+    h.run();
+    type_fast(&mut h, "12");
+    h.key_press(egui::Key::Enter);
+    h.run();
+    assert!(h.state().chosen.is_none(), "not without asking");
+    assert!(h.query_by_label("12.toml exists. Replace?").is_some());
+    h.get_by_label("Cancel").click();
+    h.run();
+    assert!(h.state().chosen.is_none());
+    assert!(h.query_by_label("12.toml exists. Replace?").is_none());
+    name_field(&h, "12");
+    // Asked again, and Replace.
+    name_field(&h, "12").click();
+    h.run();
+    h.key_press(egui::Key::Enter);
+    h.run();
+    h.get_by_label("Replace").click();
+    h.run();
+    assert_eq!(
+        h.state().chosen.as_deref(),
+        Some(dir.join("12.toml").as_path())
+    );
+    // The dialog writes nothing itself.
+    assert_eq!(
+        std::fs::read_to_string(dir.join("12.toml")).unwrap(),
+        "# 12.toml\n"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn digits_typed_in_the_viewers_save_dialog_maximise_no_view() {
+    // egui_file's text fields have no accessible names; its title starts
+    // with an emoji that egui's fonts lack.
+    let mut h = Harness::builder()
+        .with_size(SIZE)
+        .with_max_steps(12)
+        .with_accessibility_check(false)
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(cook_torrance()));
+    h.ctx
+        .set_missing_glyph_policy(egui::MissingGlyphPolicy::Tofu);
+    h.run();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.run();
+    let field = h
+        .query_all(by().role(Role::TextInput))
+        .find(|n| n.value().as_deref() == Some("scene.toml"))
+        .expect("the save dialog's name field");
+    field.click();
+    h.run();
+    type_fast(&mut h, "123");
+    type_slowly(&mut h, "45");
+    assert_eq!(h.state().state().maximised, None);
+    // Before the field is clicked, keys do not reach the views either.
+    h.key_press(egui::Key::Escape);
+    h.run();
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.run();
+    type_slowly(&mut h, "3l");
+    assert_eq!(h.state().state().maximised, None);
+    assert!(!h.state().state().display.log);
+}
+
+#[test]
+fn the_log_plot_reaches_down_to_what_the_data_reach() {
+    // A specular lobe alone: far from the mirror direction Beckmann's D
+    // falls to ~1e-27 (`bv slice` reads the same numbers).
+    let mut state = AppState::default();
+    state.add(
+        bv_core::ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"kd": 0.0, "alpha_x": 0.1, "alpha_y": 0.1}),
+        )
+        .unwrap(),
+    );
+    state.incident.theta_deg = 30.0;
+    state.display.log = true;
+    let h = viewer(state);
+    let v = h.state().view::<CartesianView>().unwrap();
+    let (bottom, top) = v.y_bounds.expect("the plot was drawn");
+    let b = h
+        .state()
+        .runtime()
+        .get(first_id(&h))
+        .unwrap()
+        .brdf
+        .clone()
+        .unwrap();
+    let samples =
+        bv::views::curves::plane_of_incidence(b.as_ref(), 30f64.to_radians(), 0.0, 720, false);
+    let max = samples.iter().map(|s| s.value).fold(0.0, f64::max);
+    let min = samples
+        .iter()
+        .map(|s| s.value)
+        .filter(|v| *v > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    assert!(min < 1e-20, "the tail is tiny: {min}");
+    // Twelve decades below the peak, a whole decade, not the old fixed
+    // floor at 1e-5 of the peak.
+    assert_eq!(
+        bottom,
+        (max.log10() - 12.0).floor(),
+        "{bottom} for max {max}"
+    );
+    assert!(bottom < (max * 1e-5).log10() - 6.0);
+    assert!(top > max.log10());
+    // The chart (the same numbers as the plot, for SVG) draws every sample
+    // at its true ordinate: no floor.
+    let scene = build_scene(h.state().state(), h.state().runtime(), false);
+    let chart = bv::views::cartesian::chart(&scene, true);
+    assert_eq!(chart.y_range.0, bottom);
+    let ys: Vec<f64> = chart.series[0].points.iter().map(|p| p[1]).collect();
+    for (y, s) in ys.iter().zip(&samples) {
+        if s.value > 0.0 {
+            assert!((y - s.value.log10()).abs() < 1e-9, "{y} vs {}", s.value);
+        }
+    }
+    assert!(
+        ys.iter().any(|y| *y < bottom),
+        "the tail leaves through the bottom"
+    );
+    // Decades are labelled as decades.
+    for (at, label) in &chart.y_ticks {
+        assert_eq!(at.fract(), 0.0);
+        assert_eq!(*label, bv::views::decade_label(*at as i32));
+    }
+}
+
+#[test]
+fn tab_and_a_click_elsewhere_commit_a_typed_value() {
+    let mut h = viewer(AppState::first_run());
+    let albedo = |h: &Harness<'_, Viewer>| {
+        h.state().state().brdfs[0]
+            .spec
+            .params
+            .color("albedo")
+            .unwrap()
+    };
+    h.get_by_role_and_label(Role::TextInput, "albedo R").click();
+    h.run();
+    type_fast(&mut h, "0.9");
+    assert_eq!(albedo(&h).x, 0.5);
+    // Tab: committed, the focus on G.
+    h.key_press(egui::Key::Tab);
+    h.run();
+    assert_eq!(albedo(&h).x, 0.9);
+    assert!(
+        h.get_by_role_and_label(Role::TextInput, "albedo G")
+            .is_focused()
+    );
+    type_fast(&mut h, "0.2");
+    // A click on an empty part of the panel, below the parameters.
+    let p = egui::pos2(150.0, SIZE[1] - 30.0);
+    h.hover_at(p);
+    h.drag_at(p);
+    h.drop_at(p);
+    h.run();
+    assert_eq!(albedo(&h).y, 0.2);
 }

@@ -7,7 +7,8 @@
 //! [`Files::save`] with a tag saying what the file is for, and call
 //! [`Files::show`] every frame; it returns `(tag, path)` once the user has
 //! chosen. A saved file gets the filter's first extension when the name typed
-//! has none of them.
+//! has none of them, and saving over an existing file asks first ("X exists.
+//! Replace?"); answering no goes back to the dialog with the name kept.
 
 use eframe::egui;
 use egui_file::FileDialog;
@@ -70,6 +71,59 @@ struct Pending<T> {
     tag: T,
     filter: Filter,
     dialog: FileDialog,
+    /// A save over this existing file waits for the user's yes.
+    confirm: Option<PathBuf>,
+    /// Frames the question has been drawn (a new window is laid out
+    /// unseen in its first frame, so a few frames are asked for).
+    confirm_frames: u32,
+}
+
+/// The answer to "X exists. Replace?".
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Answer {
+    Replace,
+    Back,
+}
+
+/// The title of the confirmation window (for tests and screen readers).
+pub const REPLACE_TITLE: &str = "Replace the file?";
+
+/// The question asked before saving over `path`.
+pub fn replace_question(path: &Path) -> String {
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    format!("{name} exists. Replace?")
+}
+
+/// Asks whether to replace `path`; `None` while unanswered. Escape means no.
+fn confirm_window(ctx: &egui::Context, path: &Path) -> Option<Answer> {
+    let mut answer = None;
+    egui::Window::new(REPLACE_TITLE)
+        .collapsible(false)
+        .resizable(false)
+        .anchor(egui::Align2::CENTER_CENTER, egui::Vec2::ZERO)
+        .order(egui::Order::Foreground)
+        .show(ctx, |ui| {
+            ui.label(egui::RichText::new(replace_question(path)).strong());
+            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                ui.weak(format!("in {}", dir.display()));
+            }
+            ui.add_space(6.0);
+            ui.horizontal(|ui| {
+                if ui.button("Replace").clicked() {
+                    answer = Some(Answer::Replace);
+                }
+                if ui.button("Cancel").clicked() {
+                    answer = Some(Answer::Back);
+                }
+            });
+        });
+    if ctx.input(|i| i.key_pressed(egui::Key::Escape)) {
+        answer = Some(Answer::Back);
+    }
+    answer
 }
 
 /// At most one open or save dialog at a time.
@@ -97,6 +151,12 @@ impl<T> Files<T> {
         self.pending.is_some()
     }
 
+    /// Makes the next dialog start in `dir` (as if the last file had been
+    /// chosen there).
+    pub fn set_start_dir(&mut self, dir: impl Into<PathBuf>) {
+        self.last_dir = Some(dir.into());
+    }
+
     /// The folder dialogs start in.
     pub fn start_dir(&self) -> PathBuf {
         self.last_dir
@@ -118,6 +178,8 @@ impl<T> Files<T> {
             tag,
             filter,
             dialog: d,
+            confirm: None,
+            confirm_frames: 0,
         });
     }
 
@@ -133,32 +195,67 @@ impl<T> Files<T> {
             tag,
             filter,
             dialog: d,
+            confirm: None,
+            confirm_frames: 0,
         });
     }
 
+    /// The existing file a save waits to replace, while the question shows.
+    pub fn confirming(&self) -> Option<&Path> {
+        self.pending.as_ref()?.confirm.as_deref()
+    }
+
     /// Draws the dialog; returns the tag and the chosen path once chosen
-    /// (saved names get the filter's extension). Cancelling drops the dialog.
+    /// (saved names get the filter's extension; an existing file only once
+    /// the user said to replace it). Cancelling drops the dialog.
     pub fn show(&mut self, ctx: &egui::Context) -> Option<(T, PathBuf)> {
         let p = self.pending.as_mut()?;
+        if let Some(path) = p.confirm.clone() {
+            if p.confirm_frames < 3 {
+                p.confirm_frames += 1;
+                ctx.request_repaint();
+            }
+            return match confirm_window(ctx, &path)? {
+                Answer::Replace => self.finish(path),
+                Answer::Back => {
+                    // Back to the dialog, the typed name kept.
+                    p.confirm = None;
+                    p.dialog.open();
+                    None
+                }
+            };
+        }
         p.dialog.show(ctx);
         match p.dialog.state() {
             egui_file::State::Open => None,
             egui_file::State::Selected => {
-                let p = self.pending.take()?;
                 let path = p.dialog.path()?.to_path_buf();
-                let path = if p.dialog.dialog_type() == egui_file::DialogType::SaveFile {
-                    p.filter.with_extension(&path)
-                } else {
-                    path
-                };
-                self.last_dir = path.parent().map(Path::to_path_buf);
-                Some((p.tag, path))
+                if p.dialog.dialog_type() == egui_file::DialogType::SaveFile {
+                    let path = p.filter.with_extension(&path);
+                    if path.exists() {
+                        p.confirm = Some(path);
+                        p.confirm_frames = 0;
+                        ctx.request_repaint();
+                        return None;
+                    }
+                    return self.finish(path);
+                }
+                self.finish(path)
             }
             _ => {
                 self.pending = None;
                 None
             }
         }
+    }
+}
+
+impl<T> Files<T> {
+    /// Ends the dialog with `path` chosen.
+    fn finish(&mut self, path: PathBuf) -> Option<(T, PathBuf)> {
+        let p = self.pending.take()?;
+        self.last_dir = path.parent().map(Path::to_path_buf);
+        Some((p.tag, path))
     }
 }
 
@@ -179,5 +276,13 @@ mod tests {
         assert_eq!(MESH.with_extension(Path::new("m.ply")), Path::new("m.ply"));
         assert_eq!(MESH.with_extension(Path::new("m")), Path::new("m.obj"));
         assert!(!PNG.accepts(Path::new("x.svg")));
+    }
+
+    #[test]
+    fn the_question_names_the_file() {
+        assert_eq!(
+            replace_question(Path::new("/tmp/talk/scene.toml")),
+            "scene.toml exists. Replace?"
+        );
     }
 }

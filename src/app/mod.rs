@@ -3,7 +3,8 @@
 //! - [`state`]: what is saved between runs; [`command`]: the changes UI code
 //!   asks for, applied after each frame; [`runtime`]: evaluators built from the
 //!   state; [`panel`] and [`params_ui`]: the left panel; [`viewer`]: the whole
-//!   UI; the views live in [`crate::views`].
+//!   UI; [`shortcuts`]: the keyboard shortcuts and their help; the views live
+//!   in [`crate::views`].
 //! - [`run`] opens the window. `--bench-frames N` drives a scripted slider
 //!   sweep and prints frame-time percentiles; `--screenshot PATH` saves the
 //!   window once it has drawn and exits.
@@ -18,6 +19,7 @@ pub mod params_ui;
 pub mod runtime;
 pub mod scene;
 pub mod screenshot;
+pub mod shortcuts;
 pub mod state;
 pub mod viewer;
 

@@ -136,28 +136,41 @@ pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         ui.vertical(|ui| {
             ui.spacing_mut().slider_width = 110.0;
-            // Display one decimal without rounding the value itself.
-            let one_decimal = |v: f64, _: std::ops::RangeInclusive<usize>| format!("{v:.1}");
-            let r = ui.add(
-                egui::Slider::new(&mut t, 0.0..=Incident::MAX_THETA_DEG)
-                    .text("θi")
-                    .suffix("°")
-                    .custom_formatter(one_decimal),
-            );
-            if r.double_clicked() {
-                t = Incident::default().theta_deg;
-            }
-            r.on_hover_text("Polar angle of the light from the normal");
-            let r = ui.add(
-                egui::Slider::new(&mut p, -180.0..=180.0)
-                    .text("φi")
-                    .suffix("°")
-                    .custom_formatter(one_decimal),
-            );
-            if r.double_clicked() {
-                p = Incident::default().phi_deg;
-            }
-            r.on_hover_text("Azimuth of the light from the tangent t towards b");
+            let max_t = Incident::MAX_THETA_DEG;
+            ui.horizontal(|ui| {
+                let row = params_ui::slider_row(
+                    ui,
+                    egui::Id::unique("bv light theta"),
+                    &mut t,
+                    0.0..=max_t,
+                    0.0..=max_t,
+                    false,
+                    "°",
+                    "θi",
+                );
+                if row.reset {
+                    t = Incident::default().theta_deg;
+                }
+                row.track
+                    .on_hover_text("Polar angle of the light from the normal");
+            });
+            ui.horizontal(|ui| {
+                let row = params_ui::slider_row(
+                    ui,
+                    egui::Id::unique("bv light phi"),
+                    &mut p,
+                    -180.0..=180.0,
+                    -180.0..=180.0,
+                    false,
+                    "°",
+                    "φi",
+                );
+                if row.reset {
+                    p = Incident::default().phi_deg;
+                }
+                row.track
+                    .on_hover_text("Azimuth of the light from the tangent t towards b");
+            });
             ui.weak("or drag the light on the disc");
         });
         hemisphere_widget(ui, inc, state.camera.yaw_deg, out);

@@ -5,12 +5,21 @@
 //! (Lafortune lobes) and mix components nested groups. Double-clicking a slider
 //! or pressing its "reset" button resets the value to its declared default.
 //!
+//! Numbers are typed into [`number_field`]s: the text is the user's while the
+//! field has the keyboard (nothing is parsed, clamped or applied mid-typing),
+//! and it is committed on Enter or when the field loses focus, if it is a
+//! number in the accepted range. An entry that is not shows in red with the
+//! range beside it; Escape puts the value back.
+//!
 //! Widgets edit a copy of a parameter's value; the caller turns a changed copy
 //! into a command, which the core validates before it is applied.
 
 use bv_core::params::{Component, FloatSpec};
 use bv_core::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
-use eframe::egui::{self, Id, Response, RichText, Role, Slider, SliderClamping, Ui, WidgetInfo};
+use eframe::egui::{
+    self, Id, Key, Response, RichText, Role, Sense, Slider, SliderClamping, Ui, WidgetInfo,
+};
+use std::ops::RangeInclusive;
 
 /// What the user did to one top-level parameter.
 #[derive(Debug, Clone, PartialEq)]
@@ -69,25 +78,229 @@ fn with_doc(r: Response, decl: &ParamDecl) -> Response {
     r.on_hover_text(format!("{}\n`{}`: {}{}", decl.doc, decl.id, range, unit))
 }
 
-/// A float slider over the declared slider span (typing a value outside it is
-/// allowed as long as it is in the accepted range).
-fn float_slider(ui: &mut Ui, s: &FloatSpec, x: &mut f64, label: &str) -> Response {
-    let lo = s.slider_min.max(s.min);
-    let hi = s.slider_max.min(s.max).max(lo);
-    let mut slider = Slider::new(x, lo..=hi)
-        .logarithmic(s.log)
+/// Width of a number field.
+const FIELD_WIDTH: f32 = 58.0;
+
+/// Formats a value for a number field: up to five significant digits, no
+/// trailing zeros (`0.3`, `0.001`, `45`, `1.5e-5`).
+pub fn format_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return if v.is_finite() {
+            "0".into()
+        } else {
+            v.to_string()
+        };
+    }
+    let a = v.abs();
+    if !(1e-4..1e6).contains(&a) {
+        let s = format!("{v:.4e}");
+        let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let m = m.trim_end_matches('0').trim_end_matches('.');
+        return format!("{m}e{e}");
+    }
+    let digits = (4 - a.log10().floor() as i32).clamp(0, 9) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Reads a typed number: a decimal point or comma, an exponent, spaces
+/// around; `None` for anything else (and for infinities and NaN).
+pub fn parse_number(text: &str) -> Option<f64> {
+    let t = text.trim().replace(',', ".");
+    let v: f64 = t.parse().ok()?;
+    v.is_finite().then_some(v)
+}
+
+/// The text of a field being edited.
+#[derive(Debug, Clone, PartialEq)]
+struct Draft {
+    /// What is typed.
+    text: String,
+    /// What the field showed when editing began (an unchanged text commits
+    /// nothing, so that focusing a field never rounds its value).
+    initial: String,
+}
+
+/// "0.001 … 1", the range a field accepts.
+fn range_text(range: &RangeInclusive<f64>) -> String {
+    format!(
+        "{} … {}",
+        format_number(*range.start()),
+        format_number(*range.end())
+    )
+}
+
+/// A number typed as text (see the module docs). `name` is what a screen
+/// reader (and a test) calls it. Returns the field and the committed value,
+/// once, on Enter or focus loss, when the text is a number in `range`.
+pub fn number_field(
+    ui: &mut Ui,
+    id: Id,
+    value: f64,
+    range: RangeInclusive<f64>,
+    name: &str,
+) -> (Response, Option<f64>) {
+    let edit_id = id.with("number field");
+    let draft: Option<Draft> = ui.data(|d| d.get_temp(edit_id.with("draft")));
+    let shown = format_number(value);
+    let mut text = draft
+        .as_ref()
+        .map_or_else(|| shown.clone(), |d| d.text.clone());
+    let accepted = parse_number(&text).filter(|v| range.contains(v));
+    let invalid = draft.is_some() && accepted.is_none();
+    let mut edit = egui::TextEdit::singleline(&mut text)
+        .id(edit_id)
+        .desired_width(FIELD_WIDTH)
+        .clip_text(false);
+    if invalid {
+        edit = edit.text_color(ui.visuals().error_fg_color);
+    }
+    let r = ui.add(edit);
+    let info_text = text.clone();
+    r.widget_info(|| {
+        let mut info = WidgetInfo::text_edit(ui.is_enabled(), &info_text, &info_text, "");
+        info.label = Some(name.to_string());
+        info
+    });
+    if r.gained_focus() {
+        // Select all, so that typing replaces the value.
+        let mut state = egui::TextEdit::load_state(ui.ctx(), edit_id).unwrap_or_default();
+        state
+            .cursor
+            .set_char_range(Some(egui::text::CCursorRange::select_all_str(&text)));
+        state.store(ui.ctx(), edit_id);
+    }
+    let draft_key = edit_id.with("draft");
+    if r.has_focus()
+        && ui.input(|i| {
+            i.events.iter().any(|e| {
+                matches!(
+                    e,
+                    egui::Event::Key { pressed: true, .. }
+                        | egui::Event::PointerButton { pressed: true, .. }
+                )
+            })
+        })
+    {
+        // Tab or a click elsewhere moves the focus at the end of this frame;
+        // the field sees that it lost it (and commits) only in the next one,
+        // which nothing else may ask for.
+        ui.ctx().request_repaint();
+    }
+    let mut committed = None;
+    if r.lost_focus() {
+        let (enter, escape) = ui.input(|i| (i.key_pressed(Key::Enter), i.key_pressed(Key::Escape)));
+        let initial = draft
+            .as_ref()
+            .map_or(shown.as_str(), |d| d.initial.as_str());
+        let typed = text.trim() != initial.trim();
+        if escape || !typed {
+            ui.data_mut(|d| d.remove::<Draft>(draft_key));
+        } else if let Some(v) = parse_number(&text).filter(|v| range.contains(v)) {
+            ui.data_mut(|d| d.remove::<Draft>(draft_key));
+            committed = Some(v);
+        } else if enter {
+            // Not a number in range: keep it, in red, to be fixed.
+            ui.data_mut(|d| {
+                d.insert_temp(
+                    draft_key,
+                    Draft {
+                        text: text.clone(),
+                        initial: initial.to_string(),
+                    },
+                )
+            });
+            r.request_focus();
+        } else {
+            // Clicked away from a bad entry: the value stays as it was.
+            ui.data_mut(|d| d.remove::<Draft>(draft_key));
+        }
+    } else if r.has_focus() {
+        let initial = draft.map_or(shown, |d| d.initial);
+        ui.data_mut(|d| d.insert_temp(draft_key, Draft { text, initial }));
+    } else if draft.is_some() {
+        ui.data_mut(|d| d.remove::<Draft>(draft_key));
+    }
+    let r = if invalid {
+        let tip = format!(
+            "Not a number in {}: type one and press Enter, or Esc to keep {}",
+            range_text(&range),
+            format_number(value)
+        );
+        if r.has_focus() {
+            r.show_tooltip_text(RichText::new(&tip).color(ui.visuals().error_fg_color));
+            r
+        } else {
+            r.on_hover_text(tip)
+        }
+    } else {
+        r.on_hover_text(format!(
+            "Type a value in {}, then Enter",
+            range_text(&range)
+        ))
+    };
+    (r, committed)
+}
+
+/// What a slider row reports.
+pub struct SliderRow {
+    /// The slider track (for hover texts).
+    pub track: Response,
+    /// The track was double-clicked: reset the value.
+    pub reset: bool,
+}
+
+/// A slider track over `span` (dragged), a [`number_field`] accepting `range`
+/// (typed), the unit and the label. `x` changes while dragging and when a
+/// typed value is committed. Double-clicking the track asks for a reset.
+#[expect(clippy::too_many_arguments)]
+pub fn slider_row(
+    ui: &mut Ui,
+    id: Id,
+    x: &mut f64,
+    span: RangeInclusive<f64>,
+    range: RangeInclusive<f64>,
+    log: bool,
+    unit: &str,
+    label: &str,
+) -> SliderRow {
+    let (lo, hi) = (*span.start(), *span.end());
+    let mut slider = Slider::new(x, span)
+        .logarithmic(log)
         .clamping(SliderClamping::Never)
-        .text(label);
-    if s.log && lo <= 0.0 {
+        .show_value(false);
+    if log && lo <= 0.0 {
         // A log slider needs a smallest positive value to start from.
         slider = slider.smallest_positive(hi.min(1.0) * 1e-3);
     }
-    if !s.unit.is_empty() {
-        slider = slider.suffix(format!(" {}", s.unit));
+    // The track senses clicks too: a slider only senses drags, and a
+    // double-click is two clicks.
+    let track = ui.add(slider).interact(Sense::click());
+    let value = *x;
+    track.widget_info(|| WidgetInfo::slider(true, value, label));
+    let reset = track.double_clicked();
+    let (_, typed) = number_field(ui, id, *x, range.clone(), &format!("{label} value"));
+    if let Some(v) = typed {
+        *x = v;
     }
-    let r = ui.add(slider);
-    *x = x.clamp(s.min, s.max);
-    r
+    if !unit.is_empty() {
+        ui.label(unit);
+    }
+    ui.label(label);
+    *x = x.clamp(*range.start(), *range.end());
+    SliderRow { track, reset }
+}
+
+/// A float slider over the declared slider span with a field for values in
+/// the accepted range (which may be wider than the span).
+fn float_slider(ui: &mut Ui, id: Id, s: &FloatSpec, x: &mut f64, label: &str) -> SliderRow {
+    let lo = s.slider_min.max(s.min);
+    let hi = s.slider_max.min(s.max).max(lo);
+    slider_row(ui, id, x, lo..=hi, s.min..=s.max, s.log, s.unit, label)
 }
 
 fn value_ui(
@@ -103,10 +316,9 @@ fn value_ui(
         (ParamKind::Float(s), ParamValue::Float(x)) => {
             ui.horizontal(|ui| {
                 ui.spacing_mut().slider_width = SLIDER_WIDTH;
-                let r = with_doc(float_slider(ui, &s, x, decl.label), decl);
-                if r.double_clicked() {
-                    out.reset = true;
-                }
+                let row = float_slider(ui, id, &s, x, decl.label);
+                with_doc(row.track, decl);
+                out.reset |= row.reset;
                 out.reset |= reset_button(ui, decl.label, is_default);
             });
         }
@@ -122,15 +334,19 @@ fn value_ui(
                 // drag dims or brightens it, and a grey stays grey.
                 let level = c.iter().copied().fold(0.0, f64::max);
                 let mut new_level = level;
-                let r = ui.add(
-                    Slider::new(&mut new_level, s.min.max(0.0)..=s.max)
-                        .clamping(SliderClamping::Always)
-                        .text(decl.label),
+                let levels = s.min.max(0.0)..=s.max;
+                let row = slider_row(
+                    ui,
+                    id.with("level"),
+                    &mut new_level,
+                    levels.clone(),
+                    levels,
+                    false,
+                    "",
+                    decl.label,
                 );
-                let r = with_doc(r, decl);
-                if r.double_clicked() {
-                    out.reset = true;
-                }
+                with_doc(row.track, decl);
+                out.reset |= row.reset;
                 if new_level != level {
                     if level > 0.0 {
                         let k = new_level / level;
@@ -151,7 +367,14 @@ fn value_ui(
                     );
                     let name = format!("{} colour", decl.label);
                     r.widget_info(|| WidgetInfo::labeled(Role::ColorWell, true, &name));
-                    if rgba != before {
+                    // The picker hands back its colour through an f32 HSV
+                    // round trip, a few ulps off the value it was given: only
+                    // a real pick replaces the (f64) channels, or a typed 0.2
+                    // would become 0.19999998807907104.
+                    let picked = (rgba.to_array().iter())
+                        .zip(before.to_array())
+                        .any(|(a, b)| (a - b).abs() > 1e-5);
+                    if picked {
                         c = [rgba.r() as f64, rgba.g() as f64, rgba.b() as f64];
                     }
                 }
@@ -160,16 +383,12 @@ fn value_ui(
             ui.horizontal(|ui| {
                 ui.add_space(4.0);
                 for (k, ch) in ["R", "G", "B"].iter().enumerate() {
-                    let speed = ((s.max - s.min) / 300.0).max(1e-4);
-                    let r = ui.add(
-                        egui::DragValue::new(&mut c[k])
-                            .range(s.min..=s.max)
-                            .speed(speed)
-                            .max_decimals(4)
-                            .prefix(format!("{ch} ")),
-                    );
+                    ui.label(*ch);
                     let name = format!("{} {ch}", decl.label);
-                    r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, &name));
+                    let (_, typed) = number_field(ui, id.with(*ch), c[k], s.min..=s.max, &name);
+                    if let Some(v) = typed {
+                        c[k] = v;
+                    }
                 }
                 if !s.unit.is_empty() {
                     ui.weak(s.unit);
@@ -299,7 +518,16 @@ fn value_ui(
                     .show(ui, |ui| {
                         ui.horizontal(|ui| {
                             ui.spacing_mut().slider_width = SLIDER_WIDTH;
-                            float_slider(ui, &weight, &mut comp.weight, "weight");
+                            let row = float_slider(
+                                ui,
+                                id.with(i).with("weight"),
+                                &weight,
+                                &mut comp.weight,
+                                "weight",
+                            );
+                            if row.reset {
+                                comp.weight = weight.default;
+                            }
                         });
                         component_model_ui(ui, id.with(i), comp, depth);
                         if depth + 1 < bv_core::params::MAX_NESTING {
@@ -382,6 +610,30 @@ fn singular(label: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_format_short_and_parse_back() {
+        for (v, t) in [
+            (0.3, "0.3"),
+            (0.001, "0.001"),
+            (45.0, "45"),
+            (12.5, "12.5"),
+            (0.123456, "0.12346"),
+            (1.5e-5, "1.5e-5"),
+            (2e6, "2e6"),
+            (0.0, "0"),
+            (-0.25, "-0.25"),
+        ] {
+            assert_eq!(format_number(v), t, "{v}");
+            let back = parse_number(t).unwrap();
+            assert!((back - v).abs() <= 1e-4 * v.abs(), "{t} → {back}");
+        }
+        assert_eq!(parse_number(" 0,4 "), Some(0.4));
+        assert_eq!(parse_number("1e-3"), Some(1e-3));
+        assert_eq!(parse_number("0.4.00100"), None);
+        assert_eq!(parse_number("inf"), None);
+        assert_eq!(parse_number(""), None);
+    }
 
     #[test]
     fn singular_labels() {

@@ -148,6 +148,11 @@ impl ExportUi {
         });
     }
 
+    /// Whether a file dialog (or its "Replace?" question) is showing.
+    pub fn files_open(&self) -> bool {
+        self.files.is_open()
+    }
+
     /// Opens the scene dialog.
     pub fn ask_open_scene(&mut self) {
         self.files

@@ -13,35 +13,11 @@ use super::panel;
 use super::runtime::Runtime;
 use super::scene;
 use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
+use super::shortcuts::{self, Action};
 use super::state::{AppState, Theme};
 use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
-use eframe::egui::{self, Color32, Key, Rect, RichText, Ui, UiBuilder, Vec2};
+use eframe::egui::{self, Color32, Rect, RichText, Ui, UiBuilder, Vec2};
 use std::path::Path;
-
-/// Keyboard shortcuts, as shown in the help overlay.
-pub const SHORTCUTS: &[(&str, &str)] = &[
-    ("F1 or ?", "show or hide this help"),
-    ("R", "reset the camera"),
-    ("L", "logarithmic scale"),
-    ("C", "multiply by cos θo"),
-    ("W", "wireframe lobe"),
-    ("N / P", "next / previous model for the selected BRDF"),
-    ("PageDown / PageUp", "select the next / previous BRDF"),
-    (
-        "M",
-        "maximise the view under the pointer (again to restore)",
-    ),
-    ("1 … 9", "maximise view 1 … 9 (again to restore)"),
-    ("Esc", "restore the layout"),
-    ("T", "switch between dark and light themes"),
-    ("Ctrl+O", "open a scene file"),
-    ("Ctrl+S", "save the scene (to the file it came from)"),
-    (
-        "Ctrl+Shift+S",
-        "export a figure: a view or the window as PNG / SVG / OBJ",
-    ),
-    ("Ctrl+Q", "quit (the session is saved)"),
-];
 
 /// Mouse gestures, as shown in the help overlay.
 pub const GESTURES: &[(&str, &str)] = &[
@@ -325,6 +301,12 @@ impl Viewer {
     /// asked for.
     pub fn ui(&mut self, ui: &mut Ui) {
         let ctx = ui.ctx().clone();
+        // Keys typed in a frame that began with a widget owning the keyboard
+        // are that widget's, even if it lets go during the frame (Enter).
+        // A file dialog owns the keyboard too: its name field may not have
+        // the focus yet when the user starts typing.
+        let keyboard_free =
+            shortcuts::keyboard_free(&ctx) && !self.files.is_open() && !self.export.files_open();
         if self.applied_theme != Some(self.state.theme) {
             ctx.set_theme(match self.state.theme {
                 Theme::Dark => egui::Theme::Dark,
@@ -351,7 +333,7 @@ impl Viewer {
                 central(ui, views, &scene, &mut out);
             });
         }
-        self.shortcuts(&ctx, &mut out);
+        self.shortcuts(&ctx, keyboard_free, &mut out);
         dropped_files(&ctx, &self.state, &self.runtime, &mut out);
         self.help_window(&ctx);
         if let Some(((), path)) = self.files.show(&ctx) {
@@ -473,76 +455,21 @@ impl Viewer {
             .and_then(|(id, _)| REGISTRY.iter().find(|e| e.id == id).map(|e| e.id))
     }
 
-    fn shortcuts(&mut self, ctx: &egui::Context, out: &mut Vec<Command>) {
-        if ctx.input(|i| i.modifiers.command_only() && i.key_pressed(Key::Q)) {
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-        }
-        // Shift+S first: `consume_key` with COMMAND alone would also match it.
-        if ctx
-            .input_mut(|i| i.consume_key(egui::Modifiers::COMMAND | egui::Modifiers::SHIFT, Key::S))
-        {
-            self.export.dialog_open = !self.export.dialog_open;
-        } else if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::S)) {
-            match self.export.scene_path.clone() {
-                Some(p) => self.handle(Request::SaveScene(p), ctx),
-                None => self.export.ask_save_scene(),
-            }
-        }
-        if ctx.input_mut(|i| i.consume_key(egui::Modifiers::COMMAND, Key::O)) {
-            self.export.ask_open_scene();
-        }
-        if ctx.egui_wants_keyboard_input() {
-            return;
-        }
-        let (pressed, question) = ctx.input(|i| {
-            let keys = [
-                Key::F1,
-                Key::R,
-                Key::L,
-                Key::C,
-                Key::W,
-                Key::N,
-                Key::P,
-                Key::PageDown,
-                Key::PageUp,
-                Key::M,
-                Key::Num1,
-                Key::Num2,
-                Key::Num3,
-                Key::Num4,
-                Key::Num5,
-                Key::Num6,
-                Key::Num7,
-                Key::Num8,
-                Key::Num9,
-                Key::Escape,
-                Key::T,
-            ];
-            let pressed: Vec<Key> = keys
-                .into_iter()
-                .filter(|k| i.key_pressed(*k) && i.modifiers.is_none())
-                .collect();
-            let question = i.key_pressed(Key::Questionmark)
-                || i.events
-                    .iter()
-                    .any(|e| matches!(e, egui::Event::Text(t) if t == "?"));
-            (pressed, question)
-        });
-        if question {
-            out.push(Command::ToggleHelp);
-        }
-        for k in pressed {
-            match k {
-                Key::F1 => out.push(Command::ToggleHelp),
-                Key::R => out.push(Command::ResetCamera),
-                Key::L => out.push(Command::ToggleLog),
-                Key::C => out.push(Command::ToggleCosine),
-                Key::W => out.push(Command::ToggleWireframe),
-                Key::N => out.push(Command::StepModel(1)),
-                Key::P => out.push(Command::StepModel(-1)),
-                Key::PageDown => out.push(Command::SelectStep(1)),
-                Key::PageUp => out.push(Command::SelectStep(-1)),
-                Key::M => {
+    /// Handles the keyboard shortcuts (see [`shortcuts::SHORTCUTS`]);
+    /// `free` says whether the keyboard was free at the start of the frame.
+    fn shortcuts(&mut self, ctx: &egui::Context, free: bool, out: &mut Vec<Command>) {
+        for action in shortcuts::pressed(ctx, free) {
+            match action {
+                Action::ToggleHelp => out.push(Command::ToggleHelp),
+                Action::ResetCamera => out.push(Command::ResetCamera),
+                Action::ToggleLog => out.push(Command::ToggleLog),
+                Action::ToggleCosine => out.push(Command::ToggleCosine),
+                Action::ToggleWireframe => out.push(Command::ToggleWireframe),
+                Action::NextModel => out.push(Command::StepModel(1)),
+                Action::PreviousModel => out.push(Command::StepModel(-1)),
+                Action::NextBrdf => out.push(Command::SelectStep(1)),
+                Action::PreviousBrdf => out.push(Command::SelectStep(-1)),
+                Action::MaximiseHovered => {
                     let id = self
                         .hovered_view(ctx)
                         .or_else(|| REGISTRY.first().map(|e| e.id));
@@ -550,43 +477,29 @@ impl Viewer {
                         out.push(Command::ToggleMaximise(id.to_string()));
                     }
                 }
-                Key::Num1
-                | Key::Num2
-                | Key::Num3
-                | Key::Num4
-                | Key::Num5
-                | Key::Num6
-                | Key::Num7
-                | Key::Num8
-                | Key::Num9 => {
-                    let keys = [
-                        Key::Num1,
-                        Key::Num2,
-                        Key::Num3,
-                        Key::Num4,
-                        Key::Num5,
-                        Key::Num6,
-                        Key::Num7,
-                        Key::Num8,
-                        Key::Num9,
-                    ];
-                    let i = keys.iter().position(|x| *x == k).unwrap_or(0);
-                    if let Some(e) = REGISTRY.get(i) {
+                Action::MaximiseView(k) => {
+                    if let Some(e) = REGISTRY.get(k) {
                         out.push(Command::ToggleMaximise(e.id.to_string()));
                     }
                 }
-                Key::Escape => {
+                Action::Escape => {
                     if self.help {
                         out.push(Command::ToggleHelp);
                     } else {
                         out.push(Command::Maximise(None));
                     }
                 }
-                Key::T => out.push(Command::SetTheme(match self.state.theme {
+                Action::ToggleTheme => out.push(Command::SetTheme(match self.state.theme {
                     Theme::Dark => Theme::Light,
                     Theme::Light => Theme::Dark,
                 })),
-                _ => {}
+                Action::OpenScene => self.export.ask_open_scene(),
+                Action::SaveScene => match self.export.scene_path.clone() {
+                    Some(p) => self.handle(Request::SaveScene(p), ctx),
+                    None => self.export.ask_save_scene(),
+                },
+                Action::ExportFigure => self.export.dialog_open = !self.export.dialog_open,
+                Action::Quit => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             }
         }
     }
@@ -606,9 +519,9 @@ impl Viewer {
                     .num_columns(2)
                     .spacing([24.0, 4.0])
                     .show(ui, |ui| {
-                        for (k, what) in SHORTCUTS {
-                            ui.label(RichText::new(*k).monospace().strong());
-                            ui.label(*what);
+                        for s in shortcuts::SHORTCUTS {
+                            ui.label(RichText::new(s.keys_text(ctx)).monospace().strong());
+                            ui.label(s.help);
                             ui.end_row();
                         }
                     });

@@ -22,6 +22,9 @@ pub struct CartesianView {
     pub readout: Option<Readout>,
     /// Where the plot was drawn in the last frame.
     pub plot_rect: Option<egui::Rect>,
+    /// The y range the plot showed in the last frame (decades on the log
+    /// scale).
+    pub y_bounds: Option<(f64, f64)>,
 }
 
 fn axis_name(a: CartesianAxis) -> &'static str {
@@ -54,14 +57,16 @@ impl View for CartesianView {
                 ui.add(
                     egui::Slider::new(&mut p2.fixed_theta_d_deg, 0.0..=89.5)
                         .text("θd")
-                        .suffix("°"),
+                        .suffix("°")
+                        .update_while_editing(false),
                 );
             }
             CartesianAxis::ThetaD => {
                 ui.add(
                     egui::Slider::new(&mut p2.fixed_theta_h_deg, 0.0..=89.5)
                         .text("θh")
-                        .suffix("°"),
+                        .suffix("°")
+                        .update_while_editing(false),
                 );
             }
         }
@@ -82,20 +87,13 @@ impl View for CartesianView {
         );
         let Data {
             curves: data,
-            floor,
             bottom,
             top,
             x_label,
             y_label,
         } = Data::compute(scene);
         let log = d.log;
-        let y_of = move |v: f64| {
-            if log {
-                curves::log_ordinate(v, floor)
-            } else {
-                v
-            }
-        };
+        let y_of = move |v: f64| if log { curves::log_ordinate(v) } else { v };
         let value_name = super::value_label(d.cosine);
         let axis = p.axis;
         let x_name = axis_name(axis);
@@ -121,8 +119,6 @@ impl View for CartesianView {
                 }
             }))
             .allow_scroll(false)
-            .include_y(bottom)
-            .include_y(top)
             .label_formatter(move |hover| match hover {
                 egui_plot::HoverPosition::NearDataPoint {
                     plot_name,
@@ -143,16 +139,19 @@ impl View for CartesianView {
                 _ => None,
             });
         if log {
+            // The axis spans the decades the data reach (see
+            // `curves::LogRange`): curves below it leave through the bottom
+            // edge, clipped, rather than resting on a floor.
             plot = plot
+                .default_y_bounds(bottom, top)
                 .y_axis_formatter(|mark, _| {
-                    let k = mark.value.round();
-                    if (mark.value - k).abs() < 1e-9 {
-                        super::decade_label(k as i32)
-                    } else {
-                        String::new()
-                    }
+                    curves::decade_mark_label(mark.value, mark.step_size)
+                        .map(super::decade_label)
+                        .unwrap_or_default()
                 })
-                .y_grid_spacer(egui_plot::uniform_grid_spacer(|_| [10.0, 1.0, 0.5]));
+                .y_grid_spacer(|input| curves::log_grid_marks(input.bounds, input.base_step_size));
+        } else {
+            plot = plot.include_y(bottom).include_y(top);
         }
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);
@@ -236,6 +235,8 @@ impl View for CartesianView {
 
         self.readout = None;
         self.plot_rect = Some(response.response.rect);
+        let b = response.transform.bounds();
+        self.y_bounds = Some((b.min()[1], b.max()[1]));
         if response.response.hovered()
             && let Some(pc) = response.inner
         {
@@ -301,7 +302,7 @@ impl View for CartesianView {
 /// its SVG).
 struct Data<'s> {
     curves: Vec<(&'s super::SceneBrdf, Vec<curves::Sample>)>,
-    floor: f64,
+    /// The y range: in decades on the log scale.
     bottom: f64,
     top: f64,
     x_label: String,
@@ -344,12 +345,8 @@ impl<'s> Data<'s> {
         };
         let curves: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
             scene.brdfs.iter().map(|b| (b, eval(b))).collect();
-        let vmax = curves
-            .iter()
-            .flat_map(|(_, s)| s.iter())
-            .map(|s| s.value)
-            .fold(0.0, f64::max);
-        let floor = curves::log_floor(vmax);
+        let values = || curves.iter().flat_map(|(_, s)| s.iter()).map(|s| s.value);
+        let vmax = values().fold(0.0, f64::max);
         let value_name = super::value_label(d.cosine);
         let x_label = match p.axis {
             CartesianAxis::ThetaO => "θo (°), negative on the light's side".to_string(),
@@ -363,16 +360,13 @@ impl<'s> Data<'s> {
         };
         // Headroom above the largest value for the legend and markers.
         let (bottom, top) = if d.log {
-            (
-                floor.log10(),
-                curves::log_ordinate(vmax.max(1e-30), floor) + 0.4,
-            )
+            let r = curves::LogRange::of(values());
+            (r.bottom, r.top)
         } else {
             (0.0, vmax.max(1e-6) * 1.3)
         };
         Self {
             curves,
-            floor,
             bottom,
             top,
             x_label,
@@ -388,13 +382,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
     let p = scene.state.plots;
     let theta_i = scene.incident.theta_deg.to_radians();
     let phi_i = scene.incident.phi_deg.to_radians();
-    let y_of = |v: f64| {
-        if d.log {
-            curves::log_ordinate(v, data.floor)
-        } else {
-            v
-        }
-    };
+    let y_of = |v: f64| if d.log { curves::log_ordinate(v) } else { v };
     let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
     let x_range = match p.axis {
         CartesianAxis::ThetaO if transmits => (-180.0, 180.0),
@@ -402,8 +390,16 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
         _ => (0.0, 90.0),
     };
     let y_ticks = if d.log {
-        let (a, b) = (data.bottom.ceil() as i32, data.top.floor() as i32);
-        (a..=b)
+        let range = curves::LogRange {
+            bottom: data.bottom,
+            top: data.top,
+        };
+        // Every decade up to a dozen, then every few.
+        let n = range.decades().count().max(1);
+        let every = n.div_ceil(13);
+        range
+            .decades()
+            .filter(|k| k.rem_euclid(every as i32) == 0)
             .map(|k| (f64::from(k), super::decade_label(k)))
             .collect()
     } else {

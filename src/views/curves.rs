@@ -160,19 +160,136 @@ pub fn half_diff_value(
     }
 }
 
-/// The plotted ordinate of a value on a log axis: log10 with a floor, so that
-/// zeros stay on the plot (at the floor) instead of breaking the line.
-pub fn log_ordinate(v: f64, floor: f64) -> f64 {
-    v.max(floor).log10()
+/// How many decades below the largest value a log plot reaches at most: a
+/// BRDF's tail can fall to 1e-27 and below, which would squash the lobe into
+/// the top of the plot; twelve decades show any tail worth reading.
+pub const LOG_DECADES: f64 = 12.0;
+
+/// Where a value that a log axis cannot show (zero or negative) is drawn:
+/// far below any plot's range, so that its line leaves the plot through the
+/// bottom edge (where it is clipped) instead of standing on a made-up floor.
+pub const LOG_ZERO: f64 = -1000.0;
+
+/// The vertical range of a log plot, in decades (log10 of the value).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LogRange {
+    /// The bottom of the axis: a whole decade.
+    pub bottom: f64,
+    /// The top of the axis: the largest value's decade plus headroom for the
+    /// legend and markers.
+    pub top: f64,
 }
 
-/// The smallest value a log plot shows: five decades below the largest value.
-pub fn log_floor(max: f64) -> f64 {
-    if max > 0.0 && max.is_finite() {
-        max * 1e-5
-    } else {
-        1e-5
+impl LogRange {
+    /// Headroom above the largest value, in decades.
+    pub const HEADROOM: f64 = 0.4;
+
+    /// The range that shows `values`: from the decade of the smallest
+    /// positive value (but at most [`LOG_DECADES`] below the largest) to the
+    /// largest. At least one decade lies below the largest value, so a
+    /// constant (Lambert) is a line inside the plot rather than on its floor.
+    /// Without a positive value: 1e-5 to 1.
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for v in values {
+            if v > 0.0 && v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        if hi <= 0.0 {
+            return Self {
+                bottom: -5.0,
+                top: Self::HEADROOM,
+            };
+        }
+        let top = hi.log10();
+        let bottom = lo
+            .log10()
+            .floor()
+            .min(top.ceil() - 1.0)
+            .max((top - LOG_DECADES).floor());
+        Self {
+            bottom,
+            top: top + Self::HEADROOM,
+        }
     }
+
+    /// The lowest value on the axis.
+    pub fn floor_value(&self) -> f64 {
+        10f64.powf(self.bottom)
+    }
+
+    /// The whole decades on the axis, bottom to top.
+    pub fn decades(&self) -> impl Iterator<Item = i32> {
+        (self.bottom.ceil() as i32)..=(self.top.floor() as i32)
+    }
+}
+
+/// The plotted ordinate of a value on a log axis: its true log10, with no
+/// floor (the plot clips what lies below its range); zero and negative
+/// values go to [`LOG_ZERO`].
+pub fn log_ordinate(v: f64) -> f64 {
+    if v > 0.0 && v.is_finite() {
+        v.log10()
+    } else {
+        LOG_ZERO
+    }
+}
+
+/// Grid marks of a log axis over `bounds` (in decades): a line at every
+/// decade, labelled every `k` decades (1, 2, 5, 10, … so that labels do not
+/// crowd: `min_step` is the plot's smallest readable step, egui_plot's
+/// `GridInput::base_step_size`), and thin lines at 2…9 × 10^k where decades
+/// are tall enough. Only whole decades carry labels (see
+/// [`decade_mark_label`]).
+pub fn log_grid_marks(bounds: (f64, f64), min_step: f64) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = bounds;
+    if !(lo.is_finite() && hi.is_finite()) || hi <= lo {
+        return Vec::new();
+    }
+    let lo_d = lo.floor() as i64;
+    let hi_d = hi.ceil() as i64;
+    if hi_d - lo_d > 10_000 {
+        return Vec::new();
+    }
+    // A label is about three minimum steps tall.
+    let want = (min_step * 3.0).max(1.0);
+    let k = [1i64, 2, 5, 10, 20, 50, 100, 200, 500, 1000]
+        .into_iter()
+        .find(|&k| k as f64 >= want)
+        .unwrap_or(1000);
+    let minor = min_step <= 0.15 && hi_d - lo_d <= 40;
+    let mut marks = Vec::new();
+    for d in lo_d..=hi_d {
+        let dv = d as f64;
+        if (lo..=hi).contains(&dv) {
+            marks.push(egui_plot::GridMark {
+                value: dv,
+                // Decades between the labelled ones: thinner, unlabelled.
+                step_size: if d.rem_euclid(k) == 0 { k as f64 } else { 0.5 },
+            });
+        }
+        if minor {
+            for m in 2..=9 {
+                let v = dv + f64::from(m).log10();
+                if (lo..=hi).contains(&v) {
+                    marks.push(egui_plot::GridMark {
+                        value: v,
+                        step_size: 0.1,
+                    });
+                }
+            }
+        }
+    }
+    marks
+}
+
+/// The decade a log axis mark labels: whole decades of step 1 or more (the
+/// labelled ones of [`log_grid_marks`]); `None` for the lines between.
+pub fn decade_mark_label(value: f64, step_size: f64) -> Option<i32> {
+    let k = value.round();
+    ((value - k).abs() < 1e-9 && step_size >= 1.0).then_some(k as i32)
 }
 
 /// "Nice" round number ≥ `x` (1, 1.2, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k), for
@@ -319,9 +436,53 @@ mod tests {
     }
 
     #[test]
-    fn log_ordinates_have_a_floor() {
-        assert_eq!(log_ordinate(0.0, 1e-3), -3.0);
-        assert!((log_ordinate(100.0, 1e-3) - 2.0).abs() < 1e-12);
-        assert_eq!(log_floor(10.0), 1e-4);
+    fn log_ordinates_are_true_values() {
+        assert!((log_ordinate(100.0) - 2.0).abs() < 1e-12);
+        assert!((log_ordinate(3e-27) + 26.522878745280337).abs() < 1e-9);
+        assert_eq!(log_ordinate(0.0), LOG_ZERO);
+        assert_eq!(log_ordinate(-1.0), LOG_ZERO);
+        assert_eq!(log_ordinate(f64::NAN), LOG_ZERO);
+    }
+
+    #[test]
+    fn log_range_comes_from_the_data() {
+        // A specular lobe whose tail falls to 3e-27: twelve decades below
+        // its peak of 1.7, not a fixed floor at 1.7e-5.
+        let r = LogRange::of([1.7, 0.2, 3e-6, 1e-9, 3e-27, 0.0]);
+        assert_eq!(r.bottom, -12.0);
+        assert!((r.top - (1.7f64.log10() + LogRange::HEADROOM)).abs() < 1e-12);
+        // A tail that stops above that: the range ends at its decade.
+        let r = LogRange::of([1.7, 2.5e-4]);
+        assert_eq!(r.bottom, -4.0);
+        // A constant keeps a decade below it.
+        assert_eq!(LogRange::of([0.159]).bottom, -1.0);
+        assert_eq!(LogRange::of([0.1]).bottom, -2.0);
+        assert_eq!(LogRange::of([100.0, 100.0]).bottom, 1.0);
+        // Nothing positive: a default range.
+        assert_eq!(LogRange::of([0.0, f64::NAN]).bottom, -5.0);
+        let r = LogRange::of([1.0, 1e-3]);
+        assert_eq!(r.decades().collect::<Vec<_>>(), vec![-3, -2, -1, 0]);
+        assert_eq!(r.floor_value(), 1e-3);
+    }
+
+    #[test]
+    fn log_grid_marks_label_whole_decades() {
+        // Tall decades: every decade strong, minor lines at 2..9.
+        let m = log_grid_marks((-3.0, 0.5), 0.05);
+        let labelled: Vec<i32> = m
+            .iter()
+            .filter_map(|g| decade_mark_label(g.value, g.step_size))
+            .collect();
+        assert_eq!(labelled, vec![-3, -2, -1, 0]);
+        assert!(m.iter().any(|g| (g.value - 2f64.log10()).abs() < 1e-12));
+        // Many short decades: labels every 5th, no minor lines.
+        let m = log_grid_marks((-27.0, 0.5), 1.2);
+        let labelled: Vec<i32> = m
+            .iter()
+            .filter_map(|g| decade_mark_label(g.value, g.step_size))
+            .collect();
+        assert_eq!(labelled, vec![-25, -20, -15, -10, -5, 0]);
+        assert!(m.iter().all(|g| g.value.fract() == 0.0));
+        assert!(log_grid_marks((1.0, 1.0), 0.1).is_empty());
     }
 }

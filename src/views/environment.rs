@@ -587,7 +587,8 @@ impl View for EnvironmentView {
                     .speed(1.0)
                     .range(-180.0..=180.0)
                     .suffix("°")
-                    .fixed_decimals(0),
+                    .fixed_decimals(0)
+                    .update_while_editing(false),
             )
             .labelled_by(label.id)
             .on_hover_text("Rotation of the environment about the vertical (double-click: 0)");

@@ -375,15 +375,19 @@ impl View for ImageSliceView {
     fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let s = &mut self.settings;
         ui.spacing_mut().slider_width = 90.0;
-        let r = ui
-            .add(
-                egui::Slider::new(&mut s.phi_d_deg, 0.0..=180.0)
-                    .text("φd")
-                    .suffix("°")
-                    .fixed_decimals(0),
-            )
+        let row = crate::app::params_ui::slider_row(
+            ui,
+            super::view_id("image_slice").with("phi_d"),
+            &mut s.phi_d_deg,
+            0.0..=180.0,
+            0.0..=180.0,
+            false,
+            "°",
+            "φd",
+        );
+        row.track
             .on_hover_text("Difference azimuth φd of the slice (φh = 0)");
-        if r.double_clicked() {
+        if row.reset {
             s.phi_d_deg = SliceSettings::default().phi_d_deg;
         }
         if super::toolbar_toggle(
@@ -400,7 +404,8 @@ impl View for ImageSliceView {
                     .range(-20.0..=20.0)
                     .speed(0.05)
                     .fixed_decimals(1)
-                    .prefix("EV "),
+                    .prefix("EV ")
+                    .update_while_editing(false),
             )
             .on_hover_text("Exposure: f × 2^EV before the gamma");
         r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "Exposure EV"));
@@ -410,7 +415,8 @@ impl View for ImageSliceView {
                     .range(1.0..=4.0)
                     .speed(0.01)
                     .fixed_decimals(2)
-                    .prefix("γ "),
+                    .prefix("γ ")
+                    .update_while_editing(false),
             )
             .on_hover_text("Display gamma: level = (2^EV f)^(1/γ)");
         r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "Gamma"));

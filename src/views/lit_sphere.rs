@@ -439,7 +439,8 @@ pub fn exposure_control(ui: &mut Ui, salt: &str, ev: &mut f64) {
             egui::DragValue::new(ev)
                 .speed(0.05)
                 .range(EV_RANGE.0..=EV_RANGE.1)
-                .fixed_decimals(1),
+                .fixed_decimals(1)
+                .update_while_editing(false),
         )
         .labelled_by(label.id)
         .on_hover_text("Exposure in stops: radiance × 2^EV (double-click: 0)");

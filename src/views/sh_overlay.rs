@@ -237,7 +237,8 @@ pub fn control(ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
                 egui::DragValue::new(&mut l)
                     .range(0..=sh::MAX_ORDER as u8)
                     .prefix("L = ")
-                    .speed(0.1),
+                    .speed(0.1)
+                    .update_while_editing(false),
             )
             .on_hover_text("Highest SH order (0–16): (L + 1)² coefficients");
         r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "SH order L"));
