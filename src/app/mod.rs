@@ -103,7 +103,7 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
     let mut state = if let Some(path) = &args.scene {
         let loaded = scene::load(path).with_context(|| format!("opening {}", path.display()))?;
         for w in &loaded.warnings {
-            eprintln!("bv: {}: {w}", path.display());
+            crate::cli::output::eprint(&format!("bv: {}: {w}\n", path.display()));
         }
         loaded.state
     } else if args.fresh {
@@ -294,8 +294,8 @@ impl eframe::App for BvApp {
             ctx.request_repaint();
             if b.done() && !b.reported {
                 b.reported = true;
-                println!("{}", b.report());
-                self.finish(&ctx, Ok(()));
+                let printed = crate::cli::output::print(&format!("{}\n", b.report()));
+                self.finish(&ctx, printed);
             }
         }
         if let Some(s) = &mut self.shot {
@@ -518,9 +518,13 @@ pub fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyho
     let bytes: Vec<u8> = img.pixels.iter().flat_map(|c| c.to_array()).collect();
     let rgba = image::RgbaImage::from_raw(w as u32, h as u32, bytes)
         .context("screenshot has the wrong size")?;
-    rgba.save(path)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    eprintln!("bv: saved screenshot {} ({w}x{h})", path.display());
+    // Through the safe writer: atomic, and never over a FIFO, a device, a
+    // read-only file or through a dangling link.
+    crate::export::save_png(&rgba, path)?;
+    crate::cli::output::eprint(&format!(
+        "bv: saved screenshot {} ({w}x{h})\n",
+        path.display()
+    ));
     Ok(())
 }
 

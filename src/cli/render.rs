@@ -149,7 +149,7 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
         Some(p) => {
             let loaded = scene::load(p).with_context(|| format!("--scene {}", p.display()))?;
             for w in &loaded.warnings {
-                eprintln!("bv render: {}: {w}", p.display());
+                super::output::eprint(&format!("bv render: {}: {w}\n", p.display()));
             }
             loaded.state
         }

@@ -13,7 +13,7 @@ use crate::app::runtime::Runtime;
 use crate::app::state::{AppState, Theme};
 use crate::app::viewer::{Viewer, build_scene};
 use crate::views::{Scene, ViewEntry};
-use anyhow::{Context as _, Result};
+use anyhow::{Context as _, Result, bail};
 use eframe::egui;
 pub use offscreen::{Frame, Offscreen};
 use std::path::Path;
