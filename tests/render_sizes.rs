@@ -183,8 +183,8 @@ fn run_all(runs: &[(String, u32, u32)], dir: &Path, views: &[String]) -> Vec<Str
 /// drawing code on one device) and the window at 800×600 and 1600×1200; at
 /// 4096×3072 the views whose GPU resources grow with the image (the
 /// environment's accumulation, the lobe's multisampled target) and the
-/// window. Every view at 4096×3072 is the ignored test below (about two
-/// minutes on lavapipe).
+/// window. Every view at 4096×3072 is the test below (about two minutes on
+/// lavapipe).
 #[test]
 fn every_view_at_every_size_draws_or_is_refused_clearly() {
     let views = view_ids();
@@ -214,10 +214,8 @@ fn every_view_at_every_size_draws_or_is_refused_clearly() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Every view at 4096×3072 (`--view all`): `cargo test --test render_sizes
-/// -- --ignored`.
+/// Every view at 4096×3072 (`--view all`, about two minutes on lavapipe).
 #[test]
-#[ignore = "about two minutes on lavapipe"]
 fn every_view_at_4096_by_3072() {
     let views = view_ids();
     let dir = out_dir("all-4096");

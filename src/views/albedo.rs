@@ -312,11 +312,16 @@ fn legend_label(s: &Shown) -> String {
     } else {
         format!("{err:.4}")
     };
+    // The method, briefly: the band is the quadrature's error estimate, or
+    // ±3 standard errors of Monte Carlo.
+    let method = match s.data.method() {
+        "quadrature" => "quad.".to_string(),
+        _ => format!("MC ±{BAND_SIGMAS}σ"),
+    };
     let mut l = format!(
-        "{}: ρhh = {:.4} ± {err_text} ({})",
+        "{}: ρhh = {:.4} ± {err_text} {method}",
         s.brdf.label,
         mean_rgb(hh.value),
-        s.data.method()
     );
     if s.data.exceeds_one() {
         l.push_str(" (ρhd > 1!)");
