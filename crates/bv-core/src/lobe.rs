@@ -442,7 +442,10 @@ mod tests {
             ),
             ("glass", serde_json::json!({})),
         ] {
-            let b = crate::ModelSpec::from_json(id, &p).unwrap().build().unwrap();
+            let b = crate::ModelSpec::from_json(id, &p)
+                .unwrap()
+                .build()
+                .unwrap();
             let opts = LobeOptions {
                 n_theta: 24,
                 n_phi: 40,
@@ -462,7 +465,10 @@ mod tests {
                 let want = b.eval(wi32, wo);
                 for c in 0..3 {
                     let tol = (1e-4 * want[c].abs()).max(1e-6);
-                    assert!((v[c] as f64 - want[c]).abs() <= tol, "{id} {k}: {v:?} vs {want}");
+                    assert!(
+                        (v[c] as f64 - want[c]).abs() <= tol,
+                        "{id} {k}: {v:?} vs {want}"
+                    );
                 }
             }
         }
