@@ -298,6 +298,8 @@ pub struct FresnelLanes {
     k2: [f32; 3],
     /// η² k² per channel (conductor).
     eta2k2: [f32; 3],
+    /// √2 η k per channel (conductor).
+    sqrt2_etak: [f32; 3],
     /// F0 per channel (Schlick).
     f0: [f32; 3],
 }
@@ -330,6 +332,7 @@ impl FresnelLanes {
             eta2: c(eta * eta),
             k2: c(k * k),
             eta2k2: c(eta * eta * k * k),
+            sqrt2_etak: c(eta * k * std::f64::consts::SQRT_2),
             f0: c(f0),
         }
     }
@@ -364,23 +367,26 @@ impl FresnelLanes {
                 std::array::from_fn(|i| {
                     let t0 = self.eta2[i] - self.k2[i] - sin2;
                     let a2b2 = (t0 * t0 + 4.0 * self.eta2k2[i]).sqrt();
-                    // a² = (a²+b² + t0)/2, which cancels in f32 when t0 < 0
-                    // (k > η, every metal); there it equals
-                    // 2η²k²/(a²+b² − t0) since (a²+b²)² − t0² = 4η²k².
-                    let a2 = if t0 >= 0.0 {
-                        0.5 * (a2b2 + t0)
+                    // a = √((a²+b² + t0)/2) cancels in f32 when t0 < 0 (k > η,
+                    // every metal); since (a²+b²)² − t0² = 4η²k² it is then
+                    // √2 ηk / r with r = √(a²+b² − t0), and otherwise r/√2
+                    // with r = √(a²+b² + t0): r never cancels. Writing
+                    // t2 = 2 cosθ a = P/Q (Q = r or 1) and clearing Q from
+                    // (Rs + Rp)/2 = Rs t3/(t3 + t4) = (t1 − t2) t3/((t1 + t2)(t3 + t4))
+                    // leaves one division per channel.
+                    let r = (a2b2 + t0.abs()).sqrt();
+                    let metal = t0 < 0.0;
+                    let p = if metal {
+                        2.0 * c * self.sqrt2_etak[i]
                     } else {
-                        2.0 * self.eta2k2[i] / (a2b2 - t0)
+                        std::f32::consts::SQRT_2 * c * r
                     };
-                    let a = a2.max(0.0).sqrt();
+                    let q = if metal { r } else { 1.0 };
                     let t1 = a2b2 + cos2;
-                    let t2 = 2.0 * c * a;
                     let t3 = cos2 * a2b2 + sin2 * sin2;
-                    let t4 = t2 * sin2;
-                    // (Rs + Rp)/2 with Rp = Rs (t3 − t4)/(t3 + t4) is
-                    // Rs t3/(t3 + t4): one division instead of two.
-                    let f = (t1 - t2) * t3 / ((t1 + t2) * (t3 + t4));
-                    if t1 + t2 <= 0.0 { 1.0 } else { f }
+                    let t1q = t1 * q;
+                    let f = (t1q - p) * t3 * q / ((t1q + p) * (t3 * q + p * sin2));
+                    if t1q + p <= 0.0 { 1.0 } else { f }
                 })
             }
             Self::SCHLICK => {

@@ -620,6 +620,35 @@ impl ScaleLanes {
         if z > 0.0 { v } else { 0.0 }
     }
 
+    /// GGX's `D(h) G(wi, wo) / (4 cosθi cosθo)` with separable
+    /// (`CORRELATED = false`) or height-correlated Smith G, from the
+    /// unnormalised half vector `hu = wi + wo` and `l2 = |hu|²`, with a single
+    /// division: with `T = hux²/αx² + huy²/αy² + huz²`, `D = l2² / (π αx αy T²)`
+    /// (`h = hu/√l2` in [`ggx_d`]), and with `s = √(z² + wx²αx² + wy²αy²)`,
+    /// `1 + Λ(w) = (z + s)/(2z)` ([`ggx_lambda`]), so the cosines cancel:
+    /// separable `G/(4 zi zo) = 1/((zi + si)(zo + so))`, correlated
+    /// `G/(4 zi zo) = 1/(2 (si zo + so zi))`. Both directions must be above
+    /// the horizon (the caller masks the others).
+    #[inline(always)]
+    pub fn ggx_dg<const CORRELATED: bool>(
+        &self,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        hu: [f32; 3],
+        l2: f32,
+    ) -> f32 {
+        let (u, v) = (hu[0] * self.inv_ax, hu[1] * self.inv_ay);
+        let t = u * u + v * v + hu[2] * hu[2];
+        let s = |w: [f32; 3]| (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt();
+        let (si, so) = (s(wi), s(wo));
+        let g = if CORRELATED {
+            2.0 * (si * wo[2] + so * wi[2])
+        } else {
+            (wi[2] + si) * (wo[2] + so)
+        };
+        self.norm * (l2 * l2) / (t * t * g)
+    }
+
     /// `1 + Λ(w)` (+∞ at and below the horizon): the form every G needs.
     /// GGX's `1 + (−1 + √(1 + t))/2` is `(1 + √(1 + t))/2`.
     #[inline(always)]

@@ -310,6 +310,19 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
         let l2 = math::dot(hu, hu);
         let inv = 1.0 / l2.sqrt();
         let h = hu.map(|c| c * inv);
+        if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
+            // The common GGX-Smith case with one division for D G/(4 cos cos).
+            let scalar = if G == CORRELATED {
+                k.first.ggx_dg::<true>(wi, wo, hu, l2)
+            } else {
+                k.first.ggx_dg::<false>(wi, wo, hu, l2)
+            };
+            let ok = above && l2 > 1e-24 && l2 < f32::INFINITY && scalar.is_finite();
+            let scalar = if ok { scalar * k.ks } else { 0.0 };
+            let fr = k.fresnel.eval::<F>(math::dot(wi, h));
+            let f: [f32; 3] = std::array::from_fn(|c| k.diffuse[c] + fr[c] * scalar);
+            return if above { f } else { [0.0; 3] };
+        }
         let w1 = 1.0 - k.w2;
         let d = if MIX {
             w1 * k.first.d::<D>(h) + k.w2 * k.second.d::<D>(h)
