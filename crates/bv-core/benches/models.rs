@@ -204,6 +204,15 @@ fn lobes(c: &mut Criterion) {
             g.bench_function(format!("{name}/{n_theta}x{n_phi}"), |bench| {
                 bench.iter(|| black_box(lobe::build(b.as_ref(), black_box(wi), &opts)))
             });
+            // A slider step: the same resolution into the previous mesh's
+            // buffers (`lobe::build_into`).
+            let mut mesh = lobe::build(b.as_ref(), wi, &opts);
+            g.bench_function(format!("{name}/{n_theta}x{n_phi}/reuse"), |bench| {
+                bench.iter(|| {
+                    lobe::build_into(b.as_ref(), black_box(wi), &opts, &mut mesh);
+                    black_box(&mesh);
+                })
+            });
         }
     }
     g.finish();

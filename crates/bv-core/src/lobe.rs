@@ -159,8 +159,19 @@ const GRID_CACHE_MAX: usize = 16;
 /// once and reused; the values come from the batch evaluator
 /// ([`crate::batch::eval`]: the model's f32 SIMD kernel, or its `eval`), rows
 /// in parallel for large grids, so the cost is the model's evaluations plus a
-/// few vector operations per vertex.
+/// few vector operations per vertex. [`build_into`] also reuses the buffers of
+/// a previous mesh.
 pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
+    let mut mesh = LobeMesh::default();
+    build_into(brdf, wi, opts, &mut mesh);
+    mesh
+}
+
+/// [`build`] into an existing mesh, reusing its buffers: when a slider moves
+/// and the resolution stays, nothing is allocated and the triangle list is
+/// not rewritten (it is taken as the one an earlier call wrote), so only the
+/// values, positions and normals are computed.
+pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMesh) {
     let n_theta = opts.n_theta.max(2);
     let n_phi = opts.n_phi.max(3);
     let full = brdf.transmits();
@@ -170,8 +181,23 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
     let grid = grid(n_theta, n_phi, full);
     let wi32 = [wi.x as f32, wi.y as f32, wi.z as f32];
 
-    let mut values = vec![[0f32; 3]; count];
-    let mut positions = vec![[0f32; 3]; count];
+    let same_grid = mesh.n_theta == n_theta
+        && mesh.n_phi == n_phi
+        && mesh.full_sphere == full
+        && mesh.indices.len() == grid.indices.len();
+    let mut values = std::mem::take(&mut mesh.values);
+    let mut positions = std::mem::take(&mut mesh.positions);
+    let mut normals = std::mem::take(&mut mesh.normals);
+    let mut indices = std::mem::take(&mut mesh.indices);
+    values.resize(count, [0.0; 3]);
+    positions.resize(count, [0.0; 3]);
+    normals.resize(count, [0.0; 3]);
+    // The triangle list depends on the resolution only; a mesh of the same
+    // resolution already holds it (callers do not edit it).
+    if !same_grid {
+        indices.clear();
+        indices.extend_from_slice(&grid.indices);
+    }
     // Rows per task: enough lanes per batch call to fill the vectors.
     let band = (2048 / n_phi).max(1);
     let fill = |first_row: usize, (vals, pos): (&mut [[f32; 3]], &mut [[f32; 3]])| {
@@ -227,11 +253,17 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
         fill(0, (&mut values[..], &mut positions[..]));
     }
 
-    let indices = grid.indices.clone();
-    let normals = grid_normals(&positions, n_theta, n_phi, parallel, |i, j| {
-        let k = i * n_phi + j;
-        Vec3::new(grid.dirs[0][k], grid.dirs[1][k], grid.dirs[2][k])
-    });
+    grid_normals(
+        &positions,
+        &mut normals,
+        n_theta,
+        n_phi,
+        parallel,
+        |i, j| {
+            let k = i * n_phi + j;
+            Vec3::new(grid.dirs[0][k], grid.dirs[1][k], grid.dirs[2][k])
+        },
+    );
     let max_value = values
         .iter()
         .map(|v| (v[0] + v[1] + v[2]) / 3.0)
@@ -242,7 +274,7 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
         .fold(0.0f32, f32::max)
         .sqrt() as f64;
 
-    LobeMesh {
+    *mesh = LobeMesh {
         positions,
         normals,
         values,
@@ -253,7 +285,7 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
         max_value,
         max_radius,
         deltas: brdf.deltas(wi),
-    }
+    };
 }
 
 /// Two triangles per grid cell; the φ seam wraps. θ grows away from the pole
@@ -290,11 +322,12 @@ fn grid_indices(n_theta: usize, n_phi: usize, parallel: bool) -> Vec<u32> {
 /// lobe) gets its grid direction, so shading never sees a NaN.
 fn grid_normals(
     positions: &[[f32; 3]],
+    normals: &mut [[f32; 3]],
     n_theta: usize,
     n_phi: usize,
     parallel: bool,
     fallback: impl Fn(usize, usize) -> Vec3 + Sync,
-) -> Vec<[f32; 3]> {
+) {
     let p = |i: usize, j: usize| Vec3::from_array(positions[i * n_phi + j]);
     let fan = |i: usize, next: usize| {
         let c = p(i, 0);
@@ -333,7 +366,6 @@ fn grid_normals(
             };
         }
     };
-    let mut normals = vec![[0f32; 3]; positions.len()];
     if parallel {
         normals
             .par_chunks_mut(n_phi)
@@ -344,7 +376,6 @@ fn grid_normals(
             normal_row(i, out);
         }
     }
-    normals
 }
 
 #[cfg(test)]
@@ -472,6 +503,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn build_into_reuses_buffers_and_equals_build() {
+        let ward = crate::ModelSpec::new("ward").unwrap().build().unwrap();
+        let glass = crate::ModelSpec::new("glass").unwrap().build().unwrap();
+        let wi = frame::from_spherical(0.5, 0.2);
+        let opts = LobeOptions::default();
+        let mut mesh = build(ward.as_ref(), wi, &opts);
+        let ptr = mesh.values.as_ptr();
+        let wi2 = frame::from_spherical(1.0, 0.2);
+        build_into(ward.as_ref(), wi2, &opts, &mut mesh);
+        assert_eq!(mesh.values.as_ptr(), ptr, "buffer reallocated");
+        assert_eq!(mesh, build(ward.as_ref(), wi2, &opts));
+        // A model covering the whole sphere, then a new resolution.
+        build_into(glass.as_ref(), wi, &opts, &mut mesh);
+        assert_eq!(mesh, build(glass.as_ref(), wi, &opts));
+        let small = LobeOptions {
+            n_theta: 5,
+            n_phi: 7,
+            ..opts
+        };
+        build_into(ward.as_ref(), wi, &small, &mut mesh);
+        assert_eq!(mesh, build(ward.as_ref(), wi, &small));
+        assert_eq!(mesh.positions.len(), 6 * 7);
     }
 
     #[test]

@@ -639,7 +639,8 @@ impl ScaleLanes {
     ) -> f32 {
         let (u, v) = (hu[0] * self.inv_ax, hu[1] * self.inv_ay);
         let t = u * u + v * v + hu[2] * hu[2];
-        let s = |w: [f32; 3]| (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt();
+        let s =
+            |w: [f32; 3]| (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt();
         let (si, so) = (s(wi), s(wo));
         let g = if CORRELATED {
             2.0 * (si * wo[2] + so * wi[2])
