@@ -111,7 +111,7 @@ struct Grid {
 /// uses a handful of resolutions; the cache is emptied if it ever holds more
 /// than [`GRID_CACHE_MAX`], so memory stays bounded.
 fn grid(n_theta: usize, n_phi: usize, full: bool) -> Arc<Grid> {
-    static CACHE: OnceLock<Mutex<HashMap<(usize, usize, bool), Arc<Grid>>>> = OnceLock::new();
+    static CACHE: OnceLock<Mutex<GridCache>> = OnceLock::new();
     let cache = CACHE.get_or_init(Default::default);
     let key = (n_theta, n_phi, full);
     // A panic elsewhere while holding the lock leaves a usable map.
@@ -150,6 +150,9 @@ fn grid(n_theta: usize, n_phi: usize, full: bool) -> Arc<Grid> {
     map.insert(key, g.clone());
     g
 }
+
+/// Grids by `(n_theta, n_phi, full sphere)`.
+type GridCache = HashMap<(usize, usize, bool), Arc<Grid>>;
 
 /// Most grid resolutions kept at once.
 const GRID_CACHE_MAX: usize = 16;
@@ -223,6 +226,9 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
                 },
             );
         }
+        // Largest channel mean and squared radius, gathered here rather than
+        // in two more passes over the mesh.
+        let (mut max_mean, mut max_r2) = (0f32, 0f32);
         for k in 0..n {
             let mut f = [rgb[0][k], rgb[1][k], rgb[2][k]];
             if opts.cosine {
@@ -240,18 +246,24 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
                 RadiusScale::Log => opts.scale.apply(mean as f64) as f32,
             };
             vals[k] = f;
-            pos[k] = [wo[0][k] * r, wo[1][k] * r, wo[2][k] * r];
+            let p = [wo[0][k] * r, wo[1][k] * r, wo[2][k] * r];
+            pos[k] = p;
+            max_mean = max_mean.max(mean);
+            max_r2 = max_r2.max(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
         }
+        (max_mean, max_r2)
     };
-    if parallel {
+    let both_max = |a: (f32, f32), b: (f32, f32)| (a.0.max(b.0), a.1.max(b.1));
+    let (max_mean, max_r2) = if parallel {
         values
             .par_chunks_mut(band * n_phi)
             .zip(positions.par_chunks_mut(band * n_phi))
             .enumerate()
-            .for_each(|(b, rows)| fill(b * band, rows));
+            .map(|(b, rows)| fill(b * band, rows))
+            .reduce(|| (0.0, 0.0), both_max)
     } else {
-        fill(0, (&mut values[..], &mut positions[..]));
-    }
+        fill(0, (&mut values[..], &mut positions[..]))
+    };
 
     grid_normals(
         &positions,
@@ -264,15 +276,8 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
             Vec3::new(grid.dirs[0][k], grid.dirs[1][k], grid.dirs[2][k])
         },
     );
-    let max_value = values
-        .iter()
-        .map(|v| (v[0] + v[1] + v[2]) / 3.0)
-        .fold(0.0f32, f32::max) as f64;
-    let max_radius = positions
-        .iter()
-        .map(|p| Vec3::from_array(*p).length_squared())
-        .fold(0.0f32, f32::max)
-        .sqrt() as f64;
+    let max_value = max_mean as f64;
+    let max_radius = max_r2.sqrt() as f64;
 
     *mesh = LobeMesh {
         positions,
@@ -332,7 +337,7 @@ fn grid_normals(
     let fan = |i: usize, next: usize| {
         let c = p(i, 0);
         (0..n_phi)
-            .map(|j| (p(next, j) - c).cross(p(next, (j + 1) % n_phi) - c))
+            .map(|j| (p(next, j) - c).cross(p(next, if j + 1 == n_phi { 0 } else { j + 1 }) - c))
             .sum::<Vec3>()
     };
     // Pole rows: the north pole (row 0) always; the south pole on a full sphere
@@ -354,8 +359,10 @@ fn grid_normals(
             } else {
                 let up = if i == 0 { p(0, j) } else { p(i - 1, j) };
                 let down = if i == n_theta { p(i, j) } else { p(i + 1, j) };
-                let left = p(i, (j + n_phi - 1) % n_phi);
-                let right = p(i, (j + 1) % n_phi);
+                // Wrap-around without `%`: an integer division per vertex
+                // cost as much as the rest of the normal.
+                let left = p(i, if j == 0 { n_phi - 1 } else { j - 1 });
+                let right = p(i, if j + 1 == n_phi { 0 } else { j + 1 });
                 (down - up).cross(right - left)
             };
             let l = n.length();

@@ -123,13 +123,16 @@ fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
         },
     );
     assert!(d.kernel);
+    #[allow(clippy::needless_range_loop)] // lane i of four arrays
     for i in 0..n {
         let (wi, wo) = dirs.pair(i);
         let want = brdf.eval(wi, wo);
         for c in 0..3 {
             let got = rgb[c][i] as f64;
             let tol = (REL * want[c].abs()).max(ABS);
-            if !((got - want[c]).abs() <= tol) {
+            // NaN fails too.
+            let close = (got - want[c]).abs() <= tol;
+            if !close {
                 return Some(format!(
                     "lane {i} channel {c}: wi {wi} wo {wo}: batch {got:e} vs eval {:e}",
                     want[c]
@@ -183,7 +186,7 @@ fn every_kernel_matches_the_scalar_reference() {
         }
     }
     eprintln!("kernels checked: {}", checked.join(", "));
-    assert!(checked.len() >= WITH_KERNEL.len() + 1, "{checked:?}");
+    assert!(checked.len() > WITH_KERNEL.len(), "{checked:?}");
 }
 
 #[test]
@@ -277,9 +280,9 @@ fn models_without_a_kernel_fall_back_to_eval() {
         },
     );
     assert_eq!((d.kernel, d.isa, d.lanes), (false, "scalar", 1));
-    for i in 0..n {
+    for (i, &red) in rgb[0].iter().enumerate() {
         let (wi, wo) = dirs.pair(i);
-        assert_eq!(rgb[0][i], b.eval(wi, wo).x as f32);
+        assert_eq!(red, b.eval(wi, wo).x as f32);
     }
 }
 
