@@ -318,6 +318,10 @@ fn bench_json_and_threads() {
     assert_eq!(v["threads"], 1);
     assert_eq!(v["params"]["albedo"], serde_json::json!([0.2, 0.3, 0.4]));
     assert!(v["m_evals_per_second"].as_f64().unwrap() > 0.0);
+    // Lambert has a batch kernel; the instruction set is this CPU's.
+    assert_eq!(v["kernel"], true);
+    assert!(["avx512", "avx2+fma", "scalar", "portable"].contains(&v["isa"].as_str().unwrap()));
+    assert!(v["lanes"].as_u64().unwrap() >= 1);
 }
 
 #[test]

@@ -3,15 +3,20 @@
 //!
 //! The pairs are drawn once, uniformly on the upper hemisphere, from
 //! [`bv_core::sampling::rng`] with a fixed seed, so every run evaluates the same
-//! pairs. They are split into chunks that a rayon pool of `--threads` workers
-//! hands to [`Brdf::eval_batch`]. One untimed pass warms up (threads started,
-//! output pages touched, caches filled); then passes are timed until at least
-//! [`MIN_TIMED`] has elapsed, so that small `--pairs` still give a stable rate.
+//! pairs; they are held as structure-of-arrays f32 lanes
+//! ([`bv_core::batch::PairBuf`]). They are split into chunks that a rayon pool
+//! of `--threads` workers hands to [`bv_core::batch::eval`]: the model's SIMD
+//! kernel where it has one, its scalar `eval` otherwise. One untimed pass warms
+//! up (threads started, output pages touched, caches filled); then passes are
+//! timed until at least [`MIN_TIMED`] has elapsed, so that small `--pairs`
+//! still give a stable rate. `--json` also says which path ran: whether the
+//! model has a kernel, the instruction set dispatched and its f32 lanes.
 
 use super::output::print;
 use super::params::ModelArgs;
 use anyhow::Context;
-use bv_core::{Brdf, Rgb, sampling};
+use bv_core::batch::{self, Out, PairBuf};
+use bv_core::{Brdf, sampling};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -26,7 +31,7 @@ pub const CHUNK: usize = 4096;
 /// Most pairs accepted per pass.
 pub const MAX_PAIRS: usize = 50_000_000;
 
-/// Most distinct pairs held in memory (48 bytes each: 48 MiB). A larger
+/// Most distinct pairs held in memory (24 bytes each as f32 lanes: 24 MiB). A larger
 /// `--pairs` evaluates this pool over again, so memory stays bounded
 /// whatever the count; a pool far larger than the caches already measures
 /// the rate of out-of-cache evaluation.
@@ -95,6 +100,8 @@ pub struct BenchResult {
     pub seconds: f64,
     /// Results that were NaN or infinite (a model bug when non-zero).
     pub non_finite: usize,
+    /// The path the evaluations took.
+    pub dispatch: batch::Dispatch,
 }
 
 impl BenchResult {
@@ -123,12 +130,13 @@ pub fn random_pairs(n: usize) -> Vec<(DVec3, DVec3)> {
 /// grow with `count`.
 pub fn measure(
     brdf: &dyn Brdf,
-    pairs: &[(DVec3, DVec3)],
+    pairs: &PairBuf,
     count: usize,
     threads: usize,
     min_timed: Duration,
 ) -> anyhow::Result<BenchResult> {
     anyhow::ensure!(!pairs.is_empty(), "no direction pairs to evaluate");
+    let dispatch = std::sync::OnceLock::new();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -141,8 +149,8 @@ pub fn measure(
             (0..chunks)
                 .into_par_iter()
                 .map_init(
-                    || vec![Rgb::ZERO; CHUNK],
-                    |out, k| {
+                    || [vec![0f32; CHUNK], vec![0f32; CHUNK], vec![0f32; CHUNK]],
+                    |[r, g, b], k| {
                         let first = k * CHUNK;
                         let len = CHUNK.min(count - first);
                         let mut done = 0;
@@ -150,12 +158,21 @@ pub fn measure(
                             let start = (first + done) % pairs.len();
                             let end = (start + len - done).min(pairs.len());
                             let n = end - start;
-                            brdf.eval_batch(&pairs[start..end], &mut out[done..done + n]);
+                            let span = done..done + n;
+                            let mut out = Out {
+                                rgb: [&mut r[span.clone()], &mut g[span.clone()], &mut b[span]],
+                            };
+                            let d = batch::eval(brdf, &pairs.dirs(start..end), &mut out);
+                            dispatch.get_or_init(|| d);
                             done += n;
                         }
-                        let o = &out[..len];
+                        let o = [&r[..len], &g[..len], &b[..len]];
                         std::hint::black_box(o);
-                        o.iter().filter(|f| !f.is_finite()).count()
+                        (0..len)
+                            .filter(|&i| {
+                                !(o[0][i].is_finite() && o[1][i].is_finite() && o[2][i].is_finite())
+                            })
+                            .count()
                     },
                 )
                 .sum()
@@ -173,12 +190,16 @@ pub fn measure(
         }
     }
     let seconds = start.elapsed().as_secs_f64();
+    let dispatch = *dispatch
+        .get()
+        .context("no batch was evaluated (an empty pass)")?;
     Ok(BenchResult {
         pairs: count,
         threads,
         passes,
         seconds,
         non_finite,
+        dispatch,
     })
 }
 
@@ -192,7 +213,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         Some(t) => usize::from(t),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
-    let pairs = random_pairs(args.pairs.min(POOL));
+    let pairs = PairBuf::from_pairs(&random_pairs(args.pairs.min(POOL)));
     let r = measure(brdf.as_ref(), &pairs, args.pairs, threads, MIN_TIMED)?;
     if r.non_finite > 0 {
         super::output::eprint(&format!(
@@ -212,6 +233,10 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             "evals_per_second": rate,
             "m_evals_per_second": rate / 1e6,
             "non_finite": r.non_finite,
+            "kernel": r.dispatch.kernel,
+            "isa": r.dispatch.isa,
+            "lanes": r.dispatch.lanes,
+            "precision": if r.dispatch.kernel { "f32" } else { "f64" },
         });
         format!("{v}\n")
     } else {
@@ -237,6 +262,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bv_core::Rgb;
 
     #[test]
     fn counts_in_both_notations() {
@@ -263,13 +289,16 @@ mod tests {
     #[test]
     fn measure_evaluates_every_pair() {
         let brdf = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
-        let pairs = random_pairs(10_000);
+        let pairs = PairBuf::from_pairs(&random_pairs(10_000));
         let r = measure(brdf.as_ref(), &pairs, pairs.len(), 2, Duration::ZERO).unwrap();
         assert_eq!(
             (r.pairs, r.threads, r.passes, r.non_finite),
             (10_000, 2, 1, 0)
         );
         assert!(r.rate() > 0.0 && r.rate().is_finite());
+        // Lambert has a kernel; the ISA is whatever this CPU offers.
+        assert!(r.dispatch.kernel && r.dispatch.lanes >= 1);
+        assert_eq!(r.dispatch.isa, batch::isa().0);
     }
 
     /// A model that is NaN everywhere, so that every evaluation is counted.
@@ -295,9 +324,12 @@ mod tests {
     fn a_count_above_the_pool_reuses_it_and_evaluates_every_pair() {
         // Chunks wrap around a pool that is not a multiple of CHUNK, and
         // the last chunk is short.
-        let pairs = random_pairs(2 * CHUNK + 3);
+        let pairs = PairBuf::from_pairs(&random_pairs(2 * CHUNK + 3));
         let count = 7 * CHUNK + 5;
         let r = measure(&Nan, &pairs, count, 3, Duration::ZERO).unwrap();
         assert_eq!((r.pairs, r.non_finite), (count, count));
+        // No kernel: the scalar fallback.
+        assert!(!r.dispatch.kernel);
+        assert_eq!((r.dispatch.isa, r.dispatch.lanes), ("scalar", 1));
     }
 }

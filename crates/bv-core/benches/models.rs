@@ -120,6 +120,72 @@ fn eval(c: &mut Criterion) {
     g.finish();
 }
 
+/// The case of `bv bench`'s speed comparison: GGX, separable Smith, α = 0.3,
+/// the exact conductor with copper's index.
+fn conductor_case() -> Option<(String, Box<dyn Brdf>)> {
+    let p = serde_json::json!({"distribution": "ggx", "geometry": "smith", "alpha": 0.3,
+        "fresnel": "conductor", "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14]});
+    let b = ModelSpec::from_json("cook-torrance", &p).and_then(|s| s.build());
+    match b {
+        Ok(b) => Some(("cook-torrance-ggx-smith-conductor".to_string(), b)),
+        Err(e) => {
+            eprintln!("skipping the conductor case: {e}");
+            None
+        }
+    }
+}
+
+/// The f32 batch path (`bv_core::batch::eval`) on one core, in chunks of 4096
+/// pairs as `bv bench` hands them out, for every model (models without a
+/// kernel run their scalar fallback) and the conductor case; the same case
+/// through the f64 `eval_batch` for comparison.
+fn batch_eval(c: &mut Criterion) {
+    use bv_core::batch::{self, Out, PairBuf};
+    const CHUNK: usize = 4096;
+    let pairs = random_pairs(PAIRS, 0xB5);
+    let soa = PairBuf::from_pairs(&pairs);
+    let mut rgb = [vec![0f32; CHUNK], vec![0f32; CHUNK], vec![0f32; CHUNK]];
+    let mut g = c.benchmark_group("batch");
+    g.throughput(Throughput::Elements(PAIRS as u64));
+    g.sample_size(10);
+    g.warm_up_time(Duration::from_millis(500));
+    g.measurement_time(Duration::from_secs(2));
+    let mut all: Vec<(String, Box<dyn Brdf>)> =
+        models().into_iter().map(|(n, _, b)| (n, b)).collect();
+    if let Some(case) = conductor_case() {
+        let mut out = vec![Rgb::ZERO; PAIRS];
+        g.bench_function(format!("{}/f64-scalar", case.0), |bench| {
+            bench.iter(|| {
+                case.1.eval_batch(black_box(&pairs), &mut out);
+                black_box(&out);
+            })
+        });
+        all.push(case);
+    }
+    for (name, b) in all {
+        let (isa, lanes) = batch::isa();
+        let path = if b.batch_kernel().is_some() {
+            format!("{isa}x{lanes}")
+        } else {
+            "fallback".to_string()
+        };
+        g.bench_function(format!("{name}/{path}"), |bench| {
+            bench.iter(|| {
+                for start in (0..PAIRS).step_by(CHUNK) {
+                    let end = (start + CHUNK).min(PAIRS);
+                    let [r, gr, bl] = &mut rgb;
+                    let mut out = Out {
+                        rgb: [&mut r[..], &mut gr[..], &mut bl[..]],
+                    };
+                    batch::eval(b.as_ref(), &soa.dirs(start..end), &mut out);
+                    black_box(&rgb);
+                }
+            })
+        });
+    }
+    g.finish();
+}
+
 fn lobes(c: &mut Criterion) {
     let wi = frame::from_spherical(45f64.to_radians(), 0.3);
     let mut g = c.benchmark_group("lobe");
@@ -137,6 +203,15 @@ fn lobes(c: &mut Criterion) {
             };
             g.bench_function(format!("{name}/{n_theta}x{n_phi}"), |bench| {
                 bench.iter(|| black_box(lobe::build(b.as_ref(), black_box(wi), &opts)))
+            });
+            // A slider step: the same resolution into the previous mesh's
+            // buffers (`lobe::build_into`).
+            let mut mesh = lobe::build(b.as_ref(), wi, &opts);
+            g.bench_function(format!("{name}/{n_theta}x{n_phi}/reuse"), |bench| {
+                bench.iter(|| {
+                    lobe::build_into(b.as_ref(), black_box(wi), &opts, &mut mesh);
+                    black_box(&mesh);
+                })
             });
         }
     }
@@ -175,5 +250,5 @@ fn albedo_curves(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, eval, lobes, albedo_curves);
+criterion_group!(benches, eval, batch_eval, lobes, albedo_curves);
 criterion_main!(benches);

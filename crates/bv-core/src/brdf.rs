@@ -113,6 +113,13 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         }
     }
 
+    /// The model's f32 batch kernel, if it has one (see [`crate::batch`]);
+    /// callers go through [`crate::batch::eval`], which falls back to
+    /// [`Brdf::eval`] lane by lane when this is `None`. Default: none.
+    fn batch_kernel(&self) -> Option<&dyn crate::batch::Kernel> {
+        None
+    }
+
     /// The measured table behind a tabulated model (`merl`) and its lookup
     /// mode, for views that upload the table to the GPU. `None` for analytic
     /// models.

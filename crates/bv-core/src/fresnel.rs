@@ -277,6 +277,129 @@ impl Fresnel {
     }
 }
 
+/// The Fresnel term in f32 lanes, for the batch kernels (see
+/// [`crate::batch`]): the same formulas as [`dielectric`], [`conductor`] and
+/// [`schlick`], with the per-channel constants precomputed. The choice is a
+/// const parameter of [`FresnelLanes::eval`] so that each kernel is compiled
+/// for one choice, without a branch in the lane loop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FresnelLanes {
+    /// Which term: [`FresnelLanes::NONE`], [`FresnelLanes::DIELECTRIC`],
+    /// [`FresnelLanes::CONDUCTOR`] or [`FresnelLanes::SCHLICK`].
+    pub kind: u8,
+    /// η per channel (dielectric, conductor).
+    eta: [f32; 3],
+    /// 1/η per channel (dielectric seen from the −z side).
+    inv_eta: [f32; 3],
+    /// 1/η² per channel, and η² for the −z side (dielectric).
+    inv_eta2: [f32; 3],
+    eta2: [f32; 3],
+    /// k² per channel (conductor).
+    k2: [f32; 3],
+    /// η² k² per channel (conductor).
+    eta2k2: [f32; 3],
+    /// √2 η k per channel (conductor).
+    sqrt2_etak: [f32; 3],
+    /// F0 per channel (Schlick).
+    f0: [f32; 3],
+}
+
+impl FresnelLanes {
+    /// F = 1.
+    pub const NONE: u8 = 0;
+    /// Exact dielectric.
+    pub const DIELECTRIC: u8 = 1;
+    /// Exact conductor.
+    pub const CONDUCTOR: u8 = 2;
+    /// Schlick's approximation.
+    pub const SCHLICK: u8 = 3;
+
+    /// The lane form of `f`.
+    pub fn new(f: &Fresnel) -> Self {
+        let c = |v: Rgb| [v.x as f32, v.y as f32, v.z as f32];
+        let zero = Rgb::ZERO;
+        let (kind, eta, k, f0) = match *f {
+            Fresnel::None => (Self::NONE, Rgb::ONE, zero, zero),
+            Fresnel::Dielectric { eta } => (Self::DIELECTRIC, eta, zero, zero),
+            Fresnel::Conductor { eta, k } => (Self::CONDUCTOR, eta, k, zero),
+            Fresnel::Schlick { f0 } => (Self::SCHLICK, Rgb::ONE, zero, f0),
+        };
+        Self {
+            kind,
+            eta: c(eta),
+            inv_eta: c(Rgb::ONE / eta),
+            inv_eta2: c(Rgb::ONE / (eta * eta)),
+            eta2: c(eta * eta),
+            k2: c(k * k),
+            eta2k2: c(eta * eta * k * k),
+            sqrt2_etak: c(eta * k * std::f64::consts::SQRT_2),
+            f0: c(f0),
+        }
+    }
+
+    /// F per channel at incidence cosine `cos` (signed for the dielectric).
+    #[inline(always)]
+    pub fn eval<const KIND: u8>(&self, cos: f32) -> [f32; 3] {
+        match KIND {
+            Self::DIELECTRIC => {
+                let inside = cos < 0.0;
+                let c = cos.abs().min(1.0);
+                let sin2_i = (1.0 - c * c).max(0.0);
+                std::array::from_fn(|i| {
+                    let eta = if inside { self.inv_eta[i] } else { self.eta[i] };
+                    let inv_eta2 = if inside {
+                        self.eta2[i]
+                    } else {
+                        self.inv_eta2[i]
+                    };
+                    let sin2_t = sin2_i * inv_eta2;
+                    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+                    let r_par = (eta * c - cos_t) / (eta * c + cos_t);
+                    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+                    let f = 0.5 * (r_par * r_par + r_perp * r_perp);
+                    if sin2_t >= 1.0 { 1.0 } else { f }
+                })
+            }
+            Self::CONDUCTOR => {
+                let c = cos.abs().min(1.0);
+                let cos2 = c * c;
+                let sin2 = 1.0 - cos2;
+                std::array::from_fn(|i| {
+                    let t0 = self.eta2[i] - self.k2[i] - sin2;
+                    let a2b2 = (t0 * t0 + 4.0 * self.eta2k2[i]).sqrt();
+                    // a = √((a²+b² + t0)/2) cancels in f32 when t0 < 0 (k > η,
+                    // every metal); since (a²+b²)² − t0² = 4η²k² it is then
+                    // √2 ηk / r with r = √(a²+b² − t0), and otherwise r/√2
+                    // with r = √(a²+b² + t0): r never cancels. Writing
+                    // t2 = 2 cosθ a = P/Q (Q = r or 1) and clearing Q from
+                    // (Rs + Rp)/2 = Rs t3/(t3 + t4) = (t1 − t2) t3/((t1 + t2)(t3 + t4))
+                    // leaves one division per channel.
+                    let r = (a2b2 + t0.abs()).sqrt();
+                    let metal = t0 < 0.0;
+                    let p = if metal {
+                        2.0 * c * self.sqrt2_etak[i]
+                    } else {
+                        std::f32::consts::SQRT_2 * c * r
+                    };
+                    let q = if metal { r } else { 1.0 };
+                    let t1 = a2b2 + cos2;
+                    let t3 = cos2 * a2b2 + sin2 * sin2;
+                    let t1q = t1 * q;
+                    let f = (t1q - p) * t3 * q / ((t1q + p) * (t3 * q + p * sin2));
+                    if t1q + p <= 0.0 { 1.0 } else { f }
+                })
+            }
+            Self::SCHLICK => {
+                let m = (1.0 - cos.abs()).clamp(0.0, 1.0);
+                let m2 = m * m;
+                let w = m2 * m2 * m;
+                std::array::from_fn(|i| self.f0[i] + (1.0 - self.f0[i]) * w)
+            }
+            _ => [1.0; 3],
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,6 +12,7 @@
 //! channel.
 
 pub mod analysis;
+pub mod batch;
 pub mod brdf;
 pub mod error;
 pub mod frame;

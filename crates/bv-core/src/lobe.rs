@@ -3,10 +3,13 @@
 //! `f · cos θo`, on a linear or logarithmic scale. The 3D view and the headless
 //! export draw this mesh; it carries a per-vertex value for colouring.
 
-use crate::{Brdf, DeltaLobe, Rgb, frame, mean_rgb};
+use crate::batch::{self, Out};
+use crate::{Brdf, DeltaLobe, frame};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// How a value becomes a radius.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
@@ -93,18 +96,30 @@ fn grid_direction(i: usize, j: usize, n_theta: usize, n_phi: usize, full: bool) 
     frame::from_spherical(theta, phi)
 }
 
-/// Builds the lobe of `brdf` for light from `wi`. Resolution below 2×3 is raised
-/// to it. Rows are evaluated in parallel for large grids; the trigonometry comes
-/// from per-row and per-column tables, so the cost is the model's evaluations
-/// plus a few vector operations per vertex.
-pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
-    let n_theta = opts.n_theta.max(2);
-    let n_phi = opts.n_phi.max(3);
-    let full = brdf.transmits();
+/// What a lobe mesh of one resolution shares across calls: the grid's
+/// directions (f32 lanes, for the batch evaluator and the fallback normals)
+/// and the triangle list. Only `f` changes when a slider moves.
+#[derive(Debug)]
+struct Grid {
+    /// Vertex directions as structure-of-arrays lanes (x, y, z).
+    dirs: [Vec<f32>; 3],
+    /// The triangle list.
+    indices: Vec<u32>,
+}
+
+/// Grids built so far, keyed by `(n_theta, n_phi, full sphere)`. A viewer
+/// uses a handful of resolutions; the cache is emptied if it ever holds more
+/// than [`GRID_CACHE_MAX`], so memory stays bounded.
+fn grid(n_theta: usize, n_phi: usize, full: bool) -> Arc<Grid> {
+    static CACHE: OnceLock<Mutex<GridCache>> = OnceLock::new();
+    let cache = CACHE.get_or_init(Default::default);
+    let key = (n_theta, n_phi, full);
+    // A panic elsewhere while holding the lock leaves a usable map.
+    if let Some(g) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return g.clone();
+    }
     let rows = n_theta + 1;
     let count = rows * n_phi;
-    let parallel = count >= 4096;
-
     let theta_max = if full { PI } else { FRAC_PI_2 };
     let ring: Vec<(f64, f64)> = (0..rows)
         .map(|i| frame::sin_cos_theta(theta_max * i as f64 / n_theta as f64))
@@ -112,59 +127,159 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
     let column: Vec<(f64, f64)> = (0..n_phi)
         .map(|j| (2.0 * PI * j as f64 / n_phi as f64).sin_cos())
         .collect();
-    let dir = |i: usize, j: usize| {
-        let (st, ct) = ring[i];
-        let (sp, cp) = column[j];
-        DVec3::new(st * cp, st * sp, ct)
-    };
+    let mut dirs = [
+        Vec::with_capacity(count),
+        Vec::with_capacity(count),
+        Vec::with_capacity(count),
+    ];
+    for &(st, ct) in &ring {
+        for &(sp, cp) in &column {
+            dirs[0].push((st * cp) as f32);
+            dirs[1].push((st * sp) as f32);
+            dirs[2].push(ct as f32);
+        }
+    }
+    let g = Arc::new(Grid {
+        dirs,
+        indices: grid_indices(n_theta, n_phi, count >= 4096),
+    });
+    let mut map = cache.lock().unwrap_or_else(|e| e.into_inner());
+    if map.len() >= GRID_CACHE_MAX {
+        map.clear();
+    }
+    map.insert(key, g.clone());
+    g
+}
 
-    let mut values = vec![[0f32; 3]; count];
-    let mut positions = vec![[0f32; 3]; count];
-    let fill_row = |i: usize, (vals, pos): (&mut [[f32; 3]], &mut [[f32; 3]])| {
-        for j in 0..n_phi {
-            let wo = dir(i, j);
-            let mut f: Rgb = brdf.eval(wi, wo);
+/// Grids by `(n_theta, n_phi, full sphere)`.
+type GridCache = HashMap<(usize, usize, bool), Arc<Grid>>;
+
+/// Most grid resolutions kept at once.
+const GRID_CACHE_MAX: usize = 16;
+
+/// Builds the lobe of `brdf` for light from `wi`. Resolution below 2×3 is raised
+/// to it. The direction grid and the triangle list of each resolution are built
+/// once and reused; the values come from the batch evaluator
+/// ([`crate::batch::eval`]: the model's f32 SIMD kernel, or its `eval`), rows
+/// in parallel for large grids, so the cost is the model's evaluations plus a
+/// few vector operations per vertex. [`build_into`] also reuses the buffers of
+/// a previous mesh.
+pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
+    let mut mesh = LobeMesh::default();
+    build_into(brdf, wi, opts, &mut mesh);
+    mesh
+}
+
+/// [`build`] into an existing mesh, reusing its buffers: when a slider moves
+/// and the resolution stays, nothing is allocated and the triangle list is
+/// not rewritten (it is taken as the one an earlier call wrote), so only the
+/// values, positions and normals are computed.
+pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMesh) {
+    let n_theta = opts.n_theta.max(2);
+    let n_phi = opts.n_phi.max(3);
+    let full = brdf.transmits();
+    let rows = n_theta + 1;
+    let count = rows * n_phi;
+    let parallel = count >= 4096;
+    let grid = grid(n_theta, n_phi, full);
+    let wi32 = [wi.x as f32, wi.y as f32, wi.z as f32];
+
+    let same_grid = mesh.n_theta == n_theta
+        && mesh.n_phi == n_phi
+        && mesh.full_sphere == full
+        && mesh.indices.len() == grid.indices.len();
+    let mut values = std::mem::take(&mut mesh.values);
+    let mut positions = std::mem::take(&mut mesh.positions);
+    let mut normals = std::mem::take(&mut mesh.normals);
+    let mut indices = std::mem::take(&mut mesh.indices);
+    values.resize(count, [0.0; 3]);
+    positions.resize(count, [0.0; 3]);
+    normals.resize(count, [0.0; 3]);
+    // The triangle list depends on the resolution only; a mesh of the same
+    // resolution already holds it (callers do not edit it).
+    if !same_grid {
+        indices.clear();
+        indices.extend_from_slice(&grid.indices);
+    }
+    // Rows per task: enough lanes per batch call to fill the vectors.
+    let band = (2048 / n_phi).max(1);
+    let fill = |first_row: usize, (vals, pos): (&mut [[f32; 3]], &mut [[f32; 3]])| {
+        let start = first_row * n_phi;
+        let n = vals.len();
+        let wo = [
+            &grid.dirs[0][start..start + n],
+            &grid.dirs[1][start..start + n],
+            &grid.dirs[2][start..start + n],
+        ];
+        let wis = [vec![wi32[0]; n], vec![wi32[1]; n], vec![wi32[2]; n]];
+        let mut rgb = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
+        {
+            let [r, g, b] = &mut rgb;
+            batch::eval(
+                brdf,
+                &batch::Dirs {
+                    wi: [&wis[0], &wis[1], &wis[2]],
+                    wo,
+                },
+                &mut Out {
+                    rgb: [&mut r[..], &mut g[..], &mut b[..]],
+                },
+            );
+        }
+        // Largest channel mean and squared radius, gathered here rather than
+        // in two more passes over the mesh.
+        let (mut max_mean, mut max_r2) = (0f32, 0f32);
+        for k in 0..n {
+            let mut f = [rgb[0][k], rgb[1][k], rgb[2][k]];
             if opts.cosine {
-                f *= wo.z.abs();
+                let c = wo[2][k].abs();
+                f = f.map(|v| v * c);
             }
             // A model bug must not poison the whole mesh: show it as 0 here; the
             // property analysis reports non-finite values loudly.
-            if !f.is_finite() {
-                f = Rgb::ZERO;
+            if !f.iter().all(|v| v.is_finite()) {
+                f = [0.0; 3];
             }
-            let r = opts.scale.apply(mean_rgb(f).max(0.0));
-            vals[j] = f.as_vec3().to_array();
-            pos[j] = (wo * r).as_vec3().to_array();
+            let mean = ((f[0] + f[1] + f[2]) / 3.0).max(0.0);
+            let r = match opts.scale {
+                RadiusScale::Linear => mean,
+                RadiusScale::Log => opts.scale.apply(mean as f64) as f32,
+            };
+            vals[k] = f;
+            let p = [wo[0][k] * r, wo[1][k] * r, wo[2][k] * r];
+            pos[k] = p;
+            max_mean = max_mean.max(mean);
+            max_r2 = max_r2.max(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
         }
+        (max_mean, max_r2)
     };
-    if parallel {
+    let both_max = |a: (f32, f32), b: (f32, f32)| (a.0.max(b.0), a.1.max(b.1));
+    let (max_mean, max_r2) = if parallel {
         values
-            .par_chunks_mut(n_phi)
-            .zip(positions.par_chunks_mut(n_phi))
+            .par_chunks_mut(band * n_phi)
+            .zip(positions.par_chunks_mut(band * n_phi))
             .enumerate()
-            .for_each(|(i, rows)| fill_row(i, rows));
+            .map(|(b, rows)| fill(b * band, rows))
+            .reduce(|| (0.0, 0.0), both_max)
     } else {
-        let rows = values.chunks_mut(n_phi).zip(positions.chunks_mut(n_phi));
-        for (i, rows) in rows.enumerate() {
-            fill_row(i, rows);
-        }
-    }
+        fill(0, (&mut values[..], &mut positions[..]))
+    };
 
-    let indices = grid_indices(n_theta, n_phi, parallel);
-    let normals = grid_normals(&positions, n_theta, n_phi, parallel, |i, j| {
-        dir(i, j).as_vec3()
-    });
-    let max_value = values
-        .iter()
-        .map(|v| mean_rgb(Vec3::from_array(*v).as_dvec3()))
-        .fold(0.0, f64::max);
-    let max_radius = positions
-        .iter()
-        .map(|p| Vec3::from_array(*p).length_squared())
-        .fold(0.0f32, f32::max)
-        .sqrt() as f64;
+    grid_normals(
+        &positions,
+        &mut normals,
+        n_theta,
+        n_phi,
+        parallel,
+        |i, j| {
+            let k = i * n_phi + j;
+            Vec3::new(grid.dirs[0][k], grid.dirs[1][k], grid.dirs[2][k])
+        },
+    );
+    let max_value = max_mean as f64;
+    let max_radius = max_r2.sqrt() as f64;
 
-    LobeMesh {
+    *mesh = LobeMesh {
         positions,
         normals,
         values,
@@ -175,7 +290,7 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
         max_value,
         max_radius,
         deltas: brdf.deltas(wi),
-    }
+    };
 }
 
 /// Two triangles per grid cell; the φ seam wraps. θ grows away from the pole
@@ -212,16 +327,17 @@ fn grid_indices(n_theta: usize, n_phi: usize, parallel: bool) -> Vec<u32> {
 /// lobe) gets its grid direction, so shading never sees a NaN.
 fn grid_normals(
     positions: &[[f32; 3]],
+    normals: &mut [[f32; 3]],
     n_theta: usize,
     n_phi: usize,
     parallel: bool,
     fallback: impl Fn(usize, usize) -> Vec3 + Sync,
-) -> Vec<[f32; 3]> {
+) {
     let p = |i: usize, j: usize| Vec3::from_array(positions[i * n_phi + j]);
     let fan = |i: usize, next: usize| {
         let c = p(i, 0);
         (0..n_phi)
-            .map(|j| (p(next, j) - c).cross(p(next, (j + 1) % n_phi) - c))
+            .map(|j| (p(next, j) - c).cross(p(next, if j + 1 == n_phi { 0 } else { j + 1 }) - c))
             .sum::<Vec3>()
     };
     // Pole rows: the north pole (row 0) always; the south pole on a full sphere
@@ -243,8 +359,10 @@ fn grid_normals(
             } else {
                 let up = if i == 0 { p(0, j) } else { p(i - 1, j) };
                 let down = if i == n_theta { p(i, j) } else { p(i + 1, j) };
-                let left = p(i, (j + n_phi - 1) % n_phi);
-                let right = p(i, (j + 1) % n_phi);
+                // Wrap-around without `%`: an integer division per vertex
+                // cost as much as the rest of the normal.
+                let left = p(i, if j == 0 { n_phi - 1 } else { j - 1 });
+                let right = p(i, if j + 1 == n_phi { 0 } else { j + 1 });
                 (down - up).cross(right - left)
             };
             let l = n.length();
@@ -255,7 +373,6 @@ fn grid_normals(
             };
         }
     };
-    let mut normals = vec![[0f32; 3]; positions.len()];
     if parallel {
         normals
             .par_chunks_mut(n_phi)
@@ -266,12 +383,12 @@ fn grid_normals(
             normal_row(i, out);
         }
     }
-    normals
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Rgb;
     use crate::models::lambert::Lambert;
 
     #[test]
@@ -347,6 +464,77 @@ mod tests {
         let theta = FRAC_PI_2 * i as f64 / 64.0;
         let r = Vec3::from_array(m.positions[i * 128]).length() as f64;
         assert!((r - (theta.cos() / PI).ln_1p()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn batch_values_match_eval_and_grids_are_reused() {
+        // Values through the batch path (a kernel for cook-torrance, the
+        // scalar fallback for glass) agree with `eval` at the grid directions,
+        // and a second mesh of the same resolution reuses the cached grid.
+        let wi = frame::from_spherical(0.7, 0.4);
+        for (id, p) in [
+            (
+                "cook-torrance",
+                serde_json::json!({"distribution": "ggx", "geometry": "smith", "alpha": 0.3,
+                    "fresnel": "conductor", "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14]}),
+            ),
+            ("glass", serde_json::json!({})),
+        ] {
+            let b = crate::ModelSpec::from_json(id, &p)
+                .unwrap()
+                .build()
+                .unwrap();
+            let opts = LobeOptions {
+                n_theta: 24,
+                n_phi: 40,
+                ..LobeOptions::default()
+            };
+            let m = build(b.as_ref(), wi, &opts);
+            let g = grid(24, 40, b.transmits());
+            assert!(Arc::ptr_eq(&g, &grid(24, 40, b.transmits())));
+            assert_eq!(m.indices, g.indices);
+            let wi32 = wi.as_vec3().as_dvec3();
+            for (k, v) in m.values.iter().enumerate() {
+                let wo = DVec3::new(
+                    g.dirs[0][k] as f64,
+                    g.dirs[1][k] as f64,
+                    g.dirs[2][k] as f64,
+                );
+                let want = b.eval(wi32, wo);
+                for c in 0..3 {
+                    let tol = (1e-4 * want[c].abs()).max(1e-6);
+                    assert!(
+                        (v[c] as f64 - want[c]).abs() <= tol,
+                        "{id} {k}: {v:?} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn build_into_reuses_buffers_and_equals_build() {
+        let ward = crate::ModelSpec::new("ward").unwrap().build().unwrap();
+        let glass = crate::ModelSpec::new("glass").unwrap().build().unwrap();
+        let wi = frame::from_spherical(0.5, 0.2);
+        let opts = LobeOptions::default();
+        let mut mesh = build(ward.as_ref(), wi, &opts);
+        let ptr = mesh.values.as_ptr();
+        let wi2 = frame::from_spherical(1.0, 0.2);
+        build_into(ward.as_ref(), wi2, &opts, &mut mesh);
+        assert_eq!(mesh.values.as_ptr(), ptr, "buffer reallocated");
+        assert_eq!(mesh, build(ward.as_ref(), wi2, &opts));
+        // A model covering the whole sphere, then a new resolution.
+        build_into(glass.as_ref(), wi, &opts, &mut mesh);
+        assert_eq!(mesh, build(glass.as_ref(), wi, &opts));
+        let small = LobeOptions {
+            n_theta: 5,
+            n_phi: 7,
+            ..opts
+        };
+        build_into(ward.as_ref(), wi, &small, &mut mesh);
+        assert_eq!(mesh, build(ward.as_ref(), wi, &small));
+        assert_eq!(mesh.positions.len(), 6 * 7);
     }
 
     #[test]

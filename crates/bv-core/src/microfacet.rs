@@ -556,6 +556,125 @@ pub fn sample_reflection_pdf(ndf: &Microfacet, wi: DVec3, wo: DVec3) -> f64 {
     ndf.pdf_h(wi, h) / (4.0 * c)
 }
 
+/// One roughness scale in f32 lanes, for the batch kernels (see
+/// [`crate::batch`]): [`beckmann_d`], [`ggx_d`], [`beckmann_lambda`] and
+/// [`ggx_lambda`] ported to f32, the distribution a const parameter
+/// ([`ScaleLanes::BECKMANN`] or [`ScaleLanes::GGX`]). Blinn's D (an `atan2`
+/// of the half vector) has no lane form yet.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScaleLanes {
+    inv_ax2: f32,
+    inv_ay2: f32,
+    inv_ax: f32,
+    inv_ay: f32,
+    ax2: f32,
+    ay2: f32,
+    /// 1/(π αx αy).
+    norm: f32,
+}
+
+impl ScaleLanes {
+    /// Beckmann.
+    pub const BECKMANN: u8 = 0;
+    /// GGX.
+    pub const GGX: u8 = 1;
+
+    /// The lane form of `s`, with its const tag; `None` for Blinn.
+    pub fn new(s: &Scale) -> Option<(u8, Self)> {
+        let tag = match s.dist {
+            Distribution::Beckmann => Self::BECKMANN,
+            Distribution::Ggx => Self::GGX,
+            Distribution::Blinn => return None,
+        };
+        let (ax, ay) = (s.ax, s.ay);
+        Some((
+            tag,
+            Self {
+                inv_ax2: (1.0 / (ax * ax)) as f32,
+                inv_ay2: (1.0 / (ay * ay)) as f32,
+                inv_ax: (1.0 / ax) as f32,
+                inv_ay: (1.0 / ay) as f32,
+                ax2: (ax * ax) as f32,
+                ay2: (ay * ay) as f32,
+                norm: (FRAC_1_PI / (ax * ay)) as f32,
+            },
+        ))
+    }
+
+    /// D(h) for a unit `h`.
+    #[inline(always)]
+    pub fn d<const DIST: u8>(&self, h: [f32; 3]) -> f32 {
+        let [x, y, z] = h;
+        let v = if DIST == Self::GGX {
+            let (u, v) = (x * self.inv_ax, y * self.inv_ay);
+            let t = u * u + v * v + z * z;
+            self.norm / (t * t)
+        } else {
+            let z2 = z * z;
+            let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) / z2;
+            // As in `beckmann_d`: exp underflows (f32: e > 87) long before
+            // the cos⁴ factor, so 0 there avoids 0/0 at the horizon.
+            let d = crate::batch::math::exp(-e) * self.norm / (z2 * z2);
+            if e > 87.0 { 0.0 } else { d }
+        };
+        if z > 0.0 { v } else { 0.0 }
+    }
+
+    /// GGX's `D(h) G(wi, wo) / (4 cosθi cosθo)` with separable
+    /// (`CORRELATED = false`) or height-correlated Smith G, from the
+    /// unnormalised half vector `hu = wi + wo` and `l2 = |hu|²`, with a single
+    /// division: with `T = hux²/αx² + huy²/αy² + huz²`, `D = l2² / (π αx αy T²)`
+    /// (`h = hu/√l2` in [`ggx_d`]), and with `s = √(z² + wx²αx² + wy²αy²)`,
+    /// `1 + Λ(w) = (z + s)/(2z)` ([`ggx_lambda`]), so the cosines cancel:
+    /// separable `G/(4 zi zo) = 1/((zi + si)(zo + so))`, correlated
+    /// `G/(4 zi zo) = 1/(2 (si zo + so zi))`. Both directions must be above
+    /// the horizon (the caller masks the others).
+    #[inline(always)]
+    pub fn ggx_dg<const CORRELATED: bool>(
+        &self,
+        wi: [f32; 3],
+        wo: [f32; 3],
+        hu: [f32; 3],
+        l2: f32,
+    ) -> f32 {
+        let (u, v) = (hu[0] * self.inv_ax, hu[1] * self.inv_ay);
+        let t = u * u + v * v + hu[2] * hu[2];
+        let s =
+            |w: [f32; 3]| (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt();
+        let (si, so) = (s(wi), s(wo));
+        let g = if CORRELATED {
+            2.0 * (si * wo[2] + so * wi[2])
+        } else {
+            (wi[2] + si) * (wo[2] + so)
+        };
+        self.norm * (l2 * l2) / (t * t * g)
+    }
+
+    /// `1 + Λ(w)` (+∞ at and below the horizon): the form every G needs.
+    /// GGX's `1 + (−1 + √(1 + t))/2` is `(1 + √(1 + t))/2`.
+    #[inline(always)]
+    pub fn one_plus_lambda<const DIST: u8>(&self, w: [f32; 3]) -> f32 {
+        let [x, y, z] = w;
+        let t = (x * x * self.ax2 + y * y * self.ay2) / (z * z);
+        let v = if DIST == Self::GGX {
+            0.5 * (1.0 + (1.0 + t).sqrt())
+        } else {
+            // beckmann_lambda_a with a = 1/(α tanθ) = 1/√t.
+            let a = 1.0 / t.sqrt();
+            let l = 0.5
+                * (crate::batch::math::exp(-a * a) / (a * SQRT_PI as f32)
+                    - crate::batch::math::erfc(a));
+            let l = if a > 26.0 { 0.0 } else { l.max(0.0) };
+            1.0 + if t == 0.0 { 0.0 } else { l }
+        };
+        if z > 0.0 && t < f32::INFINITY {
+            v
+        } else {
+            f32::INFINITY
+        }
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

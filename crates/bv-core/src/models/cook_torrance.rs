@@ -3,9 +3,10 @@
 //! 1982, eq. in §"The reflectance model"; Walter et al. 2007, eq. 20), with the
 //! choices of D, G and F of SPEC §2 ("Microfacet parts").
 
-use crate::fresnel::{self, Fresnel};
+use crate::batch::{self, Dirs, Kernel, LaneKernel, Out, math};
+use crate::fresnel::{self, Fresnel, FresnelLanes};
 use crate::microfacet::{
-    self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet,
+    self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
 };
 use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
 use crate::registry::ModelInfo;
@@ -100,6 +101,8 @@ pub struct CookTorrance {
     fresnel: Fresnel,
     /// Probability of drawing the diffuse lobe in [`Brdf::sample`].
     p_diffuse: f64,
+    /// The f32 batch kernel (none for Blinn's D).
+    kernel: Option<CtKernel>,
 }
 
 impl CookTorrance {
@@ -117,6 +120,7 @@ impl CookTorrance {
             geometry,
             fresnel,
             p_diffuse,
+            kernel: CtKernel::new(kd * FRAC_1_PI, ks, &ndf, geometry, &fresnel),
         }
     }
 
@@ -225,6 +229,163 @@ impl Brdf for CookTorrance {
 
     fn ndf(&self) -> Option<&dyn Ndf> {
         Some(&self.ndf)
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        self.kernel.as_ref().map(|k| k as &dyn Kernel)
+    }
+}
+
+/// [`CookTorrance::eval`] in f32 lanes: the same `kd/π + ks F D G / (4 cosθi
+/// cosθo)` with the lane forms of D, Λ and F. Each combination of D (Beckmann,
+/// GGX), G, F and mixture on/off is its own monomorphised loop ([`CtLane`]),
+/// so the lane code has no branch on the model's choices.
+#[derive(Debug, Clone, Copy)]
+struct CtKernel {
+    diffuse: [f32; 3],
+    ks: f32,
+    dist: u8,
+    first: ScaleLanes,
+    second: ScaleLanes,
+    /// Weight of the second scale, strictly inside (0, 1) when `mix`.
+    w2: f32,
+    mix: bool,
+    geometry: u8,
+    fresnel: FresnelLanes,
+}
+
+const VGROOVE: u8 = 0;
+const SMITH: u8 = 1;
+const CORRELATED: u8 = 2;
+
+impl CtKernel {
+    fn new(
+        diffuse: Rgb,
+        ks: f64,
+        ndf: &Microfacet,
+        geometry: Geometry,
+        fresnel: &Fresnel,
+    ) -> Option<Self> {
+        let (dist, first) = ScaleLanes::new(&ndf.first)?;
+        let (_, second) = ScaleLanes::new(&ndf.second)?;
+        // w2 = 1 is the second scale alone (as `Microfacet::lambda` treats it):
+        // a mixture weight of exactly 0 would multiply the first scale's
+        // infinite Λ at the horizon into NaN.
+        let (first, mix) = if ndf.w2 >= 1.0 {
+            (second, false)
+        } else {
+            (first, ndf.w2 > 0.0)
+        };
+        Some(Self {
+            diffuse: [diffuse.x as f32, diffuse.y as f32, diffuse.z as f32],
+            ks: ks as f32,
+            dist,
+            first,
+            second,
+            w2: ndf.w2 as f32,
+            mix,
+            geometry: match geometry {
+                Geometry::VGroove => VGROOVE,
+                Geometry::Smith => SMITH,
+                Geometry::SmithCorrelated => CORRELATED,
+            },
+            fresnel: FresnelLanes::new(fresnel),
+        })
+    }
+}
+
+/// One monomorphised combination of [`CtKernel`]'s choices.
+#[derive(Debug)]
+struct CtLane<'a, const D: u8, const G: u8, const F: u8, const MIX: bool>(&'a CtKernel);
+
+impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
+    for CtLane<'_, D, G, F, MIX>
+{
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let k = self.0;
+        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        // frame::half_vector: one square root and one division.
+        let hu = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let l2 = math::dot(hu, hu);
+        let inv = 1.0 / l2.sqrt();
+        let h = hu.map(|c| c * inv);
+        if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
+            // The common GGX-Smith case with one division for D G/(4 cos cos).
+            let scalar = if G == CORRELATED {
+                k.first.ggx_dg::<true>(wi, wo, hu, l2)
+            } else {
+                k.first.ggx_dg::<false>(wi, wo, hu, l2)
+            };
+            let ok = above && l2 > 1e-24 && l2 < f32::INFINITY && scalar.is_finite();
+            let scalar = if ok { scalar * k.ks } else { 0.0 };
+            let fr = k.fresnel.eval::<F>(math::dot(wi, h));
+            let f: [f32; 3] = std::array::from_fn(|c| k.diffuse[c] + fr[c] * scalar);
+            return if above { f } else { [0.0; 3] };
+        }
+        let w1 = 1.0 - k.w2;
+        let d = if MIX {
+            w1 * k.first.d::<D>(h) + k.w2 * k.second.d::<D>(h)
+        } else {
+            k.first.d::<D>(h)
+        };
+        let opl = |w: [f32; 3]| {
+            if MIX {
+                w1 * k.first.one_plus_lambda::<D>(w) + k.w2 * k.second.one_plus_lambda::<D>(w)
+            } else {
+                k.first.one_plus_lambda::<D>(w)
+            }
+        };
+        let g = match G {
+            VGROOVE => {
+                let oh = math::dot(wo, h);
+                let kk = 2.0 * h[2] / oh;
+                let g = 1f32.min(kk * wo[2]).min(kk * wi[2]);
+                if oh > 0.0 && h[2] > 0.0 { g } else { 0.0 }
+            }
+            SMITH => 1.0 / (opl(wi) * opl(wo)),
+            _ => 1.0 / (opl(wi) + opl(wo) - 1.0),
+        };
+        let scalar = d * g / (4.0 * wi[2] * wo[2]);
+        let ok = above && l2 > 1e-24 && l2 < f32::INFINITY && scalar.is_finite();
+        let scalar = if ok { scalar * k.ks } else { 0.0 };
+        let fr = k.fresnel.eval::<F>(math::dot(wi, h));
+        let f: [f32; 3] = std::array::from_fn(|c| k.diffuse[c] + fr[c] * scalar);
+        if above { f } else { [0.0; 3] }
+    }
+}
+
+impl Kernel for CtKernel {
+    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        macro_rules! go {
+            ($d:expr, $g:expr, $f:expr) => {
+                if self.mix {
+                    batch::run(&CtLane::<$d, $g, $f, true>(self), dirs, out)
+                } else {
+                    batch::run(&CtLane::<$d, $g, $f, false>(self), dirs, out)
+                }
+            };
+            ($d:expr, $g:expr) => {
+                match self.fresnel.kind {
+                    FresnelLanes::DIELECTRIC => go!($d, $g, { FresnelLanes::DIELECTRIC }),
+                    FresnelLanes::CONDUCTOR => go!($d, $g, { FresnelLanes::CONDUCTOR }),
+                    FresnelLanes::SCHLICK => go!($d, $g, { FresnelLanes::SCHLICK }),
+                    _ => go!($d, $g, { FresnelLanes::NONE }),
+                }
+            };
+            ($d:expr) => {
+                match self.geometry {
+                    VGROOVE => go!($d, VGROOVE),
+                    SMITH => go!($d, SMITH),
+                    _ => go!($d, CORRELATED),
+                }
+            };
+        }
+        if self.dist == ScaleLanes::GGX {
+            go!({ ScaleLanes::GGX })
+        } else {
+            go!({ ScaleLanes::BECKMANN })
+        }
     }
 }
 

@@ -1,5 +1,6 @@
 //! Lambert: the ideal diffuse reflector, `f = albedo / π`.
 
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::params::{ColorSpec, ParamDecl, ParamKind, Params};
 use crate::registry::ModelInfo;
 use crate::{Brdf, Claims, Result, Rgb};
@@ -30,6 +31,24 @@ pub struct Lambert {
     /// ρ / π, precomputed.
     f: Rgb,
     albedo: Rgb,
+    kernel: LambertLanes,
+}
+
+/// [`Lambert`]'s f32 batch kernel: `ρ/π` above the horizon.
+#[derive(Debug, Clone, Copy)]
+struct LambertLanes {
+    f: [f32; 3],
+}
+
+impl LaneKernel for LambertLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        if wi[2] > 0.0 && wo[2] > 0.0 {
+            self.f
+        } else {
+            [0.0; 3]
+        }
+    }
 }
 
 impl Lambert {
@@ -38,6 +57,9 @@ impl Lambert {
         Self {
             f: albedo * FRAC_1_PI,
             albedo,
+            kernel: LambertLanes {
+                f: math::rgb(albedo * FRAC_1_PI),
+            },
         }
     }
 }
@@ -56,6 +78,10 @@ impl Brdf for Lambert {
             return Rgb::ZERO;
         }
         self.f
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn claims(&self) -> Claims {

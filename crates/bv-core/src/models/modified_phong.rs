@@ -7,6 +7,7 @@
 //! `(e+2)/(2π)` so that the specular albedo at normal incidence is exactly `ks`.
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
 use crate::registry::ModelInfo;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
@@ -53,6 +54,35 @@ pub struct ModifiedPhong {
     e: f64,
     /// `(e+2)/(2π)`, precomputed.
     norm: f64,
+    kernel: ModifiedPhongLanes,
+}
+
+/// [`ModifiedPhong`]'s f32 batch kernel: `kd/π + ks (e+2)/(2π) (R(wo)·wi)^e`,
+/// the cosine in f64 and the lobe from `1 − R(wo)·wi` as in `phong`'s kernel.
+#[derive(Debug, Clone, Copy)]
+struct ModifiedPhongLanes {
+    diffuse: [f32; 3],
+    /// ks (e+2)/(2π).
+    spec: [f32; 3],
+    e: f32,
+}
+
+impl LaneKernel for ModifiedPhongLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let [ix, iy, iz] = wi.map(f64::from);
+        let [ox, oy, oz] = wo.map(f64::from);
+        let x = -ox * ix + -oy * iy + oz * iz;
+        let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.e);
+        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        std::array::from_fn(|c| {
+            if above {
+                self.diffuse[c] + self.spec[c] * lobe
+            } else {
+                0.0
+            }
+        })
+    }
 }
 
 impl ModifiedPhong {
@@ -63,6 +93,11 @@ impl ModifiedPhong {
             ks,
             e,
             norm: (e + 2.0) / (2.0 * PI),
+            kernel: ModifiedPhongLanes {
+                diffuse: math::rgb(kd * FRAC_1_PI),
+                spec: math::rgb(ks * ((e + 2.0) / (2.0 * PI))),
+                e: e as f32,
+            },
         }
     }
 
@@ -111,6 +146,10 @@ impl Brdf for ModifiedPhong {
     /// `ks` elsewhere. Hence `max ρhd = kd + ks`, reached at normal incidence:
     /// energy is conserved **iff** `kd + ks ≤ 1` in every channel (the lecture's
     /// "sufficient" condition is also necessary for this model).
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
+    }
+
     fn claims(&self) -> Claims {
         Claims {
             reciprocal: true,

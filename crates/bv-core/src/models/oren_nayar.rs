@@ -2,6 +2,7 @@
 //! distribution of standard deviation σ, in the "qualitative model" of Oren &
 //! Nayar 1994, "Generalization of Lambert's reflectance model" (SIGGRAPH), eq. 30.
 
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
 use crate::registry::ModelInfo;
 use crate::{Brdf, Claims, Result, Rgb};
@@ -44,17 +45,44 @@ pub struct OrenNayar {
     a: f64,
     /// `B = 0.45 σ²/(σ² + 0.09)`.
     b: f64,
+    kernel: OrenNayarLanes,
+}
+
+/// [`OrenNayar`]'s f32 batch kernel: the same `ρ/π (A + B t)` with
+/// `t = max(0, wi·wo tangential)/max(cosθi, cosθo)`.
+#[derive(Debug, Clone, Copy)]
+struct OrenNayarLanes {
+    albedo_over_pi: [f32; 3],
+    a: f32,
+    b: f32,
+}
+
+impl LaneKernel for OrenNayarLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let tangential = wi[0] * wo[0] + wi[1] * wo[1];
+        let t = tangential.max(0.0) / wi[2].max(wo[2]);
+        let s = self.a + self.b * t;
+        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        self.albedo_over_pi.map(|c| if above { c * s } else { 0.0 })
+    }
 }
 
 impl OrenNayar {
     /// The model for albedo `albedo` and roughness `sigma` (radians).
     pub fn new(albedo: Rgb, sigma: f64) -> Self {
         let s2 = sigma * sigma;
+        let (a, b) = (1.0 - 0.5 * s2 / (s2 + 0.33), 0.45 * s2 / (s2 + 0.09));
         Self {
             albedo_over_pi: albedo * FRAC_1_PI,
             albedo,
-            a: 1.0 - 0.5 * s2 / (s2 + 0.33),
-            b: 0.45 * s2 / (s2 + 0.09),
+            a,
+            b,
+            kernel: OrenNayarLanes {
+                albedo_over_pi: math::rgb(albedo * FRAC_1_PI),
+                a: a as f32,
+                b: b as f32,
+            },
         }
     }
 
@@ -93,6 +121,10 @@ impl Brdf for OrenNayar {
         let tangential = wi.x * wo.x + wi.y * wo.y;
         let t = tangential.max(0.0) / wi.z.max(wo.z);
         self.albedo_over_pi * (self.a + self.b * t)
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn claims(&self) -> Claims {

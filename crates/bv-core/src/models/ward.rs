@@ -7,6 +7,7 @@
 //! (Cornell PCG-05-06), eqs. 6–9.
 
 use super::lobes::{COS_FLOOR, half_unnormalised};
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
 use crate::registry::ModelInfo;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
@@ -59,12 +60,58 @@ pub struct Ward {
     ks: Rgb,
     ax: f64,
     ay: f64,
+    kernel: WardLanes,
+}
+
+/// [`Ward`]'s f32 batch kernel: `kd/π + ks exp(−tan²θh(…)) / (4π αx αy
+/// √cosθi √cosθo)`, the exponent from the unnormalised `wi + wo` (it is
+/// invariant under scaling, so `half_unnormalised`'s rescaling is not needed).
+#[derive(Debug, Clone, Copy)]
+struct WardLanes {
+    diffuse: [f32; 3],
+    ks: [f32; 3],
+    inv_ax2: f32,
+    inv_ay2: f32,
+    /// 1/(4π αx αy).
+    norm: f32,
+}
+
+impl LaneKernel for WardLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let s = v[0] * v[0] * self.inv_ax2 + v[1] * v[1] * self.inv_ay2;
+        let e = s / (v[2] * v[2]);
+        let g = math::exp(-(if s > 0.0 { e } else { 0.0 }));
+        let spec = g * self.norm / (wi[2].sqrt() * wo[2].sqrt());
+        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        std::array::from_fn(|c| {
+            if above {
+                self.diffuse[c] + self.ks[c] * spec
+            } else {
+                0.0
+            }
+        })
+    }
 }
 
 impl Ward {
     /// A Ward BRDF with roughnesses `ax` (along +x) and `ay` (along +y).
     pub fn new(kd: Rgb, ks: Rgb, ax: f64, ay: f64) -> Self {
-        Self { kd, ks, ax, ay }
+        let kernel = WardLanes {
+            diffuse: math::rgb(kd * FRAC_1_PI),
+            ks: math::rgb(ks),
+            inv_ax2: (1.0 / (ax * ax)) as f32,
+            inv_ay2: (1.0 / (ay * ay)) as f32,
+            norm: (1.0 / (4.0 * PI * ax * ay)) as f32,
+        };
+        Self {
+            kd,
+            ks,
+            ax,
+            ay,
+            kernel,
+        }
     }
 
     /// `tan²θh (cos²φh/αx² + sin²φh/αy²)` of the half vector along `v` (any
@@ -151,6 +198,10 @@ impl Brdf for Ward {
     /// normal incidence for ks = 1, α = 0.5), and the excess appears only very
     /// close to grazing (beyond ≈ 89.8° for ks = 1, α = 0.5; see the tests).
     /// With `ks = 0` the model is Lambertian: conserving iff `kd ≤ 1`.
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
+    }
+
     fn claims(&self) -> Claims {
         let no_specular = self.ks.max_element() == 0.0;
         Claims {
