@@ -546,9 +546,7 @@ impl EnvRenderer {
         width: u32,
         height: u32,
     ) -> Result<&wgpu::Texture> {
-        if self.accum.is_empty() || self.accum_size != Some((width, height)) {
-            bail!("nothing accumulated at {width}×{height}");
-        }
+        // `show` refuses a size with nothing accumulated.
         self.show(settings, width, height)
     }
 

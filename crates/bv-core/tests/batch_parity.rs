@@ -6,10 +6,12 @@
 //! value must be within 1e-4 relative or 1e-6 absolute of `Brdf::eval` at the
 //! same (f32) directions.
 
+mod common;
 use bv_core::batch::{self, Dirs, Kernel, LaneKernel, Out, PairBuf};
-use bv_core::params::{FloatSpec, ParamDecl, ParamKind, ParamValue, Params};
+use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
 use bv_core::sampling::{self, BvRng};
 use bv_core::{Brdf, Claims, ModelSpec, Rgb, catalogue};
+use common::random_float;
 use glam::DVec3;
 use rand::Rng;
 use std::f64::consts::PI;
@@ -17,23 +19,6 @@ use std::f64::consts::PI;
 const REL: f64 = 1e-4;
 const ABS: f64 = 1e-6;
 const SETS: u64 = 48;
-
-fn random_float(s: &FloatSpec, rng: &mut BvRng) -> f64 {
-    let r: f64 = rng.random();
-    if r < 0.05 {
-        return s.min;
-    }
-    if r < 0.10 {
-        return s.max;
-    }
-    let x = if s.log && s.max > 0.0 && s.min >= 0.0 {
-        let lo = if s.min > 0.0 { s.min } else { s.max * 1e-6 };
-        (rng.random_range(lo.ln()..=s.max.ln())).exp()
-    } else {
-        rng.random_range(s.min..=s.max)
-    };
-    x.clamp(s.min, s.max)
-}
 
 /// Random values for the declared floats, colours, choices and flags; `None`
 /// for a model with lists, components or files (none of those has a kernel).

@@ -7,10 +7,12 @@
 //! set) so that CI is repeatable; each model gets its own runner so a failure
 //! names the model and the parameters as JSON.
 
+mod common;
 use bv_core::analysis::{self, CheckOptions, albedo, directions};
 use bv_core::params::{Component, ParamDecl, ParamKind, ParamValue, Params};
 use bv_core::sampling::{self, BvRng};
 use bv_core::{Brdf, ModelInfo, ModelSpec, Rgb, catalogue};
+use common::random_float;
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngSeed, TestCaseError, TestRunner};
@@ -22,26 +24,6 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 // ---------------------------------------------------------------------------
 // Random parameters from a declaration.
-
-/// A float from its spec: 5 % exactly `min`, 5 % exactly `max` (the edges are
-/// where guards are needed: exponent 0, α = 0.001), otherwise uniform, or
-/// log-uniform when the spec says `log` (from `max · 1e-6` when `min` is 0).
-fn random_float(s: &bv_core::params::FloatSpec, rng: &mut BvRng) -> f64 {
-    let r: f64 = rng.random();
-    if r < 0.05 {
-        return s.min;
-    }
-    if r < 0.10 {
-        return s.max;
-    }
-    let x = if s.log && s.max > 0.0 && s.min >= 0.0 {
-        let lo = if s.min > 0.0 { s.min } else { s.max * 1e-6 };
-        (rng.random_range(lo.ln()..=s.max.ln())).exp()
-    } else {
-        rng.random_range(s.min..=s.max)
-    };
-    x.clamp(s.min, s.max)
-}
 
 /// Where a synthetic MERL-format table for `Path` parameters lives: a small
 /// one (dims 6 × 6 × 12) and, for a loader that refuses it, one of the public

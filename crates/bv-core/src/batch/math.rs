@@ -77,6 +77,19 @@ pub fn ln_near_one(x: f32, y: f32) -> f32 {
     if y < 0.29 { small } else { ln(x) }
 }
 
+/// The Phong lobe `clamped_pow(R(wo)·wi, e)` of `phong` and
+/// `modified-phong`, with `R(wo) = (−wo.x, −wo.y, wo.z)`. The cosine is
+/// formed in f64 and the lobe taken from `1 − R(wo)·wi` ([`pow_1m`]): with
+/// exponents up to 10⁴ an f32 cosine's rounding alone would move the peak
+/// value by 10⁻³.
+#[inline(always)]
+pub fn mirror_lobe(wi: [f32; 3], wo: [f32; 3], e: f32) -> f32 {
+    let [ix, iy, iz] = wi.map(f64::from);
+    let [ox, oy, oz] = wo.map(f64::from);
+    let x = -ox * ix + -oy * iy + oz * iz;
+    pow_1m(x as f32, (1.0 - x) as f32, e)
+}
+
 /// `clamped_pow(x, e)` of the Phong-type models, given `x` and `y = 1 − x`:
 /// `x^e` for `0 < x ≤ 1` (1 for `x ≥ 1`), 0 for `x ≤ 0`, with `x⁰ = 1` for
 /// `x > 0`. Passing `1 − x` keeps large exponents accurate near the peak.

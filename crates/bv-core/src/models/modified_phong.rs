@@ -58,7 +58,7 @@ pub struct ModifiedPhong {
 }
 
 /// [`ModifiedPhong`]'s f32 batch kernel: `kd/π + ks (e+2)/(2π) (R(wo)·wi)^e`,
-/// the cosine in f64 and the lobe from `1 − R(wo)·wi` as in `phong`'s kernel.
+/// the lobe by [`math::mirror_lobe`].
 #[derive(Debug, Clone, Copy)]
 struct ModifiedPhongLanes {
     diffuse: [f32; 3],
@@ -70,10 +70,7 @@ struct ModifiedPhongLanes {
 impl LaneKernel for ModifiedPhongLanes {
     #[inline(always)]
     fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let [ix, iy, iz] = wi.map(f64::from);
-        let [ox, oy, oz] = wo.map(f64::from);
-        let x = -ox * ix + -oy * iy + oz * iz;
-        let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.e);
+        let lobe = math::mirror_lobe(wi, wo, self.e);
         let above = wi[2] > 0.0 && wo[2] > 0.0;
         std::array::from_fn(|c| {
             if above {

@@ -61,10 +61,8 @@ pub struct Phong {
     kernel: PhongLanes,
 }
 
-/// [`Phong`]'s f32 batch kernel: `kd + ks (R(wo)·wi)^e / cosθi`. The cosine
-/// `R(wo)·wi` is taken in f64 and the lobe from `1 − R(wo)·wi`
-/// ([`math::pow_1m`]): with exponents up to 10⁴, an f32 cosine's rounding
-/// alone would move the peak value by 10⁻³.
+/// [`Phong`]'s f32 batch kernel: `kd + ks (R(wo)·wi)^e / cosθi`, the lobe
+/// by [`math::mirror_lobe`].
 #[derive(Debug, Clone, Copy)]
 struct PhongLanes {
     kd: [f32; 3],
@@ -75,10 +73,7 @@ struct PhongLanes {
 impl LaneKernel for PhongLanes {
     #[inline(always)]
     fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let [ix, iy, iz] = wi.map(f64::from);
-        let [ox, oy, oz] = wo.map(f64::from);
-        let x = -ox * ix + -oy * iy + oz * iz;
-        let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.e);
+        let lobe = math::mirror_lobe(wi, wo, self.e);
         let spec = lobe / wi[2];
         let above = wi[2] > 0.0 && wo[2] > 0.0;
         std::array::from_fn(|c| {
