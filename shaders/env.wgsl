@@ -1,15 +1,15 @@
 // Environment lighting (issue 4, item 4): spheres under an equirectangular
 // environment, one BRDF sample and one environment sample per pixel and pass,
 // combined with the power heuristic (Veach & Guibas 1995), accumulated into a
-// float buffer across frames. Delta models (mirror, glass) add their exact
-// specular paths.
+// float buffer across frames. Models with delta lobes (their GPU ports
+// declare them: a mirror reflection, or reflection and refraction into a
+// dielectric) add their exact specular paths, through the generated dispatch.
 #import bv::brdf
 #import bv::brdf_sampling
 #import bv::envmap
 #import bv::params::{pf, pu}
 #import bv::layout as L
-#import bv::models::mirror
-#import bv::models::glass
+#import bv::dispatch
 #import bv::frame::PI
 #import bv::sampling::pcg
 #import bv::sphere::{sphere_at, to_local, to_view, SpherePoint}
@@ -80,35 +80,35 @@ fn balance2(a: f32, b: f32) -> f32 {
     return a2 / (a2 + b * b);
 }
 
-// Radiance of the glass sphere along the view ray entering at normal n (view
+// Radiance of a refracting (glass) sphere along the view ray entering at normal n (view
 // space; sphere of radius 1 at the origin): Fresnel reflection plus the
 // refracted path through the ball, with internal reflections (up to 8 exits).
-fn glass_path(o: u32, n: vec3<f32>) -> vec3<f32> {
-    let eta = glass::eta(o);
+fn glass_path(model: u32, o: u32, n: vec3<f32>) -> vec3<f32> {
+    let eta = dispatch::delta_eta(model, o);
     let d = vec3<f32>(0.0, 0.0, -1.0);
     let c = -dot(d, n);
-    let f = glass::reflectance(o, c);
+    let f = dispatch::delta_reflectance(model, o, c);
     var l = f * envmap::radiance(reflect(d, n));
     var dir = refract(d, n, 1.0 / eta);
     if (dot(dir, dir) == 0.0) {
         return l;
     }
     var p = n;
-    var through = 1.0 - f;
+    var through = vec3<f32>(1.0) - f;
     for (var k = 0; k < 8; k++) {
         // Next hit of the unit sphere from inside: p + t dir with t = −2 p·dir.
         p = p + (-2.0 * dot(p, dir)) * dir;
         let m = normalize(p);
         let ci = dot(dir, m);
         // From inside: the Fresnel term of the interface seen from −z.
-        let fi = glass::reflectance(o, -ci);
+        let fi = dispatch::delta_reflectance(model, o, -ci);
         let out = refract(dir, -m, eta);
         if (dot(out, out) > 0.0) {
             l += through * (1.0 - fi) * envmap::radiance(out);
         }
         through *= fi;
         dir = reflect(dir, -m);
-        if (through < 1e-4) {
+        if (max(through.x, max(through.y, through.z)) < 1e-4) {
             break;
         }
     }
@@ -117,13 +117,14 @@ fn glass_path(o: u32, n: vec3<f32>) -> vec3<f32> {
 
 // Radiance of the delta parts of a (non-mix) model at sphere point s.
 fn delta_leaf(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
-    if (model == L::MODEL_MIRROR) {
+    let kind = dispatch::delta_kind(model);
+    if (kind == dispatch::DELTA_REFLECTION) {
         let v = vec3<f32>(0.0, 0.0, 1.0);
         let c = dot(v, s.n);
-        return mirror::reflectance(o, c) * envmap::radiance(2.0 * c * s.n - v);
+        return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
     }
-    if (model == L::MODEL_GLASS) {
-        return glass_path(o, s.n);
+    if (kind == dispatch::DELTA_REFRACTION) {
+        return glass_path(model, o, s.n);
     }
     return vec3<f32>(0.0);
 }
@@ -140,11 +141,11 @@ fn torus_radiance(p: vec3<f32>, n: vec3<f32>, d: vec3<f32>) -> vec3<f32> {
 // glass_path for the torus: the refracted path is traced through the tube by
 // its distance function (up to 8 exits); light leaving the tube is taken from
 // the environment even where it would meet the torus again.
-fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let eta = glass::eta(o);
+fn glass_path_torus(model: u32, o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let eta = dispatch::delta_eta(model, o);
     let d = vec3<f32>(0.0, 0.0, -1.0);
     let c = -dot(d, n);
-    let f = glass::reflectance(o, c);
+    let f = dispatch::delta_reflectance(model, o, c);
     var l = f * torus_radiance(p0, n, reflect(d, n));
     var dir = refract(d, n, 1.0 / eta);
     if (dot(dir, dir) == 0.0) {
@@ -152,7 +153,7 @@ fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     }
     var p = p0;
     var m_in = n;
-    var through = 1.0 - f;
+    var through = vec3<f32>(1.0) - f;
     for (var k = 0; k < 8; k++) {
         let t = torus::trace_inside(p, m_in, dir);
         if (t < 0.0) {
@@ -161,7 +162,7 @@ fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         p = p + t * dir;
         let m = torus::normal(p);
         let ci = dot(dir, m);
-        let fi = glass::reflectance(o, -ci);
+        let fi = dispatch::delta_reflectance(model, o, -ci);
         let out = refract(dir, -m, eta);
         if (dot(out, out) > 0.0) {
             l += through * (1.0 - fi) * envmap::radiance(out);
@@ -169,7 +170,7 @@ fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         through *= fi;
         dir = reflect(dir, -m);
         m_in = m;
-        if (through < 1e-4) {
+        if (max(through.x, max(through.y, through.z)) < 1e-4) {
             break;
         }
     }
@@ -177,13 +178,14 @@ fn glass_path_torus(o: u32, p0: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 }
 
 fn delta_leaf_torus(model: u32, o: u32, s: SpherePoint, p: vec3<f32>) -> vec3<f32> {
-    if (model == L::MODEL_MIRROR) {
+    let kind = dispatch::delta_kind(model);
+    if (kind == dispatch::DELTA_REFLECTION) {
         let v = vec3<f32>(0.0, 0.0, 1.0);
         let c = dot(v, s.n);
-        return mirror::reflectance(o, c) * torus_radiance(p, s.n, 2.0 * c * s.n - v);
+        return dispatch::delta_reflectance(model, o, c) * torus_radiance(p, s.n, 2.0 * c * s.n - v);
     }
-    if (model == L::MODEL_GLASS) {
-        return glass_path_torus(o, p, s.n);
+    if (kind == dispatch::DELTA_REFRACTION) {
+        return glass_path_torus(model, o, p, s.n);
     }
     return vec3<f32>(0.0);
 }

@@ -2,5 +2,5 @@
 //! sub-commands (`eval`, `check`, `models`, `bench`, …) print results for scripts.
 
 fn main() -> std::process::ExitCode {
-    bv::cli::main()
+    bv::cli::main(&bv::app::SHELL)
 }

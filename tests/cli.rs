@@ -250,7 +250,7 @@ fn models_lists_the_whole_catalogue() {
     let o = bv(&["models"], "");
     assert_eq!(o.status.code(), Some(0));
     let text = stdout(&o);
-    for m in bv_core::catalogue() {
+    for m in bv_core::catalogue().iter() {
         assert!(
             text.contains(&format!("{}  ({})", m.id, m.name)),
             "{}",
@@ -271,7 +271,7 @@ fn models_json_parses_and_matches_the_catalogue() {
     let ids: Vec<&str> = models.iter().map(|m| m["id"].as_str().unwrap()).collect();
     let want: Vec<&str> = bv_core::catalogue().iter().map(|m| m.id).collect();
     assert_eq!(ids, want);
-    for (m, info) in models.iter().zip(bv_core::catalogue()) {
+    for (m, info) in models.iter().zip(bv_core::catalogue().iter()) {
         assert_eq!(m["params"].as_array().unwrap().len(), info.params.len());
         for key in ["name", "summary", "citation"] {
             assert!(m[key].is_string(), "{} {key}", info.id);
@@ -422,7 +422,7 @@ fn check_json_has_the_report_and_the_parameters() {
 
 #[test]
 fn check_runs_on_every_model_with_its_defaults() {
-    for m in bv_core::catalogue() {
+    for m in bv_core::catalogue().iter() {
         let o = bv(&["check", "--model", m.id, "--json"], "");
         assert_no_panic(&o);
         // A model whose defaults do not build (e.g. measured data without a

@@ -2,9 +2,10 @@
 //! (Ctrl+Shift+S), figures at 1×/2×/4×, transparent backgrounds, scene
 //! shortcuts, toasts, and the albedo and Fresnel views.
 
+use bv::app::Viewer;
 use bv::app::screenshot::{FigureSettings, Format, ScreenGeometry, Target};
-use bv::app::state::AppState;
-use bv::app::{Command, Viewer};
+use bv::session::Command;
+use bv::session::state::AppState;
 use bv::views::albedo::AlbedoView;
 use bv::views::fresnel::FresnelView;
 use eframe::egui;
@@ -59,7 +60,7 @@ fn ctrl_shift_s_opens_the_export_dialog() {
     h.run();
     h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
     h.run();
-    let loaded = bv::app::scene::load(&path).unwrap();
+    let loaded = bv::session::scene_file::load(&path).unwrap();
     assert_eq!(&loaded.state, h.state().state());
     let toast = h.state().export.toast.clone().unwrap();
     assert!(

@@ -36,7 +36,7 @@ fn compare(
     let gpu = r.render_image(models, settings, w, h).unwrap();
     if let Ok(dir) = std::env::var("BV_TEST_IMAGES") {
         // For a look by eye: BV_TEST_IMAGES=/tmp cargo test --test gpu_lit_sphere
-        let name: Vec<&str> = models.iter().map(|m| m.model.as_str()).collect();
+        let name: Vec<&str> = models.iter().map(|m| m.id()).collect();
         gpu.save(format!("{dir}/lit_sphere_{}_{w}x{h}.png", name.join("+")))
             .unwrap();
     }
@@ -57,7 +57,7 @@ fn compare(
             assert!(
                 on_silhouette(x, y, w, h, models.len()),
                 "{:?}: pixel ({x}, {y}) gpu {g:?} cpu {c:?}",
-                models.iter().map(|m| &m.model).collect::<Vec<_>>()
+                models.iter().map(|m| m.id()).collect::<Vec<_>>()
             );
             edge += 1;
         }
@@ -73,7 +73,7 @@ fn compare(
     );
     println!(
         "{:?} {w}x{h}: worst |Δ| = {worst}/255, {edge} silhouette pixels beyond 1",
-        models.iter().map(|m| &m.model).collect::<Vec<_>>()
+        models.iter().map(|m| m.id()).collect::<Vec<_>>()
     );
 }
 

@@ -227,12 +227,10 @@ fn level_value(d: &ParamDecl, level: Level) -> ParamValue {
                 Level::Mid => default_items.max(1),
                 Level::Max => max_items,
             };
-            let item = Params(
-                fields
-                    .iter()
-                    .map(|f| (f.id.to_string(), level_value(f, level)))
-                    .collect(),
-            );
+            let mut item = Params::default();
+            for f in fields {
+                item.set_unvalidated(f.id, level_value(f, level));
+            }
             ParamValue::List(vec![item; n])
         }
         ParamKind::Path { .. } => d.default_value(),
@@ -267,7 +265,8 @@ fn param_sets(model: &str) -> Vec<(String, ModelSpec)> {
     ] {
         let mut s = base.clone();
         for d in decls {
-            s.params.0.insert(d.id.to_string(), level_value(d, level));
+            s.set(d.id, level_value(d, level))
+                .unwrap_or_else(|e| panic!("{model} {name}: {e}"));
         }
         sets.push((name.to_string(), s));
     }
@@ -275,9 +274,8 @@ fn param_sets(model: &str) -> Vec<(String, ModelSpec)> {
         if let ParamKind::Choice { options, .. } = d.kind {
             for o in options {
                 let mut s = base.clone();
-                s.params
-                    .0
-                    .insert(d.id.to_string(), ParamValue::Text(o.to_string()));
+                s.set(d.id, ParamValue::Text(o.to_string()))
+                    .unwrap_or_else(|e| panic!("{model} {}={o}: {e}", d.id));
                 sets.push((format!("{}={o}", d.id), s));
             }
         }
@@ -325,7 +323,7 @@ fn wgsl_ports_match_bv_core() {
         "{:<18} {:>5} {:>12}  worst case (tolerance {ABS_TOL:e} + {REL_TOL:e}·|f|)",
         "model", "sets", "|Δ|/tol"
     );
-    for m in catalogue() {
+    for m in catalogue().iter() {
         if let Some((_, why)) = NOT_PORTED.iter().find(|(id, _)| *id == m.id) {
             println!("{:<18} not ported: {why}", m.id);
             continue;

@@ -7,10 +7,11 @@
 //! machines without one) and compare small images with `tests/snapshots/`.
 //! Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p bv --test gui`.
 
-use bv::app::runtime::Runtime;
-use bv::app::state::AppState;
-use bv::app::viewer::build_scene;
-use bv::app::{Command, Viewer};
+use bv::app::Viewer;
+use bv::session::Command;
+use bv::session::build_scene;
+use bv::session::runtime::Runtime;
+use bv::session::state::AppState;
 use bv::views::cartesian::CartesianView;
 use bv::views::lobe_gpu::LobeRenderer;
 use bv::views::lobe3d::Lobe3dView;
@@ -68,7 +69,7 @@ fn add_a_brdf_by_its_label_and_remove_it() {
     h.run();
     let s = h.state().state();
     assert_eq!(s.brdfs.len(), 2);
-    assert_eq!(s.brdfs[1].spec.model, first.id);
+    assert_eq!(s.brdfs[1].spec.id(), first.id);
     assert_ne!(
         s.brdfs[0].color, s.brdfs[1].color,
         "overlaid BRDFs get distinct colours"
@@ -113,7 +114,7 @@ fn dragging_a_parameter_slider_changes_the_lobe() {
 
     let albedo = h.state().state().brdfs[0]
         .spec
-        .params
+        .params()
         .color("albedo")
         .unwrap();
     assert!(
@@ -141,7 +142,7 @@ fn a_reset_button_restores_the_default() {
     h.get_by_label("Reset albedo").click();
     h.run();
     let e = &h.state().state().brdfs[0];
-    assert_eq!(e.spec, bv_core::ModelSpec::new(&e.spec.model).unwrap());
+    assert_eq!(e.spec, bv_core::ModelSpec::new(e.spec.id()).unwrap());
 }
 
 #[test]
@@ -250,7 +251,7 @@ fn help_overlay_lists_the_shortcuts() {
 fn keyboard_shortcuts_drive_the_views() {
     let mut h = viewer(AppState::first_run());
     h.state_mut()
-        .push(Command::SetCamera(bv::app::state::Camera {
+        .push(Command::SetCamera(bv::session::state::Camera {
             yaw_deg: 10.0,
             ..Default::default()
         }));
@@ -262,10 +263,10 @@ fn keyboard_shortcuts_drive_the_views() {
         ),
         (egui::Key::W, |s: &AppState| s.display.wireframe),
         (egui::Key::R, |s: &AppState| {
-            s.camera == bv::app::state::Camera::default()
+            s.camera == bv::session::state::Camera::default()
         }),
         (egui::Key::T, |s: &AppState| {
-            s.theme == bv::app::state::Theme::Light
+            s.theme == bv::session::state::Theme::Light
         }),
     ] {
         h.key_press(key);
@@ -276,7 +277,7 @@ fn keyboard_shortcuts_drive_the_views() {
 
 #[test]
 fn every_model_gets_widgets_from_its_declaration() {
-    for info in bv_core::catalogue() {
+    for info in bv_core::catalogue().iter() {
         let mut state = AppState::default();
         state.add(bv_core::ModelSpec::new(info.id).unwrap());
         let h = viewer(state);
@@ -370,13 +371,13 @@ fn two_brdfs_overlay_in_all_three_views() {
 fn state_survives_a_restart() {
     let mut h = viewer(AppState::first_run());
     h.state_mut()
-        .push(Command::SetIncident(bv::app::state::Incident {
+        .push(Command::SetIncident(bv::session::state::Incident {
             theta_deg: 12.0,
             phi_deg: 34.0,
         }));
     h.state_mut().push(Command::ToggleLog);
     h.state_mut()
-        .push(Command::SetCamera(bv::app::state::Camera {
+        .push(Command::SetCamera(bv::session::state::Camera {
             yaw_deg: 45.0,
             ..Default::default()
         }));
@@ -431,14 +432,14 @@ impl LobeOnly {
 }
 
 fn lobe_snapshot(name: &str, model: &str, params: serde_json::Value) {
-    lobe_snapshot_from(name, model, params, bv::app::state::Camera::default());
+    lobe_snapshot_from(name, model, params, bv::session::state::Camera::default());
 }
 
 fn lobe_snapshot_from(
     name: &str,
     model: &str,
     params: serde_json::Value,
-    camera: bv::app::state::Camera,
+    camera: bv::session::state::Camera,
 ) {
     if bv_core::find(model).is_err() {
         eprintln!("skipping snapshot {name}: model `{model}` is not in this build's catalogue");
@@ -499,7 +500,7 @@ fn snapshot_lobe_ward_anisotropic() {
         "lobe_ward_anisotropic",
         "ward",
         serde_json::json!({"kd": 0.1, "ks": 0.3, "alpha_x": 0.08, "alpha_y": 0.3}),
-        bv::app::state::Camera {
+        bv::session::state::Camera {
             yaw_deg: 55.0,
             pitch_deg: 40.0,
             ..Default::default()
@@ -615,7 +616,10 @@ fn shift_drag_on_the_lobe_moves_the_light() {
         "{inc:?}"
     );
     // The camera did not orbit: the drag went to the light.
-    assert_eq!(h.state().state().camera, bv::app::state::Camera::default());
+    assert_eq!(
+        h.state().state().camera,
+        bv::session::state::Camera::default()
+    );
 }
 
 /// Renders the whole window in a few states into `$BV_RENDER_DIR` (default
@@ -641,14 +645,14 @@ fn render_window_states() {
         ("wireframe", vec![Command::ToggleWireframe]),
         (
             "light",
-            vec![Command::SetTheme(bv::app::state::Theme::Light)],
+            vec![Command::SetTheme(bv::session::state::Theme::Light)],
         ),
         ("help", vec![Command::ToggleHelp]),
         ("lobe_max", vec![Command::Maximise(Some("lobe".into()))]),
         (
             "theta_h",
             vec![Command::SetCartesianAxis(
-                bv::app::state::CartesianAxis::ThetaH,
+                bv::session::state::CartesianAxis::ThetaH,
             )],
         ),
     ];
@@ -740,7 +744,7 @@ fn type_fast<S>(h: &mut Harness<'_, S>, text: &str) {
 fn alpha_x(h: &Harness<'_, Viewer>) -> f64 {
     h.state().state().brdfs[0]
         .spec
-        .params
+        .params()
         .float("alpha_x")
         .unwrap()
 }
@@ -911,7 +915,7 @@ fn double_clicking_a_slider_resets_it() {
         value: bv_core::ParamValue::Float(0.05),
     });
     h.state_mut()
-        .push(Command::SetIncident(bv::app::state::Incident {
+        .push(Command::SetIncident(bv::session::state::Incident {
             theta_deg: 12.0,
             phi_deg: 34.0,
         }));
@@ -935,16 +939,19 @@ fn double_clicking_a_slider_resets_it() {
     let r = h.get_by_role_and_label(Role::Slider, "θi").rect();
     double_click(&mut h, r.left_center() + egui::vec2(r.width() * 0.9, 0.0));
     let inc = h.state().state().incident;
-    assert_eq!(inc.theta_deg, bv::app::state::Incident::default().theta_deg);
+    assert_eq!(
+        inc.theta_deg,
+        bv::session::state::Incident::default().theta_deg
+    );
     let r = h.get_by_role_and_label(Role::Slider, "φi").rect();
     double_click(&mut h, r.left_center() + egui::vec2(r.width() * 0.1, 0.0));
     let inc = h.state().state().incident;
-    assert_eq!(inc, bv::app::state::Incident::default());
+    assert_eq!(inc, bv::session::state::Incident::default());
 }
 
 /// A save dialog alone, in a folder of its own.
 struct SaveDialog {
-    files: bv::app::files::Files<()>,
+    files: bv::widgets::files::Files<()>,
     chosen: Option<std::path::PathBuf>,
 }
 
@@ -970,7 +977,7 @@ fn the_save_dialog_types_digits_and_asks_before_replacing() {
     for name in ["1.toml", "12.toml", "2.toml", "scene.toml"] {
         std::fs::write(dir.join(name), format!("# {name}\n")).unwrap();
     }
-    let mut files = bv::app::files::Files::default();
+    let mut files = bv::widgets::files::Files::default();
     files.set_start_dir(&dir);
     // egui_file's text fields have no accessible names; its title starts
     // with an emoji that egui's fonts lack.
@@ -988,7 +995,7 @@ fn the_save_dialog_types_digits_and_asks_before_replacing() {
         .set_missing_glyph_policy(egui::MissingGlyphPolicy::Tofu);
     h.state_mut()
         .files
-        .save((), "Save the scene", bv::app::files::SCENE, "talk");
+        .save((), "Save the scene", bv::widgets::files::SCENE, "talk");
     h.run();
     name_field(&h, "talk").click();
     h.run();
@@ -1009,7 +1016,7 @@ fn the_save_dialog_types_digits_and_asks_before_replacing() {
     h.state_mut().chosen = None;
     h.state_mut()
         .files
-        .save((), "Save the scene", bv::app::files::SCENE, "");
+        .save((), "Save the scene", bv::widgets::files::SCENE, "");
     h.run();
     name_field(&h, "").click();
     h.run();
@@ -1146,7 +1153,7 @@ fn tab_and_a_click_elsewhere_commit_a_typed_value() {
     let albedo = |h: &Harness<'_, Viewer>| {
         h.state().state().brdfs[0]
             .spec
-            .params
+            .params()
             .color("albedo")
             .unwrap()
     };

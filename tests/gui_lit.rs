@@ -4,9 +4,10 @@
 //! on a change, errors show in the view, and small snapshots of both.
 //! Regenerate the snapshots with `UPDATE_SNAPSHOTS=1 cargo test --test gui_lit`.
 
-use bv::app::lighting::{EnvObject, Lighting};
-use bv::app::state::{AppState, Incident};
-use bv::app::{Command, Viewer};
+use bv::app::Viewer;
+use bv::session::Command;
+use bv::session::lighting::{EnvObject, Lighting};
+use bv::session::state::{AppState, Incident};
 use bv::views::environment::EnvironmentView;
 use bv::views::lit_sphere::LitSphereView;
 use bv_core::{ModelSpec, ParamValue};
@@ -394,7 +395,7 @@ fn an_environment_file_can_be_loaded_by_path() {
 /// One view alone over a state (for the snapshots: no panels around it).
 struct ViewOnly<V> {
     state: AppState,
-    runtime: bv::app::runtime::Runtime,
+    runtime: bv::session::runtime::Runtime,
     view: V,
     /// Passed to the scene (a pointer button held).
     interacting: bool,
@@ -402,7 +403,7 @@ struct ViewOnly<V> {
 
 impl<V: bv::views::View> ViewOnly<V> {
     fn new(state: AppState, view: V) -> Self {
-        let mut runtime = bv::app::runtime::Runtime::default();
+        let mut runtime = bv::session::runtime::Runtime::default();
         runtime.sync(&state);
         Self {
             state,
@@ -413,7 +414,7 @@ impl<V: bv::views::View> ViewOnly<V> {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui) {
-        let scene = bv::app::viewer::build_scene(&self.state, &self.runtime, self.interacting);
+        let scene = bv::session::build_scene(&self.state, &self.runtime, self.interacting);
         let mut out = Vec::new();
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE)

@@ -9,10 +9,11 @@
 //! compares with `tests/snapshots/image_slice_cook_torrance.png`
 //! (regenerate with `UPDATE_SNAPSHOTS=1 cargo test --test gui_merl`).
 
-use bv::app::runtime::Runtime;
-use bv::app::state::AppState;
-use bv::app::viewer::build_scene;
-use bv::app::{Command, Viewer};
+use bv::app::Viewer;
+use bv::session::Command;
+use bv::session::build_scene;
+use bv::session::runtime::Runtime;
+use bv::session::state::AppState;
 use bv::views::image_slice::ImageSliceView;
 use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;
@@ -108,10 +109,10 @@ fn a_dropped_table_becomes_a_merl_brdf_with_its_lobe() {
         "the analytic model stays, the table is added"
     );
     let e = &s.brdfs[1];
-    assert_eq!(e.spec.model, "merl");
+    assert_eq!(e.spec.id(), "merl");
     let canon = std::fs::canonicalize(&path).unwrap();
     assert_eq!(
-        e.spec.params.text("path").unwrap(),
+        e.spec.params().text("path").unwrap(),
         canon.display().to_string()
     );
     assert_eq!(s.selected, Some(e.id));
@@ -294,7 +295,7 @@ fn the_sh_control_overlays_the_reconstruction_with_its_error() {
     // A higher order through the state: a smaller error.
     let d = h.state().state().display;
     h.state_mut()
-        .push(Command::SetDisplay(bv::app::state::Display {
+        .push(Command::SetDisplay(bv::session::state::Display {
             sh_order: 12,
             ..d
         }));
@@ -435,7 +436,7 @@ fn snapshot_image_slice() {
 #[test]
 #[ignore]
 fn timings() {
-    use bv::app::loader::{LoadTarget, Loader};
+    use bv::session::loader::{LoadTarget, Loader};
     use std::time::Instant;
     let dir = temp_dir("timings");
     let path = dir.join("ct.binary");

@@ -1,9 +1,9 @@
 //! Scene files (issue 6): round trips, corrupt and truncated files, atomic
 //! saves, unknown keys, and the `bv scene` / `bv --scene` command lines.
 
-use bv::app::scene::{self, END_MARKER, SceneError};
-use bv::app::state::{AppState, CartesianAxis, Incident, Theme};
 use bv::app::viewer::Viewer;
+use bv::session::scene_file::{self as scene, END_MARKER, SceneError};
+use bv::session::state::{AppState, CartesianAxis, Incident, Theme};
 use bv_core::ModelSpec;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -194,7 +194,7 @@ e = 50
 "#;
     let l = scene::from_toml(text).unwrap();
     assert_eq!(l.state.brdfs.len(), 1);
-    assert_eq!(l.state.brdfs[0].spec.params.float("e").unwrap(), 50.0);
+    assert_eq!(l.state.brdfs[0].spec.params().float("e").unwrap(), 50.0);
     assert_eq!(l.state.incident.theta_deg, 30.0);
     let w = l.warnings.join("\n");
     assert!(
@@ -293,8 +293,14 @@ fn bv_scene_check_print_and_new() {
     );
     let l = scene::load(&path).unwrap();
     assert_eq!(l.state.brdfs.len(), 2);
-    assert_eq!(l.state.brdfs[0].spec.params.color("albedo").unwrap().x, 0.3);
-    assert_eq!(l.state.brdfs[1].spec.params.float("alpha_x").unwrap(), 0.1);
+    assert_eq!(
+        l.state.brdfs[0].spec.params().color("albedo").unwrap().x,
+        0.3
+    );
+    assert_eq!(
+        l.state.brdfs[1].spec.params().float("alpha_x").unwrap(),
+        0.1
+    );
     assert!(l.state.display.log);
 
     let out = Command::new(bin)

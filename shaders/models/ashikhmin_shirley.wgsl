@@ -1,6 +1,9 @@
 // Ashikhmin & Shirley 2000, eqs. 4-5 (bv_core::models::ashikhmin_shirley).
 #define_import_path bv::models::ashikhmin_shirley
 
+#import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
+#import bv::layout as L
+
 #import bv::params::{pf, prgb}
 #import bv::frame::{PI, pow_from_sin2}
 #import bv::fresnel::schlick
@@ -44,4 +47,11 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let norm = sqrt((nu + 1.0) * (nv + 1.0));
     let spec = norm / (8.0 * PI) * hz_e / (c * max(wi.z, wo.z));
     return diffuse + schlick(rs, c) * spec;
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    let rs = mean3(prgb(o + L::ASHIKHMIN_SHIRLEY_RS));
+    return ggx_lobe(p_cos_of(mean3(prgb(o + L::ASHIKHMIN_SHIRLEY_RD)) * (1.0 - rs), max(rs, 0.2)),
+        alpha_of_exponent(pf(o + L::ASHIKHMIN_SHIRLEY_NU)), alpha_of_exponent(pf(o + L::ASHIKHMIN_SHIRLEY_NV)));
 }

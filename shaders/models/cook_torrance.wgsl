@@ -1,23 +1,27 @@
 // Cook-Torrance (bv_core::models::cook_torrance):
 // kd/π + ks F(wi·h) D(h) G(wi, wo) / (4 cosθi cosθo), D, G, F by choice.
-// Derived slots after the block (bv-core computes them; src/gpu/pack.rs):
-// Blinn's normalisation constants for alpha_x and alpha2.
+// Derived slots after the block (declared and computed with the model in
+// bv_core::models::cook_torrance): Blinn's normalisation constants for
+// alpha_x and alpha2.
 #define_import_path bv::models::cook_torrance
+
+#import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
+#import bv::layout as L
 
 #import bv::params::{pf, prgb, pu}
 #import bv::frame::INV_PI
 #import bv::fresnel::fresnel
 #import bv::microfacet::{Scale, mixture_d, mixture_g}
-#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_SIZE}
+#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_BLINN_NORM, COOK_TORRANCE_BLINN_NORM2}
 
 fn first_scale(o: u32) -> Scale {
     return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), pf(o + COOK_TORRANCE_ALPHA_X),
-        pf(o + COOK_TORRANCE_ALPHA_Y), pf(o + COOK_TORRANCE_SIZE));
+        pf(o + COOK_TORRANCE_ALPHA_Y), pf(o + COOK_TORRANCE_BLINN_NORM));
 }
 
 fn second_scale(o: u32) -> Scale {
     let a2 = pf(o + COOK_TORRANCE_ALPHA2);
-    return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), a2, a2, pf(o + COOK_TORRANCE_SIZE + 1u));
+    return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), a2, a2, pf(o + COOK_TORRANCE_BLINN_NORM2));
 }
 
 fn weight2(o: u32) -> f32 {
@@ -54,4 +58,18 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     return prgb(o + COOK_TORRANCE_KD) * INV_PI + pf(o + COOK_TORRANCE_KS) * specular(o, wi, wo);
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    var ax = pf(o + L::COOK_TORRANCE_ALPHA_X);
+    var ay = pf(o + L::COOK_TORRANCE_ALPHA_Y);
+    if (pu(o + L::COOK_TORRANCE_DISTRIBUTION) == L::COOK_TORRANCE_DISTRIBUTION_BLINN) {
+        ay = ax;
+    }
+    if (pf(o + L::COOK_TORRANCE_WEIGHT2) > 0.5) {
+        ax = pf(o + L::COOK_TORRANCE_ALPHA2);
+        ay = ax;
+    }
+    return ggx_lobe(p_cos_of(mean3(prgb(o + L::COOK_TORRANCE_KD)), pf(o + L::COOK_TORRANCE_KS)), ax, ay);
 }

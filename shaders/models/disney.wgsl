@@ -1,6 +1,9 @@
 // Disney principled BRDF, Burley 2012, as SPEC §2 fixes it (bv_core::models::disney).
 #define_import_path bv::models::disney
 
+#import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
+#import bv::layout as L
+
 #import bv::params::{pf, prgb}
 #import bv::frame::{PI, INV_PI}
 #import bv::fresnel::schlick_weight
@@ -84,4 +87,12 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     return f;
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    let aspect = sqrt(1.0 - 0.9 * pf(o + L::DISNEY_ANISOTROPIC));
+    let r = pf(o + L::DISNEY_ROUGHNESS);
+    let d = (1.0 - pf(o + L::DISNEY_METALLIC)) * mean3(prgb(o + L::DISNEY_BASE_COLOR));
+    return ggx_lobe(p_cos_of(d, 1.0), max(r * r / aspect, 0.001), max(r * r * aspect, 0.001));
 }

@@ -2,6 +2,9 @@
 // kd/π + Σ ks_j (n_j+2)/(2π) max(0, cx wi.x wo.x + cy wi.y wo.y + cz wi.z wo.z)^n_j.
 #define_import_path bv::models::lafortune
 
+#import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
+#import bv::layout as L
+
 #import bv::params::{pf, prgb, pu}
 #import bv::frame::{PI, INV_PI, log1p}
 #import bv::layout::{LAFORTUNE_KD, LAFORTUNE_LOBES, LAFORTUNE_LOBES_ITEMS, LAFORTUNE_LOBES_STRIDE, LAFORTUNE_LOBES_MAX, LAFORTUNE_LOBES_CX, LAFORTUNE_LOBES_CY, LAFORTUNE_LOBES_CZ, LAFORTUNE_LOBES_N, LAFORTUNE_LOBES_KS}
@@ -39,4 +42,27 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         f += prgb(l + LAFORTUNE_LOBES_KS) * ((n + 2.0) / (2.0 * PI) * lobe(c, n, wi, wo));
     }
     return f;
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    // The lobe of largest weight, about its axis C wo.
+    let count = min(pu(o + L::LAFORTUNE_LOBES), L::LAFORTUNE_LOBES_MAX);
+    var best = 0.0;
+    var lobe = none_lobe();
+    for (var j = 0u; j < count; j++) {
+        let l = o + L::LAFORTUNE_LOBES_ITEMS + j * L::LAFORTUNE_LOBES_STRIDE;
+        let c = vec3<f32>(pf(l + L::LAFORTUNE_LOBES_CX), pf(l + L::LAFORTUNE_LOBES_CY), pf(l + L::LAFORTUNE_LOBES_CZ));
+        let v = c * wo;
+        let w = mean3(prgb(l + L::LAFORTUNE_LOBES_KS)) * length(v);
+        if (w > best && length(v) > 0.0) {
+            best = w;
+            lobe = power_lobe(0.0, normalize(v), pf(l + L::LAFORTUNE_LOBES_N));
+        }
+    }
+    lobe.p_cos = p_cos_of(mean3(prgb(o + L::LAFORTUNE_KD)), best);
+    if (lobe.kind == LOBE_NONE) {
+        lobe.p_cos = 1.0;
+    }
+    return lobe;
 }

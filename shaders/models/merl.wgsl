@@ -1,16 +1,15 @@
-// MERL measured tables (bv_core::measured::merl; SPEC §4; Matusik et al.
-// 2003). The tables live in their own storage buffer, `merl_data`: every
+// MERL measured tables (bv_core::measured::merl; Matusik et al. 2003). The tables live in their own storage buffer, `merl_data`: every
 // table a frame draws, one after the other, each in its in-memory layout (f32
 // values of f with the channel scales applied, channel-major, cell
 // (iθh · nθd + iθd) · nφd + iφd). A model's parameter block holds its
-// interpolation choice; the packer (src/gpu/pack.rs) appends four derived
-// slots after it: nθh, nθd, nφd and the table's first element in units of
-// 4 floats (so that every offset stays an exactly representable f32).
+// interpolation choice; its GPU port (bv_core::models::merl) declares four
+// derived slots after it: nθh, nθd, nφd and the table's first element in
+// units of 4 floats (so that every offset stays an exactly representable f32).
 #define_import_path bv::models::merl
 
 #import bv::params::pu
 #import bv::frame::{PI, half_unnormalised}
-#import bv::layout::{MERL_INTERPOLATION, MERL_INTERPOLATION_NEAREST, MERL_SIZE}
+#import bv::layout::{MERL_INTERPOLATION, MERL_INTERPOLATION_NEAREST, MERL_THETA_H_COUNT, MERL_THETA_D_COUNT, MERL_PHI_D_COUNT, MERL_TABLE}
 
 @group(0) @binding(8) var<storage, read> merl_data: array<f32>;
 
@@ -114,10 +113,10 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let nh = pu(o + MERL_SIZE);
-    let nd = pu(o + MERL_SIZE + 1u);
-    let np = pu(o + MERL_SIZE + 2u);
-    let base = 4u * pu(o + MERL_SIZE + 3u);
+    let nh = pu(o + MERL_THETA_H_COUNT);
+    let nd = pu(o + MERL_THETA_D_COUNT);
+    let np = pu(o + MERL_PHI_D_COUNT);
+    let base = 4u * pu(o + MERL_TABLE);
     let cells = nh * nd * np;
     let a = half_diff(wi, wo);
     if (pu(o + MERL_INTERPOLATION) == MERL_INTERPOLATION_NEAREST) {

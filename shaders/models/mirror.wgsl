@@ -1,5 +1,6 @@
 // Ideal mirror (bv_core::models::mirror): a delta lobe, so f = 0 at every
-// finite pair; the environment renderer uses `reflectance` along R(wo).
+// finite pair; the environment renderer uses `delta_reflectance` along R(wo)
+// (the model's GPU port declares a reflection delta).
 #define_import_path bv::models::mirror
 
 #import bv::params::{prgb, pu}
@@ -11,6 +12,6 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
 }
 
 // Weight F(cosθ) of the delta lobe for light arriving at cosine c.
-fn reflectance(o: u32, c: f32) -> vec3<f32> {
+fn delta_reflectance(o: u32, c: f32) -> vec3<f32> {
     return fresnel(pu(o + MIRROR_FRESNEL), prgb(o + MIRROR_ETA), prgb(o + MIRROR_K), prgb(o + MIRROR_F0), c);
 }

@@ -2,6 +2,9 @@
 // kd/π + ks exp(−tan²θh (cos²φh/αx² + sin²φh/αy²)) / (4π αx αy √(cosθi cosθo)).
 #define_import_path bv::models::ward
 
+#import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
+#import bv::layout as L
+
 #import bv::params::{pf, prgb}
 #import bv::frame::{PI, INV_PI, COS_FLOOR}
 #import bv::layout::{WARD_KD, WARD_KS, WARD_ALPHA_X, WARD_ALPHA_Y}
@@ -22,4 +25,10 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     let g = exp(-e);
     let denom = 4.0 * PI * ax * ay * sqrt(max(wi.z, COS_FLOOR)) * sqrt(max(wo.z, COS_FLOOR));
     return prgb(o + WARD_KD) * INV_PI + prgb(o + WARD_KS) * (g / denom);
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    return ggx_lobe(p_cos_of(mean3(prgb(o + L::WARD_KD)), mean3(prgb(o + L::WARD_KS))),
+        pf(o + L::WARD_ALPHA_X), pf(o + L::WARD_ALPHA_Y));
 }

@@ -1,16 +1,16 @@
 //! The GUI of measured tables (issue 5, items 6 and 7): the "Load MERL…"
-//! button (its dialog is [`super::files`]), the progress of background reads, the error dialog of a
+//! button (its dialog is [`crate::widgets::files`]), the progress of background reads, the error dialog of a
 //! refused file, and the panel section of a `merl` BRDF (its table, the
 //! reader's warnings, and the relative L2 difference to another loaded BRDF,
 //! e.g. the analytic model a table was tabulated from).
 
-use super::command::Command;
-use super::files::Filter;
-use super::loader::{self, LoadError, Loader};
-use super::runtime::Runtime;
-use super::state::{AppState, BrdfEntry};
+use crate::session::command::Command;
+use crate::session::loader::{self, LoadError, Loader};
+use crate::session::runtime::Runtime;
+use crate::session::state::{AppState, BrdfEntry};
 use crate::views::background::{self, Done};
 use crate::views::sh_overlay::percent;
+use crate::widgets::files::Filter;
 use bv_core::Brdf;
 use eframe::egui::{self, RichText, Role, Ui, WidgetInfo};
 use std::sync::Arc;
@@ -107,28 +107,24 @@ pub fn measured_section(
     let Some(brdf) = built.brdf.clone() else {
         return;
     };
-    let Some((table, _)) = brdf.measured() else {
+    let Some(data) = brdf.file_data() else {
         return;
     };
     ui.add_space(4.0);
-    ui.label(RichText::new("Measured table").strong());
-    let d = table.dims();
-    let max = table.ranges().map(|r| r.max);
-    ui.label(format!(
-        "{d} cells (θh × θd × φd), {:.1} MB in memory",
-        table.data().len() as f64 * 4.0 / 1e6
-    ));
-    ui.label(format!(
-        "largest f: r {}, g {}, b {} 1/sr",
-        crate::views::curves::fmt_value(max[0]),
-        crate::views::curves::fmt_value(max[1]),
-        crate::views::curves::fmt_value(max[2])
-    ));
-    let warnings = table.warnings();
+    let tag = e
+        .spec
+        .model()
+        .file_param()
+        .map_or("File", |(_, format)| format.name());
+    ui.label(RichText::new(sentence_case(tag)).strong());
+    for line in data.summary() {
+        ui.label(line);
+    }
+    let warnings = data.warnings();
     if warnings.is_empty() {
         ui.weak("no unmeasured or NaN samples");
     } else {
-        for m in warnings.messages() {
+        for m in warnings {
             ui.colored_label(ui.visuals().warn_fg_color, format!("⚠ {m}"));
         }
     }
@@ -145,7 +141,7 @@ pub fn measured_section(
     let name_of = |id: u64| {
         state
             .entry(id)
-            .map(|x| super::panel::display_name(state, x))
+            .map(|x| crate::session::naming::display_name(state, x))
             .unwrap_or_default()
     };
     let before = other;
@@ -156,7 +152,7 @@ pub fn measured_section(
             .show_ui(ui, |ui| {
                 ui.selectable_value(&mut other, None, "(none)");
                 for b in state.brdfs.iter().filter(|b| b.id != e.id) {
-                    let n = super::panel::display_name(state, b);
+                    let n = crate::session::naming::display_name(state, b);
                     ui.selectable_value(&mut other, Some(b.id), n);
                 }
             })
@@ -252,5 +248,14 @@ pub fn load_button(ui: &mut Ui, out: &mut Vec<Command>) {
         .on_hover_text("Open a measured BRDF (.binary); or drop the file on the window");
     if r.clicked() {
         out.push(Command::OpenFileDialog);
+    }
+}
+
+/// "MERL table" → "MERL table", "user file" → "User file": a heading.
+fn sentence_case(text: &str) -> String {
+    let mut c = text.chars();
+    match c.next() {
+        Some(first) => first.to_uppercase().chain(c).collect(),
+        None => String::new(),
     }
 }

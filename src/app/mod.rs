@@ -1,31 +1,32 @@
 //! The viewer window (issue 3): an eframe app on wgpu around [`Viewer`].
 //!
-//! - [`state`]: what is saved between runs; [`command`]: the changes UI code
-//!   asks for, applied after each frame; [`runtime`]: evaluators built from the
-//!   state; [`panel`] and [`params_ui`]: the left panel; [`viewer`]: the whole
-//!   UI; [`shortcuts`]: the keyboard shortcuts and their help; the views live
-//!   in [`crate::views`].
+//! - The state, commands and evaluators are the session's
+//!   ([`crate::session`]); [`panel`] and [`measured_ui`]: the left panel;
+//!   [`viewer`]: the whole UI; [`shortcuts`]: the keyboard shortcuts and their
+//!   help; [`screenshot`]: the export dialog; the views live in
+//!   [`crate::views`].
 //! - [`run`] opens the window. `--bench-frames N` drives a scripted slider
 //!   sweep and prints frame-time percentiles; `--screenshot PATH` saves the
 //!   window once it has drawn and exits.
 
-pub mod command;
-pub mod files;
-pub mod lighting;
-pub mod loader;
 pub mod measured_ui;
 pub mod panel;
-pub mod params_ui;
-pub mod runtime;
-pub mod scene;
 pub mod screenshot;
 pub mod shortcuts;
-pub mod state;
 pub mod viewer;
 
-pub use command::Command;
-pub use state::AppState;
 pub use viewer::Viewer;
+
+/// The window's functions the command line calls (`bv` with no sub-command,
+/// `bv render --view window`).
+pub const SHELL: crate::cli::Shell = crate::cli::Shell {
+    run_viewer: run,
+    window: viewer::figure_window,
+};
+
+use crate::cli::viewer_args::{ViewerArgs, parse_size};
+use crate::session::scene_file as scene;
+use crate::session::{AppState, Command, state};
 
 use anyhow::{Context as _, bail};
 use bv_core::{ParamKind, ParamValue};
@@ -36,67 +37,6 @@ use std::time::{Duration, Instant};
 
 /// Key of the saved state in eframe's storage.
 pub const STORAGE_KEY: &str = "bv-state";
-
-/// Options of the viewer window, flattened into the top-level command line.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct ViewerArgs {
-    /// Open the viewer with these models (catalogue ids; repeat for several)
-    /// instead of the saved list.
-    #[arg(long = "model", value_name = "ID")]
-    pub models: Vec<String>,
-
-    /// Start from the defaults: ignore the saved session and do not overwrite it.
-    /// (`--screenshot` and `--bench-frames` never overwrite it either.)
-    #[arg(long)]
-    pub fresh: bool,
-
-    /// Benchmark: drive a scripted slider sweep of the selected BRDF for N
-    /// frames, print the frame-time p50/p95 and exit. (Set
-    /// BV_BENCH_MAXIMISE=lobe|polar|cartesian to time one view alone.)
-    #[arg(long, value_name = "N")]
-    pub bench_frames: Option<usize>,
-
-    /// Save a PNG screenshot of the window to PATH once it has drawn, and exit.
-    #[arg(long, value_name = "PATH")]
-    pub screenshot: Option<PathBuf>,
-
-    /// Window size in points, as WIDTHxHEIGHT (default 1280x800).
-    #[arg(long, value_name = "WxH")]
-    pub size: Option<String>,
-
-    /// Start with the light theme.
-    #[arg(long)]
-    pub light: bool,
-
-    /// Open a measured BRDF (a MERL `.binary` file) as one more BRDF, read in
-    /// the background with a progress bar (repeat for several).
-    #[arg(long = "open", value_name = "FILE")]
-    pub open: Vec<PathBuf>,
-
-    /// Open this scene file (TOML, see `bv scene --help`) instead of the saved
-    /// session.
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
-}
-
-/// Parses `WIDTHxHEIGHT`.
-pub fn parse_size(text: &str) -> anyhow::Result<[f32; 2]> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .with_context(|| format!("window size `{text}` is not WIDTHxHEIGHT (e.g. 1280x800)"))?;
-    let w: f32 = w
-        .trim()
-        .parse()
-        .with_context(|| format!("bad width in `{text}`"))?;
-    let h: f32 = h
-        .trim()
-        .parse()
-        .with_context(|| format!("bad height in `{text}`"))?;
-    if !(200.0..=16384.0).contains(&w) || !(150.0..=16384.0).contains(&h) {
-        bail!("window size `{text}` is out of range (200x150 to 16384x16384)");
-    }
-    Ok([w, h])
-}
 
 /// The state the window starts with.
 fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppState> {
@@ -364,7 +304,7 @@ impl Bench {
         let u = if phase <= 1.0 { phase } else { 2.0 - phase };
         let state = viewer.state();
         let target = state.selected_entry().and_then(|e| {
-            let info = bv_core::find(&e.spec.model).ok()?;
+            let info = bv_core::find(e.spec.id()).ok()?;
             // A log-scaled float first (roughness, exponent: what a lecturer
             // drags), else the first float.
             let floats = || {
@@ -387,10 +327,7 @@ impl Bench {
                 };
                 self.what = format!(
                     "{}.{param}",
-                    state
-                        .entry(id)
-                        .map(|e| e.spec.model.as_str())
-                        .unwrap_or("?")
+                    state.entry(id).map(|e| e.spec.id()).unwrap_or("?")
                 );
                 Command::SetParam {
                     brdf: id,
@@ -531,13 +468,6 @@ pub fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyho
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sizes_parse() {
-        assert_eq!(parse_size("1280x800").unwrap(), [1280.0, 800.0]);
-        assert!(parse_size("12x8").is_err());
-        assert!(parse_size("wide").is_err());
-    }
 
     #[test]
     fn percentiles() {

@@ -2,51 +2,14 @@
 //! add), the light direction (sliders and a hemisphere to drag on) and the
 //! selected BRDF's parameters, generated from its model's declaration.
 
-use super::command::Command;
-use super::params_ui::{self, Edit};
-use super::runtime::Runtime;
-use super::state::{AppState, BrdfEntry, Incident};
+use crate::session::command::Command;
+use crate::session::runtime::Runtime;
+use crate::session::state::{AppState, Incident};
 use crate::views;
+use crate::widgets::params_ui::{self, Edit};
 use eframe::egui::{
     self, Align2, Color32, FontId, RichText, Role, Sense, Stroke, Ui, Vec2, WidgetInfo,
 };
-
-/// The name shown for an entry: the model's name, numbered when the same
-/// model is loaded more than once ("Lambert", "Lambert 2").
-pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
-    // A model read from a file is named after the file ("gold-paint (MERL)").
-    if let Some(param) = super::command::path_param(&e.spec.model)
-        && let Ok(path) = e.spec.params.text(param)
-        && let Some(stem) = std::path::Path::new(path).file_stem()
-    {
-        let kind = if e.spec.model == "merl" {
-            // Nearest and trilinear lookups of one file side by side.
-            match e.spec.params.text("interpolation") {
-                Ok("nearest") => "MERL, nearest".to_string(),
-                _ => "MERL".to_string(),
-            }
-        } else {
-            e.spec.model.clone()
-        };
-        return format!("{} ({kind})", stem.to_string_lossy());
-    }
-    let name = bv_core::find(&e.spec.model).map(|m| m.name).unwrap_or("?");
-    let has_file = |b: &BrdfEntry| {
-        super::command::path_param(&b.spec.model)
-            .and_then(|p| b.spec.params.text(p).ok())
-            .is_some_and(|p| std::path::Path::new(p).file_stem().is_some())
-    };
-    let same: Vec<u64> = state
-        .brdfs
-        .iter()
-        .filter(|b| b.spec.model == e.spec.model && !has_file(b))
-        .map(|b| b.id)
-        .collect();
-    match same.iter().position(|&id| id == e.id) {
-        Some(0) | None => name.to_string(),
-        Some(k) => format!("{name} {}", k + 1),
-    }
-}
 
 fn labelled(r: &egui::Response, kind: Role, label: String) {
     r.widget_info(move || WidgetInfo::labeled(kind, true, &label));
@@ -58,7 +21,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
         ui.heading("BRDFs");
         ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
             ui.menu_button("Add BRDF", |ui| {
-                for m in bv_core::catalogue() {
+                for m in bv_core::catalogue().iter() {
                     let r = ui.button(m.name).on_hover_text(m.summary);
                     labelled(&r, Role::Button, format!("Add {}", m.name));
                     if r.clicked() {
@@ -76,7 +39,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
         ui.weak("Nothing loaded: use “Add BRDF”.");
     }
     for e in &state.brdfs {
-        let name = display_name(state, e);
+        let name = crate::session::naming::display_name(state, e);
         let selected = state.selected == Some(e.id);
         ui.horizontal(|ui| {
             let mut c = e.color;
@@ -286,14 +249,14 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui.weak("Select a BRDF to edit its parameters.");
         return;
     };
-    let Ok(info) = bv_core::find(&e.spec.model) else {
+    let Ok(info) = bv_core::find(e.spec.id()) else {
         ui.colored_label(
             ui.visuals().error_fg_color,
-            format!("unknown model `{}`", e.spec.model),
+            format!("unknown model `{}`", e.spec.id()),
         );
         return;
     };
-    let name = display_name(state, e);
+    let name = crate::session::naming::display_name(state, e);
     ui.horizontal(|ui| {
         let [r, g, b] = e.color;
         let (swatch, _) = ui.allocate_exact_size(Vec2::splat(14.0), Sense::hover());
@@ -320,14 +283,14 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui,
         egui::Id::unique(("bv params", e.id)),
         info.params,
-        &e.spec.params,
+        &e.spec.params(),
     );
     for edit in edits {
         out.push(match edit {
             // A file is read in the background first; a file the reader
             // refuses leaves the BRDF as it was (see `loader`).
             Edit::Set(param, bv_core::ParamValue::Text(path))
-                if super::command::path_param(&e.spec.model) == Some(param.as_str())
+                if crate::session::command::path_param(e.spec.id()) == Some(param.as_str())
                     && !path.trim().is_empty() =>
             {
                 Command::OpenFile {
@@ -355,13 +318,25 @@ mod tests {
         let mut s = AppState::default();
         let a = s.add(ModelSpec::new("lambert").unwrap());
         let b = s.add(ModelSpec::new("lambert").unwrap());
-        assert_eq!(display_name(&s, s.entry(a).unwrap()), "Lambert");
-        assert_eq!(display_name(&s, s.entry(b).unwrap()), "Lambert 2");
+        assert_eq!(
+            crate::session::naming::display_name(&s, s.entry(a).unwrap()),
+            "Lambert"
+        );
+        assert_eq!(
+            crate::session::naming::display_name(&s, s.entry(b).unwrap()),
+            "Lambert 2"
+        );
         let mut spec = ModelSpec::new("merl").unwrap();
         spec.set_str("path", "/data/gold-paint.binary").unwrap();
         let m = s.add(spec);
-        assert_eq!(display_name(&s, s.entry(m).unwrap()), "gold-paint (MERL)");
+        assert_eq!(
+            crate::session::naming::display_name(&s, s.entry(m).unwrap()),
+            "gold-paint (MERL)"
+        );
         let fresh = s.add(ModelSpec::new("merl").unwrap());
-        assert_eq!(display_name(&s, s.entry(fresh).unwrap()), "MERL measured");
+        assert_eq!(
+            crate::session::naming::display_name(&s, s.entry(fresh).unwrap()),
+            "MERL measured"
+        );
     }
 }

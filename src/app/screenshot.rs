@@ -8,11 +8,11 @@
 //! laid out at the on-screen size in points and rasterised at the chosen
 //! pixels per point: a 4× PNG is drawn at 4×, not upscaled.
 
-use super::files::{self, Files, Filter};
-use super::scene;
-use super::state::AppState;
 use crate::export::{self, Offscreen};
+use crate::session::scene_file as scene;
+use crate::session::state::AppState;
 use crate::views::REGISTRY;
+use crate::widgets::files::{self, Files, Filter};
 use eframe::egui::{self, Align2, RichText};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -218,7 +218,7 @@ impl ExportUi {
                             .selected_text(current)
                             .show_ui(ui, |ui| {
                                 ui.selectable_value(&mut s.target, Target::Window, "Whole window");
-                                for e in REGISTRY {
+                                for e in REGISTRY.iter() {
                                     ui.selectable_value(
                                         &mut s.target,
                                         Target::View(e.id.to_string()),
@@ -362,7 +362,9 @@ impl ExportUi {
                 let mut off = self.offscreen()?;
                 let img = match entry {
                     Some(e) => export::render_view(&mut off, state, e, frame)?,
-                    None => export::render_window(&mut off, state, frame)?,
+                    None => {
+                        export::render_window(&mut off, state, frame, super::viewer::figure_window)?
+                    }
                 };
                 export::save_png(&img, path)?;
                 Ok(format!(

@@ -5,18 +5,19 @@
 //! lay out the panels and the views (which push [`Command`]s), handle
 //! shortcuts, then apply the commands.
 
-use super::command::Command;
-use super::files::Files;
-use super::loader::{self, LoadError, LoadTarget, Loader};
 use super::measured_ui;
 use super::panel;
-use super::runtime::Runtime;
-use super::scene;
 use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::shortcuts::{self, Action};
-use super::state::{AppState, Theme};
-use crate::views::{REGISTRY, Scene, SceneBrdf, View, ViewEntry};
-use eframe::egui::{self, Color32, Rect, RichText, Ui, UiBuilder, Vec2};
+use crate::session::build_scene;
+use crate::session::command::Command;
+use crate::session::loader::{self, LoadError, LoadTarget, Loader};
+use crate::session::runtime::Runtime;
+use crate::session::scene_file as scene;
+use crate::session::state::{AppState, Theme};
+use crate::views::{REGISTRY, Scene, View, ViewEntry};
+use crate::widgets::files::Files;
+use eframe::egui::{self, Rect, RichText, Ui, UiBuilder, Vec2};
 use std::path::Path;
 
 /// Mouse gestures, as shown in the help overlay.
@@ -252,15 +253,7 @@ impl Viewer {
     pub fn views_busy(&self) -> bool {
         // A view is hidden only by another one being maximised.
         let shown = |id: &str| self.state.maximised.as_deref().is_none_or(|m| m == id);
-        let env = shown("environment")
-            && self
-                .view::<crate::views::environment::EnvironmentView>()
-                .is_some_and(|v| v.busy());
-        let lit = shown("lit_sphere")
-            && self
-                .view::<crate::views::lit_sphere::LitSphereView>()
-                .is_some_and(|v| v.busy());
-        env || lit
+        self.views.iter().any(|(e, v)| shown(e.id) && v.busy())
     }
 
     /// Whether the help overlay is open.
@@ -543,6 +536,24 @@ impl Viewer {
     }
 }
 
+impl crate::export::WindowUi for Viewer {
+    fn ui(&mut self, ui: &mut Ui) {
+        Viewer::ui(self, ui);
+    }
+
+    fn error(&self) -> Option<String> {
+        self.views.iter().find_map(|(_, v)| v.figure_error())
+    }
+}
+
+/// The window drawn as a figure (what `bv render --view window` and the
+/// export dialog's "whole window" draw).
+pub fn figure_window(state: &AppState) -> Box<dyn crate::export::WindowUi> {
+    let mut viewer = Viewer::new(state.clone());
+    viewer.figure = true;
+    Box::new(viewer)
+}
+
 /// Where view `id` was drawn in the last frame.
 pub fn view_rect(ctx: &egui::Context, id: &str) -> Option<Rect> {
     ctx.memory(|m| {
@@ -603,42 +614,12 @@ pub fn file_command(state: &AppState, runtime: &Runtime, path: &str, several: bo
     let into = state
         .selected_entry()
         .filter(|_| !several)
-        .filter(|e| super::command::path_param(&e.spec.model).is_some())
+        .filter(|e| crate::session::command::path_param(e.spec.id()).is_some())
         .filter(|e| runtime.get(e.id).is_none_or(|b| b.brdf.is_none()))
         .map(|e| e.id);
     Command::OpenFile {
         path: path.to_string(),
         into,
-    }
-}
-
-/// Builds the frame's scene from the state and the built evaluators.
-pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool) -> Scene<'a> {
-    let brdfs = state
-        .brdfs
-        .iter()
-        .filter(|e| state.is_drawn(e))
-        .filter_map(|e| {
-            let built = runtime.get(e.id)?;
-            let brdf = built.brdf.clone()?;
-            let [r, g, b] = e.color;
-            Some(SceneBrdf {
-                id: e.id,
-                label: panel::display_name(state, e),
-                color: Color32::from_rgb(r, g, b),
-                brdf,
-                revision: built.revision,
-                selected: state.selected == Some(e.id),
-            })
-        })
-        .collect();
-    Scene {
-        state,
-        brdfs,
-        incident: state.incident,
-        interacting,
-        figure: false,
-        transparent: false,
     }
 }
 

@@ -208,7 +208,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     let spec = args.model.spec()?;
     let brdf = spec
         .build()
-        .with_context(|| format!("building model `{}`", spec.model))?;
+        .with_context(|| format!("building model `{}`", spec.id()))?;
     let threads = match args.threads {
         Some(t) => usize::from(t),
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -218,14 +218,16 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
     if r.non_finite > 0 {
         super::output::eprint(&format!(
             "bv bench: warning: {} of {} results were not finite (a bug in model `{}`)\n",
-            r.non_finite, r.pairs, spec.model
+            r.non_finite,
+            r.pairs,
+            spec.id()
         ));
     }
     let rate = r.rate();
     let text = if args.json {
         let v = serde_json::json!({
-            "model": spec.model,
-            "params": spec.params.to_json(),
+            "model": spec.id(),
+            "params": spec.params().to_json(),
             "pairs": r.pairs,
             "threads": r.threads,
             "passes": r.passes,
@@ -246,7 +248,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             // Slow models (below 1 M evals/s) keep three significant digits.
             if rate >= 1e6 { 2 } else { 4 },
             rate / 1e6,
-            spec.model,
+            spec.id(),
             r.pairs,
             s(r.pairs),
             r.threads,

@@ -44,7 +44,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
     let spec = args.model.spec()?;
     let brdf = spec
         .build()
-        .with_context(|| format!("building model `{}`", spec.model))?;
+        .with_context(|| format!("building model `{}`", spec.id()))?;
     let opts = CheckOptions {
         albedo_method: match args.albedo {
             AlbedoChoice::Auto => AlbedoMethod::Auto,
@@ -58,7 +58,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         let mut v = serde_json::to_value(&report).context("encoding the report as JSON")?;
         // The report names the model; the parameters make it reproducible.
         if let Value::Object(m) = &mut v {
-            m.insert("params".into(), spec.params.to_json());
+            m.insert("params".into(), spec.params().to_json());
         }
         print(&format!("{}\n", serde_json::to_string_pretty(&v)?))
     } else {

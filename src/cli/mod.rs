@@ -1,6 +1,7 @@
 //! Command line (SPEC §5).
 //!
-//! `bv` with no sub-command opens the viewer ([`crate::app::run`]); each
+//! `bv` with no sub-command opens the viewer (through the [`Shell`] the
+//! binary hands in, so that this layer does not import the window); each
 //! sub-command lives in its own module and prints results for scripts:
 //!
 //! - [`eval`]: JSON Lines queries on stdin, one answer per line on stdout;
@@ -25,6 +26,7 @@ pub mod render;
 pub mod scene;
 pub mod slice;
 pub mod tabulate;
+pub mod viewer_args;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -50,7 +52,7 @@ pub struct Cli {
 
     /// Options of the viewer window (used when no sub-command is given).
     #[command(flatten)]
-    pub viewer: crate::app::ViewerArgs,
+    pub viewer: viewer_args::ViewerArgs,
 }
 
 /// The sub-commands of SPEC §5.
@@ -76,8 +78,18 @@ pub enum Command {
     Scene(scene::SceneArgs),
 }
 
+/// What the command line needs from the window above it: the binary wires
+/// the application's functions in (`src/main.rs`).
+#[derive(Clone, Copy)]
+pub struct Shell {
+    /// Opens the viewer window and returns when it is closed.
+    pub run_viewer: fn(&viewer_args::ViewerArgs) -> anyhow::Result<()>,
+    /// The window as a figure (`bv render --view window`).
+    pub window: crate::export::MakeWindow,
+}
+
 /// Entry point of the binary.
-pub fn main() -> ExitCode {
+pub fn main(shell: &Shell) -> ExitCode {
     // `Cli::parse` would print help, version or a usage error itself and
     // exit 0 even when that print fails (`bv --help > /dev/full`).
     let cli = match Cli::try_parse() {
@@ -85,14 +97,14 @@ pub fn main() -> ExitCode {
         Err(e) => return clap_exit(&e),
     };
     let result = match &cli.command {
-        None => crate::app::run(&cli.viewer).map(|()| ExitCode::SUCCESS),
+        None => (shell.run_viewer)(&cli.viewer).map(|()| ExitCode::SUCCESS),
         Some(Command::Eval(a)) => eval::run(a),
         Some(Command::Models(a)) => models::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Check(a)) => check::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Tabulate(a)) => tabulate::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),
-        Some(Command::Render(a)) => render::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Render(a)) => render::run(a, shell.window).map(|()| ExitCode::SUCCESS),
         Some(Command::Slice(a)) => slice::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Scene(a)) => {
             let argv: Vec<String> = std::env::args().collect();

@@ -118,7 +118,7 @@ pub fn catalogue_text() -> String {
         models.len(),
         if models.len() == 1 { "" } else { "s" }
     );
-    for m in models {
+    for m in models.iter() {
         let _ = writeln!(s, "\n{}  ({})", m.id, m.name);
         let _ = writeln!(s, "  {}", m.summary);
         let _ = writeln!(s, "  source: {}", m.citation);
@@ -221,7 +221,7 @@ mod tests {
         let v = catalogue_json();
         let arr = v.as_array().unwrap();
         assert_eq!(arr.len(), catalogue().len());
-        for (j, m) in arr.iter().zip(catalogue()) {
+        for (j, m) in arr.iter().zip(catalogue().iter()) {
             assert_eq!(j["id"], m.id);
             let ps = j["params"].as_array().unwrap();
             assert_eq!(ps.len(), m.params.len());
@@ -238,7 +238,7 @@ mod tests {
     #[test]
     fn text_names_every_model_and_parameter() {
         let t = catalogue_text();
-        for m in catalogue() {
+        for m in catalogue().iter() {
             assert!(t.contains(&format!("\n{}  ({})", m.id, m.name)), "{}", m.id);
             for d in m.params {
                 assert!(t.contains(d.id) && t.contains(d.doc), "{} {}", m.id, d.id);

@@ -58,10 +58,13 @@ mod tests {
     #[test]
     fn grey_and_colour_forms() {
         let s = spec_from_cli("lambert", &strings(&["albedo=0.25"])).unwrap();
-        assert_eq!(s.params.color("albedo").unwrap(), glam::DVec3::splat(0.25));
+        assert_eq!(
+            s.params().color("albedo").unwrap(),
+            glam::DVec3::splat(0.25)
+        );
         let s = spec_from_cli("lambert", &strings(&["albedo = 0.1, 0.2,0.3"])).unwrap();
         assert_eq!(
-            s.params.color("albedo").unwrap(),
+            s.params().color("albedo").unwrap(),
             glam::DVec3::new(0.1, 0.2, 0.3)
         );
     }

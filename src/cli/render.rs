@@ -4,11 +4,12 @@
 //! per view into a folder, with a progress bar on stderr.
 
 use super::params::spec_from_cli;
-use crate::app::lighting::MAX_TARGET_SPP;
-use crate::app::scene;
-use crate::app::state::{AppState, Incident, Theme};
 use crate::export::{self, Frame, Offscreen};
-use crate::views::{ALIASES, REGISTRY, ViewEntry};
+use crate::session::lighting::MAX_TARGET_SPP;
+use crate::session::scene_file as scene;
+use crate::session::state::{AppState, Incident, Theme};
+use crate::session::views::ALIASES;
+use crate::views::{REGISTRY, ViewEntry};
 use anyhow::{Context as _, Result, bail};
 use eframe::egui::Vec2;
 use std::io::{IsTerminal, Write as _};
@@ -255,7 +256,7 @@ impl Progress {
 }
 
 /// Runs `bv render`.
-pub fn run(a: &RenderArgs) -> Result<()> {
+pub fn run(a: &RenderArgs, make_window: export::MakeWindow) -> Result<()> {
     let window = a.view.trim().eq_ignore_ascii_case("window");
     let views = if window {
         Vec::new()
@@ -297,7 +298,7 @@ pub fn run(a: &RenderArgs) -> Result<()> {
             bail!("--view window: only PNG (--out FILE.png)");
         }
         let mut off = open_device(frame)?;
-        let img = export::render_window(&mut off, &state, frame)?;
+        let img = export::render_window(&mut off, &state, frame, make_window)?;
         return export::save_png(&img, &a.out);
     }
     if !all {

@@ -3,8 +3,8 @@
 //! --scene FILE` draws them).
 
 use super::output::eprint;
-use crate::app::scene;
-use crate::app::state::AppState;
+use crate::session::scene_file as scene;
+use crate::session::state::AppState;
 use anyhow::{Context as _, Result, bail};
 use std::path::PathBuf;
 
@@ -76,7 +76,7 @@ fn summary(s: &AppState) -> String {
         .map(|b| {
             format!(
                 "{}{}",
-                b.spec.model,
+                b.spec.id(),
                 if b.visible { "" } else { " (hidden)" }
             )
         })
@@ -168,7 +168,7 @@ pub fn new_state(o: &NewScene, argv: &[String]) -> Result<AppState> {
     state.display.log = o.log;
     state.display.cosine = o.cosine;
     if o.light {
-        state.theme = crate::app::state::Theme::Light;
+        state.theme = crate::session::state::Theme::Light;
     }
     // The same checks a scene file gets; what it would clamp is refused here,
     // where the user can say it again.

@@ -60,8 +60,8 @@ pub fn run(args: &TabulateArgs) -> Result<()> {
     print(&format!(
         "wrote {}: {} {}, dims {} ({} bytes), tabulated in {:.2} s\n",
         args.out.display(),
-        spec.model,
-        spec.params.to_json(),
+        spec.id(),
+        spec.params().to_json(),
         dims,
         dims.file_len(),
         tab_s

@@ -6,9 +6,9 @@
 //! (+z the normal, which is Blender's up axis), in units of the shown
 //! quantity (1/sr, or ln(1 + f) on the log scale).
 
-use crate::app::runtime::Runtime;
-use crate::app::state::AppState;
-use crate::app::viewer::build_scene;
+use crate::session::build_scene;
+use crate::session::runtime::Runtime;
+use crate::session::state::AppState;
 use crate::views::colormap;
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use std::fmt::Write as _;
@@ -53,7 +53,7 @@ pub fn lobe_meshes(state: &AppState) -> Vec<Exported> {
             let mesh = lobe::build(b.brdf.as_ref(), scene.wi(), &opts);
             Exported {
                 label: b.label.clone(),
-                color: [b.color.r(), b.color.g(), b.color.b()],
+                color: b.rgb,
                 by_value: Some(b.id) == primary && d.color_by_value,
                 mesh,
             }

@@ -1,18 +1,17 @@
-//! Figures out of bv (issue 6): the views drawn offscreen to PNG at any
-//! resolution ([`offscreen`], [`render_view`], [`render_window`]), the 2D
-//! plots as SVG ([`svg`], [`view_svg`]), and lobe meshes as OBJ/PLY
+//! Figures out of bv: the views drawn offscreen to PNG at any resolution
+//! ([`offscreen`], [`render_view`], [`render_window`]), the 2D plots as SVG
+//! ([`view_svg`], written by the views with `views::svg`), and lobe meshes as OBJ/PLY
 //! ([`mesh`]). `bv render` and the viewer's screenshot dialog both go
 //! through here, so a figure from the command line and one from the window
 //! are drawn by the same code.
 
 pub mod mesh;
 pub mod offscreen;
-pub mod svg;
 
-use crate::app::runtime::Runtime;
-use crate::app::state::{AppState, Theme};
-use crate::app::viewer::{Viewer, build_scene};
-use crate::views::{Scene, ViewEntry};
+use crate::session::frame::figure_scene;
+use crate::session::runtime::Runtime;
+use crate::session::state::{AppState, Theme};
+use crate::views::ViewEntry;
 use anyhow::{Context as _, Result, bail};
 use eframe::egui;
 pub use offscreen::{Frame, Offscreen};
@@ -20,14 +19,6 @@ use std::path::Path;
 
 /// Margin around a view in a figure, in points.
 pub const FIGURE_MARGIN: f32 = 4.0;
-
-/// The scene of a figure: the state's drawn BRDFs, not interacting.
-fn figure_scene<'a>(state: &'a AppState, runtime: &Runtime, transparent: bool) -> Scene<'a> {
-    let mut scene = build_scene(state, runtime, false);
-    scene.figure = true;
-    scene.transparent = transparent;
-    scene
-}
 
 /// Whether figures of `state` use the dark theme.
 pub fn is_dark(state: &AppState) -> bool {
@@ -39,7 +30,7 @@ pub fn is_dark(state: &AppState) -> bool {
 /// would be wrong, not merely incomplete.
 pub fn check_brdfs(state: &AppState, runtime: &Runtime) -> Result<()> {
     for e in state.brdfs.iter().filter(|e| state.is_drawn(e)) {
-        let name = crate::app::panel::display_name(state, e);
+        let name = crate::session::naming::display_name(state, e);
         match runtime.get(e.id) {
             Some(b) if b.brdf.is_some() => {}
             Some(b) => bail!(
@@ -52,24 +43,20 @@ pub fn check_brdfs(state: &AppState, runtime: &Runtime) -> Result<()> {
     Ok(())
 }
 
-/// The errors a rendered view showed in its image (an environment map that
-/// did not load, a renderer that failed, a BRDF the GPU cannot draw), if
-/// any: a figure must not carry an error message in its pixels.
-fn view_error(view: &dyn crate::views::View) -> Option<String> {
-    let any = view.as_any();
-    let (messages, error) =
-        if let Some(v) = any.downcast_ref::<crate::views::environment::EnvironmentView>() {
-            (v.messages().to_vec(), v.error())
-        } else if let Some(v) = any.downcast_ref::<crate::views::lit_sphere::LitSphereView>() {
-            (v.messages().to_vec(), v.error().map(str::to_string))
-        } else {
-            return None;
-        };
-    match (messages.is_empty(), error) {
-        (false, _) => Some(messages.join("; ")),
-        (true, e) => e,
-    }
+/// A whole window's UI that figures can draw: the application hands one in
+/// ([`MakeWindow`]), so that this module draws the window without knowing the
+/// viewer.
+pub trait WindowUi {
+    /// Draws the whole window into `ui`.
+    fn ui(&mut self, ui: &mut egui::Ui);
+    /// An error one of its views showed in the last frame (a figure must not
+    /// carry an error message in its pixels).
+    fn error(&self) -> Option<String>;
 }
+
+/// Builds the window's UI showing `state`, drawn as a figure (slow work
+/// finished before drawing, no hover readouts).
+pub type MakeWindow = fn(&AppState) -> Box<dyn WindowUi>;
 
 /// Draws one view of `state` alone, filling a `frame.size` image (no title
 /// bar or toolbar, no hover readouts). Fails, rather than drawing an
@@ -99,17 +86,18 @@ pub fn render_view(
                 view.ui(ui, &scene, &mut ignored);
             });
     })?;
-    if let Some(e) = view_error(view.as_ref()) {
+    if let Some(e) = view.figure_error() {
         bail!("{e}");
     }
     Ok(img)
 }
 
-/// Draws the whole viewer window showing `state`.
+/// Draws the whole viewer window showing `state`, as `make` builds it.
 pub fn render_window(
     off: &mut Offscreen,
     state: &AppState,
     frame: Frame,
+    make: MakeWindow,
 ) -> Result<image::RgbaImage> {
     // The window's albedo view computes in the background; a figure shows
     // the finished curves, so compute them first (they are cached).
@@ -128,18 +116,9 @@ pub fn render_window(
             crate::views::albedo::curve_now(&scene, b);
         }
     }
-    let mut viewer = Viewer::new(state.clone());
-    viewer.figure = true;
-    let img = off.render(frame, |ui| viewer.ui(ui))?;
-    let errors = [
-        viewer
-            .view::<crate::views::environment::EnvironmentView>()
-            .and_then(|v| view_error(v)),
-        viewer
-            .view::<crate::views::lit_sphere::LitSphereView>()
-            .and_then(|v| view_error(v)),
-    ];
-    if let Some(e) = errors.into_iter().flatten().next() {
+    let mut window = make(state);
+    let img = off.render(frame, |ui| window.ui(ui))?;
+    if let Some(e) = window.error() {
         bail!("{e}");
     }
     Ok(img)

@@ -1,7 +1,7 @@
 //! Batch evaluation of a model on the GPU (the parity test's compute pass, also
 //! usable by any tool that wants GPU values of f).
 
-use super::pack::{MerlTables, TableBuffer, pack};
+use super::pack::{TableBuffer, Tables, pack};
 use super::{Gpu, shaders::ShaderLibrary};
 use anyhow::Result;
 use bv_core::ModelSpec;
@@ -43,7 +43,7 @@ impl GpuEvaluator {
     /// `f(wi, wo)` of `spec` for every pair, computed by the WGSL port in f32.
     pub fn eval(&self, spec: &ModelSpec, pairs: &[([f32; 3], [f32; 3])]) -> Result<Vec<[f32; 3]>> {
         let mut params = Vec::new();
-        let mut tables = MerlTables::default();
+        let mut tables = Tables::default();
         let r = pack(spec, &mut params, &mut tables)?;
         if params.is_empty() {
             params.push(0.0);

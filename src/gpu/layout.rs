@@ -9,6 +9,7 @@
 //! | `MODEL_<MODEL>` | catalogue index of the model (`gpu_model_index`) |
 //! | `MODEL_COUNT` | number of models |
 //! | `<MODEL>_SIZE` | slots of the model's block |
+//! | `<MODEL>_<DERIVED>` | offset of a derived slot of the model's GPU port (after the block) |
 //! | `<MODEL>_<PARAM>` | offset of the parameter in the block (a list's count slot) |
 //! | `<MODEL>_<PARAM>_<OPTION>` | index of a choice option |
 //! | `<MODEL>_<LIST>_ITEMS`, `_STRIDE`, `_MAX` | first item, slots per item, most items |
@@ -87,12 +88,19 @@ pub fn layout_module() -> Result<String> {
         COMPONENT_ENTRY_SLOTS,
         "mix table",
     )?;
-    for m in models {
+    for m in models.iter() {
         let id = ident(m.id);
         c.push(format!("MODEL_{id}"), gpu_model_index(m.id)?, m.id)?;
         let layout = gpu_layout(m.params);
         c.push(format!("{id}_SIZE"), layout.size, m.id)?;
         c.block(&id, &layout)?;
+        // Derived slots follow the block, in the port's declared order.
+        if let Some(port) = &m.gpu {
+            for (k, name) in port.derived.iter().enumerate() {
+                let at = layout.size + u32::try_from(k).unwrap_or(u32::MAX);
+                c.push(format!("{id}_{}", ident(name)), at, name)?;
+            }
+        }
     }
     Ok(c.out)
 }
@@ -110,6 +118,17 @@ mod tests {
         assert!(src.contains("const MODIFIED_PHONG_E: u32 = 6u;"));
         assert!(src.contains("const MODIFIED_PHONG_SIZE: u32 = 7u;"));
         assert_eq!(ident("cook-torrance"), "COOK_TORRANCE");
+        // Derived slots follow the block: cook-torrance's Blinn constants,
+        // merl's dimensions and table offset.
+        let size = |m: &str| gpu_layout(bv_core::find(m).unwrap().params).size;
+        let ct = size("cook-torrance");
+        assert!(src.contains(&format!("const COOK_TORRANCE_BLINN_NORM: u32 = {ct}u;")));
+        assert!(src.contains(&format!(
+            "const COOK_TORRANCE_BLINN_NORM2: u32 = {}u;",
+            ct + 1
+        )));
+        let merl = size("merl");
+        assert!(src.contains(&format!("const MERL_TABLE: u32 = {}u;", merl + 3)));
     }
 
     #[test]
@@ -122,7 +141,7 @@ mod tests {
                 bv_core::ParamKind::Choice { options, .. } => options,
                 _ => panic!("{model}.{id} is not a choice"),
             };
-        for m in bv_core::catalogue() {
+        for m in bv_core::catalogue().iter() {
             if let Ok(d) = m.param("fresnel") {
                 assert!(matches!(d.kind, bv_core::ParamKind::Choice { .. }));
                 assert_eq!(

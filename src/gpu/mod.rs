@@ -7,6 +7,7 @@
 //! ([`bv_core::params::gpu_layout`], [`bv_core::params::pack_model`]).
 
 pub mod context;
+pub mod dispatch;
 pub mod display;
 pub mod env;
 pub mod errors;

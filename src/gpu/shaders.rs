@@ -6,10 +6,13 @@
 //! sources embedded in the binary; the result is written back to WGSL for
 //! `wgpu::ShaderSource::Wgsl` (no extra wgpu feature needed).
 //!
-//! Modules (`#define_import_path`) are registered in dependency order; entry
-//! shaders (`parity`, `lit_sphere`, `env`) import what they need. The
-//! `bv::layout` module is generated from the parameter declarations
-//! ([`super::layout`]).
+//! Modules (`#define_import_path`) are registered in dependency order: the
+//! generated `bv::layout` (parameter offsets, [`super::layout`]), the shared
+//! [`COMMON`] modules, every model's own module from its GPU port in the
+//! catalogue, the generated `bv::dispatch` ([`super::dispatch`]) and the
+//! [`DISPATCHERS`] over it. Entry shaders (`parity`, `lit_sphere`, `env`)
+//! import what they need. A library holds the catalogue as it was when it was
+//! made ([`ShaderLibrary::catalogue_revision`]).
 
 use anyhow::{Context, Result, anyhow};
 use naga_oil::compose::{
@@ -26,8 +29,9 @@ macro_rules! shader {
     };
 }
 
-/// Composable modules, in dependency order: (path under the crate root, source).
-pub const MODULES: &[(&str, &str)] = &[
+/// Shared modules the model ports build on, in dependency order: (path under
+/// the crate root, source).
+pub const COMMON: &[(&str, &str)] = &[
     shader!("common/params.wgsl"),
     shader!("common/frame.wgsl"),
     shader!("common/fresnel.wgsl"),
@@ -36,25 +40,12 @@ pub const MODULES: &[(&str, &str)] = &[
     shader!("common/sphere.wgsl"),
     shader!("common/torus.wgsl"),
     shader!("common/sampling.wgsl"),
+    shader!("common/sampling_lobe.wgsl"),
     shader!("common/envmap.wgsl"),
-    shader!("models/lambert.wgsl"),
-    shader!("models/phong.wgsl"),
-    shader!("models/blinn_phong.wgsl"),
-    shader!("models/modified_phong.wgsl"),
-    shader!("models/ashikhmin_shirley.wgsl"),
-    shader!("models/oren_nayar.wgsl"),
-    shader!("models/hapke.wgsl"),
-    shader!("models/ward.wgsl"),
-    shader!("models/lafortune.wgsl"),
-    shader!("models/banks.wgsl"),
-    shader!("models/cook_torrance.wgsl"),
-    shader!("models/disney.wgsl"),
-    shader!("models/mirror.wgsl"),
-    shader!("models/glass.wgsl"),
-    shader!("models/merl.wgsl"),
-    shader!("brdf.wgsl"),
-    shader!("brdf_sampling.wgsl"),
 ];
+
+/// Modules over the generated dispatch: evaluation with mixes, and sampling.
+pub const DISPATCHERS: &[(&str, &str)] = &[shader!("brdf.wgsl"), shader!("brdf_sampling.wgsl")];
 
 /// Entry shaders (with entry points): (name, (path, source)).
 pub const ENTRIES: &[(&str, (&str, &str))] = &[
@@ -74,6 +65,7 @@ pub const ANY_MODEL: u32 = 0xffff_ffff;
 /// A composer holding every module of `shaders/`.
 pub struct ShaderLibrary {
     composer: Composer,
+    revision: u64,
 }
 
 impl std::fmt::Debug for ShaderLibrary {
@@ -83,10 +75,11 @@ impl std::fmt::Debug for ShaderLibrary {
 }
 
 impl ShaderLibrary {
-    /// Registers the generated layout and every module.
+    /// Registers the generated layout, every shared module, every model's
+    /// port of the current catalogue and the generated dispatch.
     pub fn new() -> Result<Self> {
         let mut composer = Composer::default();
-        let layout = super::layout::layout_module()?;
+        let revision = bv_core::registry::revision();
         let mut add = |path: &str, source: &str| -> Result<()> {
             let r = composer.add_composable_module(ComposableModuleDescriptor {
                 source,
@@ -97,11 +90,42 @@ impl ShaderLibrary {
             r.map(|_| ())
                 .map_err(|e| anyhow!("{path}: {}", e.emit_to_string(&composer)))
         };
-        add("<generated bv::layout>", &layout)?;
-        for (path, source) in MODULES {
-            add(path, source)?;
+        for (path, source) in Self::modules()? {
+            add(&path, &source)?;
         }
-        Ok(Self { composer })
+        Ok(Self { composer, revision })
+    }
+
+    /// Every composable module of the current catalogue, generated ones
+    /// included, in registration order: (path, source).
+    pub fn modules() -> Result<Vec<(String, String)>> {
+        let catalogue = bv_core::catalogue();
+        let mut out = vec![(
+            "<generated bv::layout>".to_string(),
+            super::layout::layout_module()?,
+        )];
+        out.extend(COMMON.iter().map(|(p, s)| (p.to_string(), s.to_string())));
+        for (_, m) in super::dispatch::ported(&catalogue) {
+            if let Some(port) = &m.gpu {
+                out.push((port.path.to_string(), port.source.to_string()));
+            }
+        }
+        out.push((
+            "<generated bv::dispatch>".to_string(),
+            super::dispatch::dispatch_module(&catalogue)?,
+        ));
+        out.extend(
+            DISPATCHERS
+                .iter()
+                .map(|(p, s)| (p.to_string(), s.to_string())),
+        );
+        Ok(out)
+    }
+
+    /// The catalogue revision ([`bv_core::registry::revision`]) the library
+    /// was made for: a model registered since is not in it.
+    pub fn catalogue_revision(&self) -> u64 {
+        self.revision
     }
 
     /// The composed, validated naga module of entry shader `name`.

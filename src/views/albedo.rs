@@ -12,9 +12,10 @@
 //! progress bar, and starts no work until the pointer is released. Figures
 //! (screenshots, `bv render`) compute it before drawing.
 
+use super::BrdfColor as _;
 use super::chart::{self, Band, Chart, Marker, Palette, Series};
 use super::{Scene, SceneBrdf, View};
-use crate::app::command::Command;
+use crate::session::command::Command;
 use bv_core::analysis::albedo::{AlbedoOptions, Estimate, rho_hd_auto, rho_hh_auto, theta_grid};
 use bv_core::analysis::directions::stream_seed;
 use bv_core::{Brdf, mean_rgb};
@@ -398,13 +399,13 @@ impl View for AlbedoView {
                 }
                 pui.add(
                     FilledArea::new("", &s.data.theta_deg, &lo, &hi)
-                        .fill_color(s.brdf.color.gamma_multiply(0.3)),
+                        .fill_color(s.brdf.color().gamma_multiply(0.3)),
                 );
                 let pts: Vec<[f64; 2]> = (0..n)
                     .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
                     .collect();
                 let mut line = Line::new(legend_label(s), PlotPoints::from(pts))
-                    .color(s.brdf.color)
+                    .color(s.brdf.color())
                     .width(if s.brdf.selected { 2.5 } else { 1.8 });
                 if s.stale {
                     line = line.style(LineStyle::Dashed { length: 8.0 });
@@ -446,14 +447,14 @@ impl View for AlbedoView {
             let n = s.data.rho.len();
             let mb: Vec<(f64, f64)> = (0..n).map(|k| s.data.mean_and_band(k)).collect();
             c.bands.push(Band {
-                color: s.brdf.color.gamma_multiply(0.3),
+                color: s.brdf.color().gamma_multiply(0.3),
                 xs: s.data.theta_deg.clone(),
                 lo: mb.iter().map(|(v, b)| v - b).collect(),
                 hi: mb.iter().map(|(v, b)| v + b).collect(),
             });
             c.series.push(Series {
                 label: legend_label(s),
-                color: s.brdf.color,
+                color: s.brdf.color(),
                 points: (0..n).map(|k| [s.data.theta_deg[k], mb[k].0]).collect(),
                 width: if s.brdf.selected { 2.5 } else { 1.8 },
                 dash: None,

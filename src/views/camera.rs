@@ -1,7 +1,7 @@
 //! The lobe view's orbit camera: matrices, projection of 3D points to the
 //! screen (for labels) and pointer rays (for dragging the light).
 
-use crate::app::state::Camera;
+use crate::session::state::Camera;
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 /// Vertical field of view, degrees: narrow enough to look like a textbook

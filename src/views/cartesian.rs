@@ -3,12 +3,13 @@
 //! (Rusinkiewicz angles with φh = 0 and φd = 90°). Every drawn BRDF in its
 //! colour, a legend, a log toggle and the exact values under the pointer.
 
+use super::BrdfColor as _;
 use super::chart::{self, Chart, Marker, Palette, Series};
 use super::curves::{self, HalfDiffAxis};
 use super::polar::{Readout, readout_ui};
 use super::{Scene, View};
-use crate::app::command::Command;
-use crate::app::state::CartesianAxis;
+use crate::session::command::Command;
+use crate::session::state::CartesianAxis;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text, VLine};
 
@@ -200,7 +201,7 @@ impl View for CartesianView {
                         let w = bv_core::mean_rgb(dl.weight);
                         pui.vline(
                             VLine::new(format!("{} δ", b.label), a)
-                                .color(b.color)
+                                .color(b.color())
                                 .style(LineStyle::Dotted { spacing: 4.0 })
                                 .width(2.0),
                         );
@@ -210,7 +211,7 @@ impl View for CartesianView {
                                 PlotPoint::new(a, bottom + (top - bottom) * 0.85),
                                 RichText::new(format!("δ {w:.3}")).size(11.0),
                             )
-                            .color(b.color)
+                            .color(b.color())
                             .anchor(egui::Align2::LEFT_TOP)
                             .allow_hover(false),
                         );
@@ -226,7 +227,7 @@ impl View for CartesianView {
                     .collect();
                 pui.line(
                     Line::new(b.label.clone(), PlotPoints::from(pts))
-                        .color(b.color)
+                        .color(b.color())
                         .width(if b.selected { 2.5 } else { 1.8 }),
                 );
             }
@@ -264,7 +265,7 @@ impl View for CartesianView {
                             d.cosine,
                         ),
                     };
-                    (b.label.clone(), b.color, s)
+                    (b.label.clone(), b.color(), s)
                 })
                 .collect();
             let limit = match axis {
@@ -433,7 +434,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
                 let a = along.atan2(dl.direction.z).to_degrees();
                 c.vlines.push(Marker {
                     at: a,
-                    color: b.color,
+                    color: b.color(),
                     dashed: true,
                     label: format!("δ {:.3}", bv_core::mean_rgb(dl.weight)),
                 });
@@ -445,7 +446,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
     for (b, samples) in order {
         c.series.push(Series {
             label: b.label.clone(),
-            color: b.color,
+            color: b.color(),
             points: samples
                 .iter()
                 .map(|s| [s.x.to_degrees(), y_of(s.value)])

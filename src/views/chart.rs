@@ -3,7 +3,7 @@
 //! builds one from the same numbers it hands egui_plot, and [`Chart::to_svg`]
 //! draws it with the GUI's colours, ticks and labels.
 
-use crate::export::svg::{Anchor, Baseline, Svg};
+use super::svg::{Anchor, Baseline, Svg};
 use eframe::egui::Color32;
 
 /// One curve.

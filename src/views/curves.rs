@@ -315,17 +315,7 @@ pub fn nice_ceil(x: f64) -> f64 {
     scaled(10.0)
 }
 
-/// Formats a value with about four significant digits (plots, readouts).
-pub fn fmt_value(v: f64) -> String {
-    if v == 0.0 {
-        "0".to_string()
-    } else if !(1e-3..1e4).contains(&v.abs()) {
-        format!("{v:.3e}")
-    } else {
-        let digits = (3 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
-        format!("{v:.digits$}")
-    }
-}
+pub use bv_core::text::fmt_value;
 
 /// `v` rounded to `digits` significant digits.
 pub fn round_significant(v: f64, digits: i32) -> f64 {

@@ -17,10 +17,10 @@
 use super::gpu_image::{self, Deferred, Drawable, GpuImage, PackCheck};
 use super::lit_sphere::{arrangement_control, exposure_control, tone_control};
 use super::{Scene, View};
-use crate::app::command::Command;
-use crate::app::files::{Files, Filter};
-use crate::app::lighting::{EnvObject, EnvView, MAX_TARGET_SPP};
 use crate::gpu::{EnvRenderer, EnvSettings, EnvironmentMap};
+use crate::session::command::Command;
+use crate::session::lighting::{EnvObject, EnvView, MAX_TARGET_SPP};
+use crate::widgets::files::{Files, Filter};
 use bv_core::ModelSpec;
 use eframe::egui::{self, Align2, Color32, Rect, Sense, Ui, Vec2};
 use std::path::PathBuf;
@@ -255,7 +255,7 @@ impl EnvironmentView {
         EnvSettings {
             rotation: env.rotation_deg.to_radians(),
             exposure_ev: env.exposure_ev,
-            tone_map: env.tone_map.to_gpu(),
+            tone_map: gpu_image::tone_map(env.tone_map),
             background_fov_deg: BACKGROUND_FOV_DEG,
         }
     }
@@ -344,7 +344,7 @@ impl EnvironmentView {
             Some(r) => {
                 let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
                 let (w, h) = gpu_image::pixel_size(rect, pixels_per_point * current);
-                r.object() != env.object.to_gpu()
+                r.object() != gpu_image::env_object(env.object)
                     || r.would_restart(&specs, &Self::settings(env), w, h)
             }
             None => false,
@@ -437,7 +437,7 @@ impl EnvironmentView {
         let Some(renderer) = self.renderer.ready_mut() else {
             return (None, false);
         };
-        renderer.set_object(env.object.to_gpu());
+        renderer.set_object(gpu_image::env_object(env.object));
         if figure {
             // A figure is drawn in one go: accumulate to the target now.
             let target = figure_spp(env.target_spp, software);
@@ -823,7 +823,7 @@ impl View for EnvironmentView {
         let circle = gpu_image::sphere_circle(rect, drawables.len());
         for (k, d) in drawables.iter().enumerate() {
             let (c, r) = circle(k);
-            let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
+            let [cr, cg, cb] = d.brdf.rgb;
             gpu_image::plate_text(
                 &painter,
                 egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
@@ -861,6 +861,19 @@ impl View for EnvironmentView {
                 egui::FontId::proportional(16.0),
                 text,
             );
+        }
+    }
+
+    fn busy(&self) -> bool {
+        Self::busy(self)
+    }
+
+    fn figure_error(&self) -> Option<String> {
+        let messages = self.messages();
+        if messages.is_empty() {
+            self.error()
+        } else {
+            Some(messages.join("; "))
         }
     }
 

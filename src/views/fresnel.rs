@@ -12,12 +12,16 @@
 //!   channel, with the exact dielectric of the same F0 (η = (1 + √F0)/(1 − √F0))
 //!   dashed for comparison.
 //! - `fresnel = "none"`: F = 1. Models without a Fresnel term say so.
+//!
+//! Which term a model has is the model's own declaration
+//! ([`bv_core::Brdf::fresnel_term`]); this view names no model.
 
+use super::BrdfColor as _;
 use super::chart::{self, Chart, Marker, Palette, Series};
 use super::{Scene, View};
-use crate::app::command::Command;
+use crate::session::command::Command;
 use bv_core::fresnel::{self, Fresnel};
-use bv_core::{ModelSpec, Rgb};
+use bv_core::{Brdf, Rgb};
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
 
@@ -33,44 +37,11 @@ pub enum FresnelOf {
     Absent(String),
 }
 
-/// The Fresnel term of a spec, if its model has one.
-pub fn fresnel_of(spec: &ModelSpec) -> FresnelOf {
-    let p = &spec.params;
-    if p.get("fresnel").is_ok() {
-        return match Fresnel::from_params(p) {
-            Ok(f) => {
-                let kind = p.text("fresnel").unwrap_or("?");
-                FresnelOf::Term(f, format!("fresnel = {kind}"))
-            }
-            Err(e) => FresnelOf::Absent(e.to_string()),
-        };
-    }
-    match spec.model.as_str() {
-        "glass" => match p.float("eta") {
-            Ok(eta) => FresnelOf::Term(
-                Fresnel::Dielectric {
-                    eta: Rgb::splat(eta),
-                },
-                "exact dielectric (glass)".into(),
-            ),
-            Err(e) => FresnelOf::Absent(e.to_string()),
-        },
-        "disney" => {
-            // Burley 2012's reference shader: Cspec0 =
-            // mix(0.08 · specular · mix(1, Ctint, specular_tint), base, metallic),
-            // Ctint = base / Cdlum, Cdlum = 0.3 R + 0.6 G + 0.1 B (SPEC §2).
-            let get = |id| p.float(id).unwrap_or(0.0);
-            let base = p.color("base_color").unwrap_or(Rgb::ONE);
-            let cdlum = 0.3 * base.x + 0.6 * base.y + 0.1 * base.z;
-            let ctint = if cdlum > 0.0 { base / cdlum } else { Rgb::ONE };
-            let f0 = (get("specular") * 0.08 * Rgb::ONE.lerp(ctint, get("specular_tint")))
-                .lerp(base, get("metallic"));
-            FresnelOf::Term(
-                Fresnel::Schlick { f0 },
-                "Schlick, F0 from specular, specular_tint and metallic (Burley 2012)".into(),
-            )
-        }
-        m => FresnelOf::Absent(format!("{m}: this model has no Fresnel term")),
+/// The Fresnel term of a built BRDF, as its model declares it.
+pub fn fresnel_of(brdf: &dyn Brdf) -> FresnelOf {
+    match brdf.fresnel_term() {
+        Some(t) => FresnelOf::Term(t.fresnel, t.source),
+        None => FresnelOf::Absent(format!("{}: this model has no Fresnel term", brdf.id())),
     }
 }
 
@@ -100,9 +71,6 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
         c.note = "no BRDF is shown".into();
         return c;
     };
-    let Some(entry) = scene.state.entry(b.id) else {
-        return c;
-    };
     let xs: Vec<f64> = (0..=SAMPLES)
         .map(|k| 90.0 * k as f64 / SAMPLES as f64)
         .collect();
@@ -122,7 +90,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
         dashed: false,
         label: "θi".into(),
     });
-    let fres = match fresnel_of(&entry.spec) {
+    let fres = match fresnel_of(b.brdf.as_ref()) {
         FresnelOf::Absent(msg) => {
             c.note = msg;
             return c;
@@ -137,7 +105,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
         Fresnel::None => {
             c.series.push(series(
                 "F = 1 (no Fresnel effect)".into(),
-                b.color,
+                b.color(),
                 curve(&|_| 1.0),
                 2.5,
                 None,
@@ -168,7 +136,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
                 ));
                 c.series.push(series(
                     format!("F = (Rp + Rs)/2, η = {}", fmt_eta(e)),
-                    b.color,
+                    b.color(),
                     curve(&|cos| fresnel::dielectric(cos, e)),
                     2.5,
                     None,
@@ -215,7 +183,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
             if grey(eta) && grey(k) {
                 c.series.push(series(
                     format!("F, η = {} + {}i", fmt_eta(eta.x), fmt_eta(k.x)),
-                    b.color,
+                    b.color(),
                     curve(&|cos| fresnel::conductor(cos, eta.x, k.x)),
                     2.5,
                     None,
@@ -237,7 +205,7 @@ pub fn chart_of(scene: &Scene<'_>, dark: bool) -> Chart {
             if grey(f0) {
                 c.series.push(series(
                     format!("Schlick, F0 = {:.3}", f0.x),
-                    b.color,
+                    b.color(),
                     curve(&|cos| fresnel::schlick(f0.x, cos)),
                     2.5,
                     None,
@@ -348,14 +316,19 @@ impl View for FresnelView {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bv_core::ModelSpec;
+
+    fn of(spec: &ModelSpec) -> FresnelOf {
+        fresnel_of(spec.build().unwrap().as_ref())
+    }
 
     #[test]
     fn models_with_and_without_fresnel() {
         let ct = ModelSpec::new("cook-torrance").unwrap();
-        assert!(matches!(fresnel_of(&ct), FresnelOf::Term(..)));
+        assert!(matches!(of(&ct), FresnelOf::Term(..)));
         let glass = ModelSpec::from_json("glass", &serde_json::json!({"eta": 1.5})).unwrap();
         assert_eq!(
-            fresnel_of(&glass),
+            of(&glass),
             FresnelOf::Term(
                 Fresnel::Dielectric {
                     eta: Rgb::splat(1.5)
@@ -364,7 +337,7 @@ mod tests {
             )
         );
         let l = ModelSpec::new("lambert").unwrap();
-        match fresnel_of(&l) {
+        match of(&l) {
             FresnelOf::Absent(m) => assert!(m.contains("no Fresnel term"), "{m}"),
             other => panic!("{other:?}"),
         }
@@ -378,7 +351,7 @@ mod tests {
             &serde_json::json!({"specular": 0.5, "specular_tint": 0.0, "metallic": 0.0}),
         )
         .unwrap();
-        match fresnel_of(&d) {
+        match of(&d) {
             FresnelOf::Term(Fresnel::Schlick { f0 }, _) => {
                 assert!((f0 - Rgb::splat(0.04)).abs().max_element() < 1e-15, "{f0}");
             }
@@ -390,7 +363,7 @@ mod tests {
             &serde_json::json!({"base_color": [0.9, 0.6, 0.2], "metallic": 1.0}),
         )
         .unwrap();
-        match fresnel_of(&m) {
+        match of(&m) {
             FresnelOf::Term(Fresnel::Schlick { f0 }, _) => {
                 assert!((f0 - Rgb::new(0.9, 0.6, 0.2)).abs().max_element() < 1e-12);
             }

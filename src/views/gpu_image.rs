@@ -10,8 +10,10 @@
 //! nothing.
 
 use super::{Scene, SceneBrdf};
-use crate::gpu::Gpu;
+use crate::gpu::env::Object;
 use crate::gpu::shaders::ShaderLibrary;
+use crate::gpu::{Background, Gpu, ToneMap};
+use crate::session::lighting::{BackgroundChoice, EnvObject, Tone};
 use bv_core::ModelSpec;
 use eframe::egui::{self, TextureId};
 use eframe::egui_wgpu::RenderState;
@@ -246,7 +248,7 @@ impl PackCheck {
             return r.clone();
         }
         let mut scratch = Vec::new();
-        let mut tables = crate::gpu::pack::MerlTables::default();
+        let mut tables = crate::gpu::pack::Tables::default();
         let r = crate::gpu::pack::pack(spec, &mut scratch, &mut tables)
             .map(|_| ())
             .map_err(|e| format!("{}: {e:#}", b.label));
@@ -332,4 +334,39 @@ pub fn plate_text(
 pub fn theme_background(dark: bool) -> [f32; 3] {
     let b = super::lobe3d::background(dark);
     [b[0], b[1], b[2]]
+}
+
+/// The renderers' tone map for a saved choice.
+pub fn tone_map(t: Tone) -> ToneMap {
+    match t {
+        Tone::None => ToneMap::None,
+        Tone::Reinhard => ToneMap::Reinhard,
+        Tone::Aces => ToneMap::Aces,
+    }
+}
+
+/// The renderer's background for a saved choice; `theme` is the theme's view
+/// colour (sRGB 0..1) and `pixels_per_point` scales the checker squares to 12
+/// points.
+pub fn background(b: BackgroundChoice, theme: [f32; 3], pixels_per_point: f32) -> Background {
+    match b {
+        BackgroundChoice::Theme => Background::Flat(theme),
+        BackgroundChoice::Black => Background::Flat([0.0; 3]),
+        // sRGB encoding of 18 % reflectance.
+        BackgroundChoice::Grey => Background::Flat([0.4613; 3]),
+        BackgroundChoice::White => Background::Flat([1.0; 3]),
+        BackgroundChoice::Checker => Background::Checker {
+            a: [0.32; 3],
+            b: [0.55; 3],
+            size: 12.0 * pixels_per_point,
+        },
+    }
+}
+
+/// The environment renderer's object for a saved choice.
+pub fn env_object(o: EnvObject) -> Object {
+    match o {
+        EnvObject::Sphere => Object::Sphere,
+        EnvObject::Torus => Object::Torus,
+    }
 }

@@ -13,8 +13,9 @@
 //! evaluations, split across threads. The displayed colours are rebuilt only
 //! when the display settings change.
 
+use super::BrdfColor as _;
 use super::{Scene, View, curves};
-use crate::app::command::Command;
+use crate::session::command::Command;
 use bv_core::{Brdf, Rgb, frame};
 use eframe::egui::{
     self, Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Role, Sense, Stroke,
@@ -375,7 +376,7 @@ impl View for ImageSliceView {
     fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let s = &mut self.settings;
         ui.spacing_mut().slider_width = 90.0;
-        let row = crate::app::params_ui::slider_row(
+        let row = crate::widgets::params_ui::slider_row(
             ui,
             super::view_id("image_slice").with("phi_d"),
             &mut s.phi_d_deg,
@@ -501,7 +502,7 @@ impl View for ImageSliceView {
                 Align2::LEFT_BOTTOM,
                 &b.label,
                 FontId::proportional(12.5),
-                b.color,
+                b.color(),
             );
             // Axes: θh along the bottom, θd up the left side, ticks every
             // 15°, labels as dense as the tile allows.
@@ -596,7 +597,7 @@ impl View for ImageSliceView {
                     .map(|b| {
                         (
                             b.label.clone(),
-                            b.color,
+                            b.color(),
                             value_at(b.brdf.as_ref(), th, td, pd),
                         )
                     })

@@ -17,11 +17,11 @@
 
 use super::gpu_image::{self, Deferred, Drawable, GpuImage, PackCheck};
 use super::{Scene, View};
-use crate::app::command::Command;
-use crate::app::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
-use crate::app::state::Incident;
 use crate::gpu::sphere::{light_from_drag, sphere_at};
 use crate::gpu::{LitSphereRenderer, LitSphereSettings};
+use crate::session::command::Command;
+use crate::session::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
+use crate::session::state::Incident;
 use bv_core::ModelSpec;
 use eframe::egui::{self, Align2, Color32, Rect, Sense, Stroke, Ui, Vec2};
 use glam::{DVec2, DVec3};
@@ -102,10 +102,12 @@ impl LitSphereView {
             light: scene.wi(),
             irradiance: 1.0,
             exposure_ev: lit.exposure_ev,
-            tone_map: lit.tone_map.to_gpu(),
-            background: lit
-                .background
-                .to_gpu(gpu_image::theme_background(dark), pixels_per_point),
+            tone_map: gpu_image::tone_map(lit.tone_map),
+            background: gpu_image::background(
+                lit.background,
+                gpu_image::theme_background(dark),
+                pixels_per_point,
+            ),
         }
     }
 
@@ -296,6 +298,19 @@ impl View for LitSphereView {
         }
     }
 
+    fn busy(&self) -> bool {
+        Self::busy(self)
+    }
+
+    fn figure_error(&self) -> Option<String> {
+        let messages = self.messages();
+        if messages.is_empty() {
+            self.error().map(str::to_string)
+        } else {
+            Some(messages.join("; "))
+        }
+    }
+
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
@@ -324,7 +339,7 @@ impl LitSphereView {
             let at = c + Vec2::new(wi.x as f32, -wi.y as f32) * r;
             painter.circle_stroke(at, 5.0, Stroke::new(2.0, light));
             painter.circle_stroke(at, 6.5, Stroke::new(1.0, Color32::from_black_alpha(160)));
-            let [cr, cg, cb] = [d.brdf.color.r(), d.brdf.color.g(), d.brdf.color.b()];
+            let [cr, cg, cb] = d.brdf.rgb;
             gpu_image::plate_text(
                 &painter,
                 egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),

@@ -9,12 +9,13 @@
 //! once. While a pointer button is held the meshes are built at 64 × 128, and
 //! refined to 128 × 256 when it is released.
 
+use super::BrdfColor as _;
 use super::camera::{self, CameraMatrices};
 use super::lobe_gpu::{LineSeg, LobeCallback, LobeFrame, MeshDraw, MeshStyle};
 use super::sh_overlay::{self, ShDone};
 use super::{Scene, View, colormap, curves};
-use crate::app::command::Command;
-use crate::app::state::{Camera, Display, Incident};
+use crate::session::command::Command;
+use crate::session::state::{Camera, Display, Incident};
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use eframe::egui::{self, Align2, Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, Vec2};
 use glam::Vec3;
@@ -229,7 +230,7 @@ impl Lobe3dView {
                 mesh: c.mesh.clone(),
                 style: MeshStyle {
                     by_value: is_primary && d.color_by_value,
-                    color: super::srgb_f32(b.color),
+                    color: super::srgb_f32(b.color()),
                     alpha: if d.wireframe {
                         1.0
                     } else if is_primary {
@@ -289,7 +290,7 @@ impl Lobe3dView {
         let mut lines = guide_lines(scene.incident, dark);
         for b in &scene.brdfs {
             if let Some(c) = self.cache.get(&b.id) {
-                delta_spikes(&c.mesh, b.color, &mut lines);
+                delta_spikes(&c.mesh, b.color(), &mut lines);
             }
         }
         let frame = Arc::new(LobeFrame {

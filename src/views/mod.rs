@@ -25,74 +25,24 @@ pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
 pub mod sh_overlay;
+pub mod svg;
 
-use crate::app::command::Command;
-use crate::app::state::{AppState, Incident};
-use bv_core::Brdf;
+use crate::session::command::Command;
+pub use crate::session::frame::{Scene, SceneBrdf};
+use crate::session::views;
 use eframe::egui::{self, Color32, Ui};
 use std::any::Any;
-use std::sync::Arc;
 
-/// One drawn BRDF, ready to evaluate.
-#[derive(Clone)]
-pub struct SceneBrdf {
-    /// Its id in the state's list.
-    pub id: u64,
-    /// Display name (model name, numbered when the same model is loaded twice).
-    pub label: String,
-    /// Display colour.
-    pub color: Color32,
-    /// The evaluator.
-    pub brdf: Arc<dyn Brdf>,
-    /// Changes whenever its parameters change (cache key).
-    pub revision: u64,
-    /// Whether it is the selected BRDF.
-    pub selected: bool,
+/// A drawn BRDF's display colour as egui draws it.
+pub trait BrdfColor {
+    /// The colour of its curves, legend entries and meshes.
+    fn color(&self) -> Color32;
 }
 
-impl std::fmt::Debug for SceneBrdf {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("SceneBrdf")
-            .field("id", &self.id)
-            .field("label", &self.label)
-            .field("revision", &self.revision)
-            .finish_non_exhaustive()
-    }
-}
-
-/// What every view reads in one frame.
-pub struct Scene<'a> {
-    /// The whole saved state (display options, camera, plot settings).
-    pub state: &'a AppState,
-    /// The drawn BRDFs, in list order.
-    pub brdfs: Vec<SceneBrdf>,
-    /// The light direction.
-    pub incident: Incident,
-    /// A pointer button is held somewhere (a slider or the light is being
-    /// dragged): views may trade resolution for speed.
-    pub interacting: bool,
-    /// Drawn as a figure (screenshot, `bv render`): no hover hints or
-    /// readouts, and slow results (albedo curves) computed before drawing
-    /// rather than in the background.
-    pub figure: bool,
-    /// Figure with a transparent background: views leave their own
-    /// backgrounds unfilled.
-    pub transparent: bool,
-}
-
-impl Scene<'_> {
-    /// The BRDF drawn opaque and coloured by value in the lobe view: the
-    /// selected one if drawn, else the first drawn.
-    pub fn primary(&self) -> Option<&SceneBrdf> {
-        self.brdfs
-            .iter()
-            .find(|b| b.selected)
-            .or_else(|| self.brdfs.first())
-    }
-
-    /// The unit direction towards the light.
-    pub fn wi(&self) -> glam::DVec3 {
-        self.incident.direction()
+impl BrdfColor for SceneBrdf {
+    fn color(&self) -> Color32 {
+        let [r, g, b] = self.rgb;
+        Color32::from_rgb(r, g, b)
     }
 }
 
@@ -107,6 +57,20 @@ pub trait View: Any {
     /// For tests and drivers that need the concrete view.
     fn as_any(&self) -> &dyn Any;
 
+    /// Whether the view is still working on what it showed in the last frame
+    /// (building a renderer, sampling towards its target): screenshots and
+    /// figures wait for it.
+    fn busy(&self) -> bool {
+        false
+    }
+
+    /// An error the view showed in its image (an environment map that did not
+    /// load, a renderer that failed, a BRDF the GPU cannot draw): a figure must
+    /// not carry an error message in its pixels.
+    fn figure_error(&self) -> Option<String> {
+        None
+    }
+
     /// The view as an SVG document of `size` points (2D plots only; `None`
     /// for views that have no vector form). Same data, colours and labels as
     /// [`View::ui`] draws.
@@ -115,7 +79,8 @@ pub trait View: Any {
     }
 }
 
-/// A registered view.
+/// A registered view: its name (from the session's list of views) and its
+/// constructor.
 pub struct ViewEntry {
     /// Stable id (saved as the maximised view, used by shortcuts).
     pub id: &'static str,
@@ -125,61 +90,38 @@ pub struct ViewEntry {
     pub make: fn() -> Box<dyn View>,
 }
 
-/// Every view, in layout order (see `app::viewer::layout`: the first two share
-/// the top row, the others fill the rows below). Add a view here.
-pub const REGISTRY: &[ViewEntry] = &[
-    ViewEntry {
-        id: "lobe",
-        title: "3D lobe",
-        make: || Box::new(lobe3d::Lobe3dView::new()),
-    },
-    ViewEntry {
-        id: "lit_sphere",
-        title: "Lit sphere",
-        make: || Box::new(lit_sphere::LitSphereView::new()),
-    },
-    ViewEntry {
-        id: "polar",
-        title: "Plane of incidence (polar)",
-        make: || Box::new(polar::PolarView::default()),
-    },
-    ViewEntry {
-        id: "cartesian",
-        title: "f versus angle",
-        make: || Box::new(cartesian::CartesianView::default()),
-    },
-    ViewEntry {
-        id: "environment",
-        title: "Environment",
-        make: || Box::new(environment::EnvironmentView::new()),
-    },
-    ViewEntry {
-        id: "albedo",
-        title: "Directional albedo ρhd(θi)",
-        make: || Box::new(albedo::AlbedoView::default()),
-    },
-    ViewEntry {
-        id: "fresnel",
-        title: "Fresnel reflectance",
-        make: || Box::new(fresnel::FresnelView::default()),
-    },
-    ViewEntry {
-        id: "slice",
-        title: "Image slice (θh × θd)",
-        make: || Box::new(image_slice::ImageSliceView::default()),
-    },
-];
+/// The constructor of the view with session id `id`. Add a view here and in
+/// [`crate::session::views::VIEWS`].
+fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
+    let make: fn() -> Box<dyn View> = match id {
+        "lobe" => || Box::new(lobe3d::Lobe3dView::new()),
+        "lit_sphere" => || Box::new(lit_sphere::LitSphereView::new()),
+        "polar" => || Box::new(polar::PolarView::default()),
+        "cartesian" => || Box::new(cartesian::CartesianView::default()),
+        "environment" => || Box::new(environment::EnvironmentView::new()),
+        "albedo" => || Box::new(albedo::AlbedoView::default()),
+        "fresnel" => || Box::new(fresnel::FresnelView::default()),
+        "slice" => || Box::new(image_slice::ImageSliceView::default()),
+        _ => return None,
+    };
+    Some(make)
+}
 
-/// Other names a view answers to on the command line (`bv render --view
-/// lobe3d`).
-pub const ALIASES: &[(&str, &str)] = &[
-    ("lobe3d", "lobe"),
-    ("3d", "lobe"),
-    ("lit", "lit_sphere"),
-    ("sphere", "lit_sphere"),
-    ("lit-sphere", "lit_sphere"),
-    ("env", "environment"),
-];
+/// Every view, in the session's layout order (see
+/// [`crate::session::views::VIEWS`]; a view without a constructor is
+/// skipped, which a test forbids).
+pub static REGISTRY: std::sync::LazyLock<Vec<ViewEntry>> = std::sync::LazyLock::new(|| {
+    views::VIEWS
+        .iter()
+        .filter_map(|v| {
+            Some(ViewEntry {
+                id: v.id,
+                title: v.title,
+                make: make(v.id)?,
+            })
+        })
+        .collect()
+});
 
 /// The registry entry with id `id`.
 pub fn entry(id: &str) -> Option<&'static ViewEntry> {
@@ -188,12 +130,7 @@ pub fn entry(id: &str) -> Option<&'static ViewEntry> {
 
 /// The registry entry with id or alias `name` (case-insensitive).
 pub fn find_view(name: &str) -> Option<&'static ViewEntry> {
-    let name = name.trim().to_ascii_lowercase();
-    let id = ALIASES
-        .iter()
-        .find(|(a, _)| *a == name)
-        .map_or(name.as_str(), |(_, id)| id);
-    entry(id)
+    views::find(name).and_then(|v| entry(v.id))
 }
 
 /// Installs the GPU resources of every view with its own pipeline into a
@@ -323,11 +260,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn registry_ids_are_unique() {
-        let mut ids: Vec<_> = REGISTRY.iter().map(|v| v.id).collect();
-        ids.sort();
-        ids.dedup();
-        assert_eq!(ids.len(), REGISTRY.len());
+    fn every_session_view_has_a_constructor() {
+        let ids: Vec<_> = REGISTRY.iter().map(|v| v.id).collect();
+        let want: Vec<_> = views::VIEWS.iter().map(|v| v.id).collect();
+        assert_eq!(ids, want);
         assert!(entry("lobe").is_some());
         assert_eq!(find_view("LOBE3D").map(|e| e.id), Some("lobe"));
         assert!(find_view("nope").is_none());

@@ -4,9 +4,10 @@
 //! right, the surface horizontal. Every drawn BRDF in its colour, with a legend
 //! and the exact values under the pointer.
 
+use super::BrdfColor as _;
 use super::curves::{self, Sample};
 use super::{Scene, View, sh_overlay};
-use crate::app::command::Command;
+use crate::session::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
 use std::f64::consts::FRAC_PI_2;
@@ -107,7 +108,11 @@ impl View for PolarView {
                     [rad * s.x.sin(), rad * s.x.cos()]
                 })
                 .collect();
-            Some((format!("{} SH L = {}", b.label, r.lobe.order), b.color, pts))
+            Some((
+                format!("{} SH L = {}", b.label, r.lobe.order),
+                b.color(),
+                pts,
+            ))
         });
         self.sh_curve = sh.as_ref().map(|s| s.2.clone());
 
@@ -280,7 +285,7 @@ impl View for PolarView {
                             PlotPoints::from(vec![[0.0, 0.0]]),
                             PlotPoints::from(vec![tip]),
                         )
-                        .color(b.color),
+                        .color(b.color()),
                     );
                     pui.text(
                         Text::new(
@@ -288,7 +293,7 @@ impl View for PolarView {
                             PlotPoint::new(tip[0] * 1.05, tip[1] * 1.05),
                             RichText::new(format!("δ {w:.3}")).size(11.0),
                         )
-                        .color(b.color)
+                        .color(b.color())
                         .allow_hover(false),
                     );
                 }
@@ -318,7 +323,7 @@ impl View for PolarView {
                         .map(|b| {
                             (
                                 b.label.clone(),
-                                b.color,
+                                b.color(),
                                 curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine),
                             )
                         })
@@ -367,7 +372,7 @@ fn polar_curves(scene: &Scene<'_>) -> (Vec<PolarCurve>, f64) {
                     [r * s.x.sin(), r * s.x.cos()]
                 })
                 .collect();
-            (b.label.clone(), b.color, b.selected, pts)
+            (b.label.clone(), b.color(), b.selected, pts)
         })
         .collect();
     let rmax = curves
@@ -399,7 +404,7 @@ fn rings(outer: f64, log: bool) -> Vec<(f64, f64)> {
 /// The polar plot as SVG: the same rings, spokes, markers and curves.
 pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
     use super::chart::{Palette, Series, legend};
-    use crate::export::svg::{Anchor, Baseline, Svg};
+    use super::svg::{Anchor, Baseline, Svg};
     let d = scene.state.display;
     let pal = Palette::new(dark, scene.transparent);
     let (curves, outer) = polar_curves(scene);
@@ -523,12 +528,12 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
             let a = along.atan2(dir.z);
             let wgt = bv_core::mean_rgb(dl.weight);
             let tip = [outer * wgt * a.sin(), outer * wgt * a.cos()];
-            svg.line(at([0.0, 0.0]), at(tip), b.color, 2.0, None);
+            svg.line(at([0.0, 0.0]), at(tip), b.color(), 2.0, None);
             svg.text(
                 at([tip[0] * 1.05, tip[1] * 1.05]),
                 &format!("δ {wgt:.3}"),
                 10.5,
-                b.color,
+                b.color(),
                 Anchor::Middle,
                 Baseline::Middle,
                 None,

@@ -12,8 +12,8 @@
 
 use super::background::{self, Done};
 use super::{Scene, curves};
-use crate::app::command::Command;
-use crate::app::state::Display;
+use crate::session::command::Command;
+use crate::session::state::Display;
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use bv_core::represent::sh::{self, Domain, ShLobe};
 use bv_core::{Brdf, Claims, Rgb, frame};

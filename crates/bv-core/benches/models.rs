@@ -74,7 +74,7 @@ fn write_synthetic_table() -> String {
 /// defaults name no file reads a synthetic table), plus Cook-Torrance with GGX.
 fn models() -> Vec<(String, &'static ModelInfo, Box<dyn Brdf>)> {
     let mut out = Vec::new();
-    for &m in catalogue() {
+    for &m in catalogue().iter() {
         let built = ModelSpec::new(m.id).and_then(|mut s| {
             if !analytic(m) {
                 for d in m.params {

@@ -48,7 +48,8 @@ pub trait Ndf: Send + Sync {
     fn d(&self, h: DVec3) -> f64;
 }
 
-/// A bidirectional scattering distribution function (SPEC §1 conventions).
+/// A bidirectional scattering distribution function: `wi` towards the light,
+/// `wo` towards the viewer, both away from the surface, normal `+z`.
 pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// Model id from the catalogue.
     fn id(&self) -> &'static str;
@@ -97,7 +98,7 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// may integrate to its stated accuracy. Tabulated and user-defined models
     /// answer `false`: their albedo is estimated by Monte Carlo.
     fn is_analytic(&self) -> bool {
-        self.measured().is_none()
+        self.file_data().is_none()
     }
 
     /// The microfacet distribution, for models that have one.
@@ -120,15 +121,27 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         None
     }
 
-    /// The measured table behind a tabulated model (`merl`) and its lookup
-    /// mode, for views that upload the table to the GPU. `None` for analytic
+    /// The data a file-backed model read from its file (a measured table),
+    /// for the panel and for GPU views that upload it. `None` for analytic
     /// models.
-    fn measured(
-        &self,
-    ) -> Option<(
-        &std::sync::Arc<crate::measured::MerlTable>,
-        crate::measured::Interpolation,
-    )> {
+    fn file_data(&self) -> Option<std::sync::Arc<dyn crate::model::FileData>> {
         None
     }
+
+    /// The model's Fresnel term, for the Fresnel view: what multiplies its
+    /// specular (or delta) lobe as a function of the angle of incidence.
+    /// `None` for models without one.
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        None
+    }
+}
+
+/// A model's Fresnel term and a one-line description of where it comes from
+/// (`fresnel = conductor`, "Schlick, F0 from specular, …").
+#[derive(Debug, Clone, PartialEq)]
+pub struct FresnelTerm {
+    /// The term.
+    pub fresnel: crate::fresnel::Fresnel,
+    /// Where it comes from, in the model's words.
+    pub source: String,
 }

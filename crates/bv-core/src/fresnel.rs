@@ -7,7 +7,8 @@
 //! −z side with respect to the +z side (air above glass: `eta = 1.5`). Light
 //! arriving from the −z side has `cos_i < 0` and sees the reciprocal index.
 
-use crate::params::{ColorSpec, ParamDecl, ParamKind, Params};
+use crate::params::decl::{ColorSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{BvError, Result, Rgb};
 
 /// Amplitude reflection coefficients `(r∥, r⊥)` of a dielectric interface
@@ -221,6 +222,16 @@ pub enum Fresnel {
 }
 
 impl Fresnel {
+    /// The name of the term's kind, as the `fresnel` parameter spells it.
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Fresnel::None => "none",
+            Fresnel::Dielectric { .. } => "dielectric",
+            Fresnel::Conductor { .. } => "conductor",
+            Fresnel::Schlick { .. } => "schlick",
+        }
+    }
+
     /// F at incidence cosine `cos` (signed for dielectrics: negative means
     /// light from the −z side; the other terms use |cos|).
     pub fn eval(&self, cos: f64) -> Rgb {
@@ -623,19 +634,19 @@ mod tests {
     fn enum_from_params_and_eval() {
         let decls = [fresnel_param("conductor"), ETA, K, F0];
         let mut p = Params::defaults(&decls);
-        p.0.insert("eta".into(), crate::ParamValue::Color([0.2, 1.0, 1.5]));
-        p.0.insert("k".into(), crate::ParamValue::Color([3.9, 0.0, 0.0]));
+        p.set_unvalidated("eta", crate::ParamValue::Color([0.2, 1.0, 1.5]));
+        p.set_unvalidated("k", crate::ParamValue::Color([3.9, 0.0, 0.0]));
         let f = Fresnel::from_params(&p).unwrap();
         let v = f.eval(1.0);
         assert!(close(v.x, (0.64 + 3.9 * 3.9) / (1.44 + 3.9 * 3.9), 1e-14));
         assert!(close(v.y, 0.0, 1e-15));
         assert!(close(v.z, 0.04, 1e-15));
-        p.0.insert("fresnel".into(), crate::ParamValue::Text("none".into()));
+        p.set_unvalidated("fresnel", crate::ParamValue::Text("none".into()));
         assert_eq!(Fresnel::from_params(&p).unwrap().eval(0.3), Rgb::ONE);
-        p.0.insert("fresnel".into(), crate::ParamValue::Text("schlick".into()));
+        p.set_unvalidated("fresnel", crate::ParamValue::Text("schlick".into()));
         let s = Fresnel::from_params(&p).unwrap().eval(0.0);
         assert!(close(s.x, 1.0, 1e-15));
-        p.0.insert("fresnel".into(), crate::ParamValue::Text("bogus".into()));
+        p.set_unvalidated("fresnel", crate::ParamValue::Text("bogus".into()));
         assert!(Fresnel::from_params(&p).is_err());
     }
 }

@@ -6,7 +6,7 @@
 //! crate; the `bv` application, the shaders' parity tests and the command line
 //! all call into it.
 //!
-//! Conventions (SPEC §1): local frame with normal `+z`, tangent `+x`; `wi`
+//! Conventions: local frame with normal `+z`, tangent `+x`; `wi`
 //! towards the light and `wo` towards the viewer, both pointing away from the
 //! surface; `f(wi, wo)` is returned without the cosine factor, per linear-RGB
 //! channel.
@@ -21,16 +21,19 @@ pub mod fsio;
 pub mod lobe;
 pub mod measured;
 pub mod microfacet;
+pub mod model;
 pub mod models;
 pub mod params;
 pub mod registry;
 pub mod represent;
 pub mod sampling;
+pub mod text;
 
-pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, Ndf};
+pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, Ndf};
 pub use error::{BvError, Result};
+pub use model::ModelInfo;
 pub use params::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
-pub use registry::{ModelInfo, catalogue, find};
+pub use registry::{catalogue, find, register};
 
 /// A linear-RGB triple (one value per channel).
 pub type Rgb = glam::DVec3;

@@ -1,62 +1,83 @@
-//! The model catalogue: every model id with its parameter declaration and its
-//! constructor (SPEC §2).
+//! The model catalogue: the built-in models (one line each in
+//! [`crate::models::BUILT_IN`]) and the models registered at run time (user
+//! files), in presentation order. Everything that lists or finds models goes
+//! through here, so nothing may assume the set is fixed at compile time:
+//! [`revision`] changes whenever a model is registered, and caches built from
+//! the catalogue (the generated shader dispatch) key on it.
 
-use crate::params::{ParamDecl, Params};
-use crate::{Brdf, BvError, Result, models};
+use crate::model::ModelInfo;
+use crate::{BvError, Result, models};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, LazyLock, RwLock};
 
-/// One model of the catalogue.
-#[derive(Debug, Clone, Copy)]
-pub struct ModelInfo {
-    /// Stable id (`cook-torrance`).
-    pub id: &'static str,
-    /// Display name (`Cook-Torrance`).
-    pub name: &'static str,
-    /// One-line description.
-    pub summary: &'static str,
-    /// Where the formula comes from (paper, equation).
-    pub citation: &'static str,
-    /// The parameter declaration: the one source the CLI, scenes and GUI read.
-    pub params: &'static [ParamDecl],
-    /// Builds an evaluator from a complete, validated parameter set.
-    pub build: fn(&Params) -> Result<Box<dyn Brdf>>,
-}
+/// A snapshot of the catalogue.
+pub type Catalogue = Arc<Vec<&'static ModelInfo>>;
 
-impl ModelInfo {
-    /// The declaration of parameter `id`, or an error listing the known ones.
-    pub fn param(&self, id: &str) -> Result<&'static ParamDecl> {
-        self.params
-            .iter()
-            .find(|d| d.id == id)
-            .ok_or_else(|| BvError::UnknownParam {
-                model: self.id.to_string(),
-                param: id.to_string(),
-                known: self
-                    .params
-                    .iter()
-                    .map(|d| d.id)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })
+static CATALOGUE: LazyLock<RwLock<Catalogue>> =
+    LazyLock::new(|| RwLock::new(Arc::new(models::BUILT_IN.to_vec())));
+
+static REVISION: AtomicU64 = AtomicU64::new(0);
+
+/// Every model, in catalogue order (built-ins first, then run-time models in
+/// the order they were first registered).
+pub fn catalogue() -> Catalogue {
+    match CATALOGUE.read() {
+        Ok(c) => c.clone(),
+        // A writer cannot panic while holding the lock (it only swaps an
+        // Arc), but a poisoned lock still holds a consistent catalogue.
+        Err(poisoned) => poisoned.into_inner().clone(),
     }
 }
 
-/// Every model, in catalogue order.
-pub fn catalogue() -> &'static [&'static ModelInfo] {
-    models::CATALOGUE
+/// Changes whenever the catalogue does.
+pub fn revision() -> u64 {
+    REVISION.load(Ordering::Acquire)
 }
 
 /// The model with id `id`.
 pub fn find(id: &str) -> Result<&'static ModelInfo> {
-    catalogue()
-        .iter()
+    let c = catalogue();
+    c.iter()
         .copied()
         .find(|m| m.id == id)
         .ok_or_else(|| BvError::UnknownModel {
             id: id.to_string(),
-            known: catalogue()
-                .iter()
-                .map(|m| m.id)
-                .collect::<Vec<_>>()
-                .join(", "),
+            known: c.iter().map(|m| m.id).collect::<Vec<_>>().join(", "),
         })
+}
+
+/// Adds a model built at run time to the catalogue, or replaces the run-time
+/// model with the same id (a reloaded file), keeping its place. Returns the
+/// catalogue entry. A built-in id cannot be replaced.
+///
+/// Entries live for the rest of the process: specs made from a replaced
+/// entry keep pointing at it (and compare unequal to specs of the new one,
+/// so that their evaluators are rebuilt). Each registration costs the size of
+/// one declaration, which a user's edits of one file do not make large.
+pub fn register(info: ModelInfo) -> Result<&'static ModelInfo> {
+    if info.id.is_empty() || info.id.chars().any(|c| c.is_whitespace()) {
+        return Err(BvError::Invalid(format!(
+            "model id `{}` is empty or contains white space",
+            info.id
+        )));
+    }
+    if models::BUILT_IN.iter().any(|m| m.id == info.id) {
+        return Err(BvError::Invalid(format!(
+            "`{}` is a built-in model and cannot be replaced",
+            info.id
+        )));
+    }
+    let leaked: &'static ModelInfo = Box::leak(Box::new(info));
+    let mut guard = match CATALOGUE.write() {
+        Ok(g) => g,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    let mut next: Vec<&'static ModelInfo> = guard.as_ref().clone();
+    match next.iter_mut().find(|m| m.id == leaked.id) {
+        Some(slot) => *slot = leaked,
+        None => next.push(leaked),
+    }
+    *guard = Arc::new(next);
+    REVISION.fetch_add(1, Ordering::AcqRel);
+    Ok(leaked)
 }

@@ -145,17 +145,20 @@ fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Params {
                             let m = pool[rng.random_range(0..pool.len())];
                             Component {
                                 weight: random_float(&weight, rng),
-                                spec: ModelSpec {
-                                    model: m.id.to_string(),
-                                    params: random_params(m.params, rng),
-                                },
+                                spec: ModelSpec::from_json(
+                                    m.id,
+                                    &random_params(m.params, rng).to_json(),
+                                )
+                                .unwrap_or_else(|e| {
+                                    panic!("{}: generated parameters refused: {e}", m.id)
+                                }),
                             }
                         })
                         .collect(),
                 )
             }
         };
-        p.0.insert(d.id.to_string(), v);
+        p.set_unvalidated(&d.id.to_string(), v);
     }
     p
 }
@@ -192,9 +195,8 @@ fn random_model(m: &ModelInfo, seed: u64) -> (ModelSpec, Arc<dyn Brdf>) {
         let mut full = spec.clone();
         for d in m.params {
             if matches!(d.kind, ParamKind::Path { .. }) {
-                full.params
-                    .0
-                    .insert(d.id.to_string(), ParamValue::Text(synthetic_table(true)));
+                full.set(d.id, ParamValue::Text(synthetic_table(true)))
+                    .unwrap_or_else(|e| panic!("{}: {e}", m.id));
             }
         }
         full.build()
@@ -276,7 +278,7 @@ fn for_every_model<S: Strategy>(
     S::Value: std::fmt::Debug,
 {
     let mut failures = Vec::new();
-    for m in catalogue() {
+    for m in catalogue().iter() {
         let result = runner(cases).run(&strategy, |v| test(m, v));
         if let Err(e) = result {
             failures.push(format!("model `{}`: {e}", m.id));
@@ -469,7 +471,7 @@ fn quick() -> CheckOptions {
 #[test]
 fn check_agrees_with_claims_for_every_default_model() {
     let mut failures = Vec::new();
-    for m in catalogue() {
+    for m in catalogue().iter() {
         let (spec, b) = if m
             .params
             .iter()
@@ -590,7 +592,7 @@ fn sharp_lobes_give_accurate_albedo() {
 /// parameters pass the shared parser and build (checked over many seeds).
 #[test]
 fn random_params_are_accepted_by_every_model() {
-    for m in catalogue() {
+    for m in catalogue().iter() {
         for seed in 0..40 {
             let (spec, b) = random_model(m, seed);
             assert_eq!(b.id(), m.id, "{}", ctx(&spec));

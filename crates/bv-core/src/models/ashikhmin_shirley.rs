@@ -4,9 +4,10 @@
 //! (`cos²φ` written twice in D, the missing `/2` in the diffuse term).
 
 use crate::frame::half_vector;
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
-use crate::{Brdf, Claims, Result, Rgb, mean_rgb, sampling};
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
+use crate::{Brdf, Claims, FresnelTerm, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -39,13 +40,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "ashikhmin-shirley",
     name: "Ashikhmin-Shirley",
     summary: "Anisotropic Phong: Schlick-Fresnel specular lobe over a coupled diffuse term",
     citation: "Ashikhmin & Shirley 2000, \"An anisotropic Phong BRDF model\", eqs. 4-5, 9-10",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::ashikhmin_shirley",
+            "shaders/models/ashikhmin_shirley.wgsl",
+            include_str!("../../../../shaders/models/ashikhmin_shirley.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// The Ashikhmin-Shirley BRDF.
@@ -170,6 +180,13 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for AshikhminShirley {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        Some(FresnelTerm {
+            fresnel: crate::fresnel::Fresnel::Schlick { f0: self.rs },
+            source: "Schlick with F0 = rs (Ashikhmin & Shirley 2000, eq. 5)".into(),
+        })
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {

@@ -14,8 +14,9 @@
 //! reciprocal: the diffuse part depends on `wi` only.
 
 use super::lobes::clamped_pow;
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -43,13 +44,19 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "banks",
     name: "Banks (anisotropic fibres)",
     summary: "Fibres along the tangent x: kd sin αi + ks (sin αi sin αo − cos αi cos αo)^e; anisotropic, not reciprocal",
     citation: "Banks 1994, \"Illumination in diverse codimensions\", §4",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(GpuPort::new(
+        "bv::models::banks",
+        "shaders/models/banks.wgsl",
+        include_str!("../../../../shaders/models/banks.wgsl"),
+    )),
 };
 
 /// Banks fibre BRDF.

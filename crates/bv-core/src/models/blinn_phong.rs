@@ -10,8 +10,9 @@
 
 use super::lobes::{COS_FLOOR, clamped_pow, half_vector};
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -39,13 +40,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "blinn-phong",
     name: "Blinn-Phong",
     summary: "Half-vector Phong as a BRDF: kd + ks (h·n)^e / cosθi; not reciprocal, not energy-conserving",
     citation: "Blinn 1977, \"Models of light reflection for computer synthesized pictures\"; BRDF form as in the lecture",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::blinn_phong",
+            "shaders/models/blinn_phong.wgsl",
+            include_str!("../../../../shaders/models/blinn_phong.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Blinn-Phong BRDF.

@@ -8,9 +8,10 @@ use crate::fresnel::{self, Fresnel, FresnelLanes};
 use crate::microfacet::{
     self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
 };
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
-use crate::{Brdf, Claims, Ndf, Result, Rgb, mean_rgb, sampling};
+use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::{ModelSpec, Params};
+use crate::{Brdf, Claims, FresnelTerm, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::FRAC_1_PI;
 
@@ -80,14 +81,42 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "cook-torrance",
     name: "Cook-Torrance",
     summary: "Microfacet specular (choice of D, G, F) over a Lambertian base",
     citation: "Cook & Torrance 1982; Walter et al. 2007 (GGX, Smith G); Heitz 2014 (masking)",
     params: PARAMS,
-    build,
+    aliases: &[ALPHA_ALIAS],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::cook_torrance",
+            "shaders/models/cook_torrance.wgsl",
+            include_str!("../../../../shaders/models/cook_torrance.wgsl"),
+        )
+        .with_sampling_lobe()
+        .with_derived(DERIVED_SLOTS, derive_slots),
+    ),
 };
+
+/// Derived GPU slots (read by `shaders/models/cook_torrance.wgsl`): Blinn's
+/// normalisation constant for `alpha_x` and for `alpha2`, 0 unless the
+/// distribution is `blinn` (each costs a quadrature, done once here rather
+/// than per shaded pixel).
+const DERIVED_SLOTS: &[&str] = &["blinn_norm", "blinn_norm2"];
+
+fn derive_slots(spec: &ModelSpec, _tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
+    let p = spec.params();
+    Ok(if p.text("distribution")? == "blinn" {
+        vec![
+            microfacet::blinn_normalisation(p.float("alpha_x")?) as f32,
+            microfacet::blinn_normalisation(p.float("alpha2")?) as f32,
+        ]
+    } else {
+        vec![0.0, 0.0]
+    })
+}
 
 /// The Cook-Torrance model with its D, G and F.
 #[derive(Debug, Clone)]
@@ -161,6 +190,13 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for CookTorrance {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        Some(FresnelTerm {
+            fresnel: self.fresnel,
+            source: format!("fresnel = {}", self.fresnel.kind_name()),
+        })
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {

@@ -5,9 +5,10 @@
 
 use crate::fresnel::schlick_weight;
 use crate::microfacet::{self, Distribution, Microfacet};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
-use crate::{Brdf, Claims, Ndf, Result, Rgb, mean_rgb, sampling};
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
+use crate::{Brdf, Claims, FresnelTerm, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
 
@@ -86,13 +87,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "disney",
     name: "Disney principled",
     summary: "Burley's artist-friendly BRDF: diffuse, subsurface, sheen, GTR2 specular, GTR1 clearcoat",
     citation: "Burley 2012, Physically Based Shading at Disney; reference shader disney.brdf",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::disney",
+            "shaders/models/disney.wgsl",
+            include_str!("../../../../shaders/models/disney.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Linear interpolation `a (1 − t) + b t` (GLSL `mix`).
@@ -243,6 +253,13 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for Disney {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        Some(FresnelTerm {
+            fresnel: crate::fresnel::Fresnel::Schlick { f0: self.cspec0 },
+            source: "Schlick, F0 from specular, specular_tint and metallic (Burley 2012)".into(),
+        })
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {

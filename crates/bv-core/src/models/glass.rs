@@ -3,9 +3,10 @@
 //! (SPEC §2; the seed's "ideal specular" summary; PBRT 3rd ed. §8.2).
 
 use crate::fresnel;
-use crate::params::{FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
-use crate::{Brdf, Claims, DeltaKind, DeltaLobe, Result, Rgb, frame};
+use crate::model::{Build, DeltaPort, GpuPort, ModelInfo};
+use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
+use crate::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, Result, Rgb, frame};
 use glam::DVec3;
 
 /// Parameter declaration.
@@ -17,13 +18,22 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
 }];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "glass",
     name: "Glass",
     summary: "Smooth dielectric: Fresnel-weighted mirror reflection and refraction",
     citation: "Seed lecture, ideal specular summary; PBRT 3rd ed. §8.2",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::glass",
+            "shaders/models/glass.wgsl",
+            include_str!("../../../../shaders/models/glass.wgsl"),
+        )
+        .with_delta(DeltaPort::Refraction),
+    ),
 };
 
 /// A smooth dielectric interface of relative index `eta`.
@@ -46,6 +56,15 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for Glass {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        Some(FresnelTerm {
+            fresnel: crate::fresnel::Fresnel::Dielectric {
+                eta: Rgb::splat(self.eta),
+            },
+            source: "exact dielectric (glass)".into(),
+        })
     }
 
     /// Zero at every finite pair: all the energy is in the delta lobes.

@@ -5,8 +5,9 @@
 //! Hapke's closed-form approximation of Chandrasekhar's H function. The lecture
 //! uses it for the Moon's flat, retro-reflective look.
 
-use crate::params::{FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -43,13 +44,19 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "hapke",
     name: "Hapke",
     summary: "Lunar regolith: single scattering with opposition surge plus multiple scattering",
     citation: "Hapke 1981, \"Bidirectional reflectance spectroscopy 1. Theory\" (no macroscopic roughness)",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(GpuPort::new(
+        "bv::models::hapke",
+        "shaders/models/hapke.wgsl",
+        include_str!("../../../../shaders/models/hapke.wgsl"),
+    )),
 };
 
 /// The Hapke 1981 BRDF (grey: one value for all channels).

@@ -16,8 +16,9 @@
 //! overflow for any exponent up to 10000 (`2^10000` would).
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, mean_rgb};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -81,13 +82,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "lafortune",
     name: "Lafortune",
     summary: "Sum of generalised cosine lobes: reciprocal, off-specular, retro-reflective or anisotropic",
     citation: "Lafortune, Foo, Torrance & Greenberg 1997, \"Non-linear approximation of reflectance functions\", eq. 4",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::lafortune",
+            "shaders/models/lafortune.wgsl",
+            include_str!("../../../../shaders/models/lafortune.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// One generalised cosine lobe.

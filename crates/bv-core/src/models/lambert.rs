@@ -1,8 +1,9 @@
 //! Lambert: the ideal diffuse reflector, `f = albedo / π`.
 
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
 use std::f64::consts::FRAC_1_PI;
@@ -16,13 +17,19 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
 }];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "lambert",
     name: "Lambert",
     summary: "Ideal diffuse reflection: the same radiance in every direction",
     citation: "Lambert 1760; PBRT 3rd ed. §8.3",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(GpuPort::new(
+        "bv::models::lambert",
+        "shaders/models/lambert.wgsl",
+        include_str!("../../../../shaders/models/lambert.wgsl"),
+    )),
 };
 
 /// Lambertian reflector.

@@ -2,11 +2,15 @@
 //! 2003, "A Data-Driven Reflectance Model").
 
 use crate::measured::merl::{self as table, Interpolation, MerlTable};
-use crate::params::{ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{
+    Build, FileData, FileFormat, GpuPort, GpuTables, ModelInfo, Progress, TABLE_ALIGN,
+};
+use crate::params::decl::{ParamDecl, ParamKind};
+use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, BvError, Claims, Result, Rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::path::Path;
 use std::sync::Arc;
 
 /// Parameter declaration.
@@ -15,7 +19,10 @@ pub const PARAMS: &[ParamDecl] = &[
         id: "path",
         label: "file",
         doc: "MERL .binary file (half/difference-angle table, 90×90×180 in the public set)",
-        kind: ParamKind::Path { default: "" },
+        kind: ParamKind::Path {
+            default: "",
+            format: &MERL_FILES,
+        },
     },
     ParamDecl {
         id: "interpolation",
@@ -29,14 +36,73 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "merl",
     name: "MERL measured",
     summary: "Measured isotropic BRDF, tabulated in half/difference angles",
     citation: "Matusik, Pfister, Brand, McMillan 2003, A Data-Driven Reflectance Model; Rusinkiewicz 1998",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::merl",
+            "shaders/models/merl.wgsl",
+            include_str!("../../../../shaders/models/merl.wgsl"),
+        )
+        .with_derived(DERIVED_SLOTS, derive_slots),
+    ),
 };
+
+/// MERL `.binary` tables as a file format of bv-core's table reader and
+/// cache (`crate::measured::merl`).
+#[derive(Debug)]
+pub struct MerlFiles;
+
+/// The format of `merl`'s `path` parameter.
+pub static MERL_FILES: MerlFiles = MerlFiles;
+
+impl FileFormat for MerlFiles {
+    fn name(&self) -> &'static str {
+        "MERL table"
+    }
+
+    fn tag(&self) -> &'static str {
+        "MERL"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["binary"]
+    }
+
+    fn load(&self, path: &Path, progress: &mut Progress<'_>) -> Result<Arc<dyn FileData>> {
+        let t = table::read_cached_with_progress(path, &mut |a, b| progress(a, b))?;
+        Ok(t)
+    }
+
+    fn is_cached(&self, path: &Path) -> bool {
+        table::is_cached(path)
+    }
+}
+
+/// Derived GPU slots of `merl` (read by `shaders/models/merl.wgsl`): the
+/// table's dimensions and its offset in the frame's table buffer, in units
+/// of [`TABLE_ALIGN`] floats.
+const DERIVED_SLOTS: &[&str] = &["theta_h_count", "theta_d_count", "phi_d_count", "table"];
+
+fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
+    // Through the cache: the same table (and so the same upload) as the
+    // built model's.
+    let t = table::read_cached(spec.params().text("path")?)?;
+    let d = t.dims();
+    let offset = tables.offset_of(t) / TABLE_ALIGN;
+    Ok(vec![
+        d.theta_h as f32,
+        d.theta_d as f32,
+        d.phi_d as f32,
+        offset as f32,
+    ])
+}
 
 /// A measured BRDF: a shared table and how to look it up.
 #[derive(Debug, Clone)]
@@ -170,8 +236,8 @@ impl Brdf for Merl {
         }
     }
 
-    fn measured(&self) -> Option<(&Arc<MerlTable>, Interpolation)> {
-        Some((&self.table, self.interpolation))
+    fn file_data(&self) -> Option<Arc<dyn FileData>> {
+        Some(self.table.clone())
     }
 
     /// Half of the samples cosine-weighted, half through a half vector drawn

@@ -2,9 +2,10 @@
 //! the seed's "ideal specular" summary; PBRT 3rd ed. §8.2.2).
 
 use crate::fresnel::{self, Fresnel};
-use crate::params::{ParamDecl, Params};
-use crate::registry::ModelInfo;
-use crate::{Brdf, Claims, DeltaKind, DeltaLobe, Result, Rgb, frame};
+use crate::model::{Build, DeltaPort, GpuPort, ModelInfo};
+use crate::params::decl::ParamDecl;
+use crate::params::value::Params;
+use crate::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, Result, Rgb, frame};
 use glam::DVec3;
 
 /// Copper's normal-incidence reflectance from [`fresnel::COPPER_ETA`] and
@@ -22,13 +23,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "mirror",
     name: "Mirror",
     summary: "Ideal specular reflection weighted by a Fresnel term (a delta lobe)",
     citation: "Seed lecture, ideal specular summary; PBRT 3rd ed. §8.2.2",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::mirror",
+            "shaders/models/mirror.wgsl",
+            include_str!("../../../../shaders/models/mirror.wgsl"),
+        )
+        .with_delta(DeltaPort::Reflection),
+    ),
 };
 
 /// Ideal mirror with a Fresnel term.
@@ -51,6 +61,13 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for Mirror {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn fresnel_term(&self) -> Option<FresnelTerm> {
+        Some(FresnelTerm {
+            fresnel: self.fresnel,
+            source: format!("fresnel = {}", self.fresnel.kind_name()),
+        })
     }
 
     /// Zero at every finite pair: all the energy is in the delta lobe.

@@ -3,10 +3,10 @@
 //! linearity property of BRDFs (seed, "BRDF Property 1"; Sillion, Arvo, Westin
 //! & Greenberg 1991).
 
-use crate::params::{
-    Component, FloatSpec, MAX_NESTING, ModelSpec, ParamDecl, ParamKind, ParamValue, Params,
-};
-use crate::registry::ModelInfo;
+use crate::model::{Build, ModelInfo};
+use crate::params::MAX_NESTING;
+use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::{Component, ModelSpec, ParamValue, Params};
 use crate::{Brdf, BvError, Claims, DeltaLobe, Result, Rgb};
 use glam::{DVec2, DVec3};
 
@@ -29,30 +29,29 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
 }];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "mix",
     name: "Mix",
     summary: "Weighted sum of other models (BRDFs are linear)",
     citation: "Linearity of BRDFs: Sillion, Arvo, Westin & Greenberg 1991; the lecture's complex BRDF",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: None,
 };
 
 /// The default component list: the seed's "complex BRDF" as a sum of a
 /// diffuse and a glossy part (0.6 · orange Lambert + 0.4 · pure-specular GGX
 /// Cook-Torrance), built from the declarations directly so that it cannot fail.
 fn default_components() -> Vec<Component> {
-    let component = |weight: f64, info: &ModelInfo, set: &[(&str, ParamValue)]| {
+    let component = |weight: f64, info: &'static ModelInfo, set: &[(&str, ParamValue)]| {
         let mut params = Params::defaults(info.params);
         for (k, v) in set {
-            params.0.insert((*k).to_string(), v.clone());
+            params.insert((*k).to_string(), v.clone());
         }
         Component {
             weight,
-            spec: ModelSpec {
-                model: info.id.to_string(),
-                params,
-            },
+            spec: ModelSpec::from_parts(info, params),
         }
     };
     vec![
@@ -139,7 +138,7 @@ fn nesting_levels(p: &Params) -> usize {
     let mut stack: Vec<(&Params, usize)> = vec![(p, 0)];
     while let Some((params, depth)) = stack.pop() {
         deepest = deepest.max(depth);
-        for value in params.0.values() {
+        for (_, value) in params.iter() {
             match value {
                 ParamValue::Components(cs) => {
                     // Refuse early: nothing deeper needs to be looked at.
@@ -147,7 +146,7 @@ fn nesting_levels(p: &Params) -> usize {
                         return depth + 1;
                     }
                     for c in cs {
-                        stack.push((&c.spec.params, depth + 1));
+                        stack.push((c.spec.params(), depth + 1));
                     }
                     deepest = deepest.max(depth + 1);
                 }
@@ -384,32 +383,26 @@ mod tests {
         let err = ModelSpec::from_json("mix", &deep["params"]).unwrap_err();
         assert!(err.to_string().contains("nest deeper"), "{err}");
 
-        // A nest built in code bypasses the parser; build refuses it too.
+        // A nest built inside the crate bypasses the parser; build refuses it too.
         let mut spec = ModelSpec::new("lambert").unwrap();
         for _ in 0..(MAX_NESTING + 1) {
             let mut params = Params::default();
-            params.0.insert(
+            params.insert(
                 "components".into(),
                 ParamValue::Components(vec![Component { weight: 1.0, spec }]),
             );
-            spec = ModelSpec {
-                model: "mix".into(),
-                params,
-            };
+            spec = ModelSpec::from_parts(&INFO, params);
         }
         let err = spec.build().unwrap_err();
         assert!(err.to_string().contains("nest deeper"), "{err}");
         // Far deeper still fails cleanly (no recursion before the check).
         for _ in 0..10_000 {
             let mut params = Params::default();
-            params.0.insert(
+            params.insert(
                 "components".into(),
                 ParamValue::Components(vec![Component { weight: 1.0, spec }]),
             );
-            spec = ModelSpec {
-                model: "mix".into(),
-                params,
-            };
+            spec = ModelSpec::from_parts(&INFO, params);
         }
         assert!(spec.build().is_err());
         // Dropping a 10 000-deep nest recurses in Drop; leak it instead so the
@@ -426,23 +419,8 @@ mod tests {
             "{err}"
         );
         assert!(err.to_string().contains("unknown model `nope`"), "{err}");
-        // The same through a parameter set made in code.
-        let mut params = Params::default();
-        params.0.insert(
-            "components".into(),
-            ParamValue::Components(vec![Component {
-                weight: 1.0,
-                spec: ModelSpec {
-                    model: "nope".into(),
-                    params: Params::default(),
-                },
-            }]),
-        );
-        let spec = ModelSpec {
-            model: "mix".into(),
-            params,
-        };
-        assert!(matches!(spec.build(), Err(BvError::UnknownModel { .. })));
+        // (A spec holds its model, so a component of an unknown model cannot
+        // be made in code either.)
         // Other malformed components.
         for bad in [
             json!({"components": []}),
@@ -458,9 +436,9 @@ mod tests {
     #[test]
     fn default_is_diffuse_plus_glossy_and_round_trips() {
         let spec = ModelSpec::new("mix").unwrap();
-        let comps = spec.params.components("components").unwrap();
+        let comps = spec.params().components("components").unwrap();
         assert_eq!(comps.len(), 2);
-        assert!(comps.iter().all(|c| registry::find(&c.spec.model).is_ok()));
+        assert!(comps.iter().all(|c| registry::find(c.spec.id()).is_ok()));
         let b = spec.build().unwrap();
         // Lambert part 0.6 · (0.8, 0.3, 0.1)/π. At wi = wo = n the GGX part is
         // F(1) D(n) G / 4 with F(1) = ((1.5 − 1)/(1.5 + 1))² = 0.04 (the default

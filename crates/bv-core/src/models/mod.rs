@@ -1,8 +1,10 @@
-//! One module per model of the catalogue (SPEC §2). Each declares `INFO`, its
-//! id, parameter list and constructor; [`CATALOGUE`] lists them in the order
-//! the CLI and the GUI present them.
+//! One module per built-in model. Each declares everything about its model in
+//! one `INFO` ([`ModelInfo`]: id, parameters and aliases, constructor, GPU
+//! port); [`BUILT_IN`] lists them in the order the CLI and the GUI present
+//! them. Adding a model: its module here, its WGSL file under
+//! `shaders/models/`, and one line in [`BUILT_IN`].
 
-use crate::registry::ModelInfo;
+use crate::model::ModelInfo;
 
 pub mod ashikhmin_shirley;
 pub mod banks;
@@ -25,8 +27,8 @@ pub mod ward;
 #[cfg(test)]
 pub(crate) mod testkit;
 
-/// Every model, in presentation order (SPEC §2).
-pub static CATALOGUE: &[&ModelInfo] = &[
+/// Every built-in model, in presentation order.
+pub static BUILT_IN: &[&ModelInfo] = &[
     &lambert::INFO,
     &phong::INFO,
     &blinn_phong::INFO,

@@ -8,8 +8,9 @@
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -37,13 +38,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "modified-phong",
     name: "Modified Phong",
     summary: "Normalised, reciprocal Phong: kd/π + ks (e+2)/(2π) (R(wo)·wi)^e",
     citation: "Lafortune & Willems 1994, \"Using the modified Phong reflectance model for physically based rendering\", §3",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::modified_phong",
+            "shaders/models/modified_phong.wgsl",
+            include_str!("../../../../shaders/models/modified_phong.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Modified Phong BRDF.

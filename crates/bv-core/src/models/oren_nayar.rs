@@ -3,8 +3,9 @@
 //! Nayar 1994, "Generalization of Lambert's reflectance model" (SIGGRAPH), eq. 30.
 
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
@@ -26,13 +27,19 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "oren-nayar",
     name: "Oren-Nayar",
     summary: "Rough diffuse surfaces: Lambertian V-cavities, brighter towards the light",
     citation: "Oren & Nayar 1994, \"Generalization of Lambert's reflectance model\", eq. 30",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(GpuPort::new(
+        "bv::models::oren_nayar",
+        "shaders/models/oren_nayar.wgsl",
+        include_str!("../../../../shaders/models/oren_nayar.wgsl"),
+    )),
 };
 
 /// The qualitative Oren-Nayar model.

@@ -13,8 +13,9 @@
 
 use super::lobes::{COS_FLOOR, Mixture, PowerLobe, clamped_pow};
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
@@ -43,13 +44,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "phong",
     name: "Phong (classical)",
     summary: "Classical Phong as a BRDF: kd + ks (R(wo)·wi)^e / cosθi; not reciprocal, not energy-conserving",
     citation: "Phong 1975, \"Illumination for computer generated pictures\"; BRDF form as in the lecture; flaws: Lewis 1994",
     params: PARAMS,
-    build,
+    aliases: &[],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::phong",
+            "shaders/models/phong.wgsl",
+            include_str!("../../../../shaders/models/phong.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Classical Phong BRDF.

@@ -8,8 +8,9 @@
 
 use super::lobes::{COS_FLOOR, half_unnormalised};
 use crate::batch::{Kernel, LaneKernel, math};
-use crate::params::{ColorSpec, FloatSpec, ParamDecl, ParamKind, Params};
-use crate::registry::ModelInfo;
+use crate::model::{ALPHA_ALIAS, Build, GpuPort, ModelInfo};
+use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -44,13 +45,22 @@ pub const PARAMS: &[ParamDecl] = &[
 ];
 
 /// Catalogue entry.
-pub const INFO: ModelInfo = ModelInfo {
+pub static INFO: ModelInfo = ModelInfo {
     id: "ward",
     name: "Ward",
     summary: "Anisotropic Gaussian highlight: kd/π + ks exp(−tan²θh(...)) / (4π αx αy √(cosθi cosθo))",
     citation: "Ward 1992, \"Measuring and modeling anisotropic reflection\", eq. 5; sampling: Walter 2005, \"Notes on the Ward BRDF\"",
     params: PARAMS,
-    build,
+    aliases: &[ALPHA_ALIAS],
+    build: Build::Static(build),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::ward",
+            "shaders/models/ward.wgsl",
+            include_str!("../../../../shaders/models/ward.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Ward's anisotropic BRDF.

@@ -212,7 +212,7 @@ fn pack_nested(
     depth: usize,
     derived: &mut DerivedSlots<'_>,
 ) -> Result<GpuModelRef> {
-    let info = registry::find(&spec.model)?;
+    let info = spec.model();
     let model = gpu_model_index(info.id)?;
     let layout = gpu_layout(info.params);
     let offset = buf.len();
@@ -221,7 +221,7 @@ fn pack_nested(
     }
     buf.resize(offset + layout.size as usize, 0.0);
     let mut deferred = Vec::new();
-    write_block(&layout, &spec.params, buf, offset, &mut deferred)?;
+    write_block(&layout, spec.params(), buf, offset, &mut deferred)?;
     let extra = derived(spec)?;
     if buf.len() + extra.len() >= MAX_SLOTS {
         return Err(too_big());
@@ -269,12 +269,14 @@ fn flatten<'a>(
         if w == 0.0 {
             continue;
         }
-        let nested = registry::find(&c.spec.model)?
+        let nested = c
+            .spec
+            .model()
             .params
             .iter()
             .find(|d| matches!(d.kind, ParamKind::Components { .. }));
         match nested {
-            Some(d) => flatten(c.spec.params.components(d.id)?, w, depth + 1, out)?,
+            Some(d) => flatten(c.spec.params().components(d.id)?, w, depth + 1, out)?,
             None => out.push((w, &c.spec)),
         }
         if out.len() * COMPONENT_ENTRY_SLOTS as usize >= MAX_SLOTS {
@@ -392,7 +394,10 @@ mod tests {
             id: "file",
             label: "file",
             doc: "path",
-            kind: ParamKind::Path { default: "" },
+            kind: ParamKind::Path {
+                default: "",
+                format: &crate::models::merl::MERL_FILES,
+            },
         },
         ParamDecl {
             id: "e",
@@ -443,7 +448,7 @@ mod tests {
 
     #[test]
     fn every_catalogue_model_packs_its_defaults() {
-        for m in registry::catalogue() {
+        for m in registry::catalogue().iter() {
             let spec = ModelSpec::new(m.id).unwrap();
             let mut buf = vec![0.0; 5];
             let r = pack_model(&spec, &mut buf).unwrap();
@@ -502,11 +507,11 @@ mod tests {
     #[test]
     fn mismatched_values_are_refused() {
         let mut p = Params::defaults(DECLS);
-        p.0.insert("mode".into(), ParamValue::Text("zzz".into()));
+        p.set_unvalidated("mode", ParamValue::Text("zzz".into()));
         let l = gpu_layout(DECLS);
         let mut buf = vec![0.0; l.size as usize];
         assert!(write_block(&l, &p, &mut buf, 0, &mut Vec::new()).is_err());
-        p.0.insert("mode".into(), ParamValue::Float(1.0));
+        p.set_unvalidated("mode", ParamValue::Float(1.0));
         assert!(write_block(&l, &p, &mut buf, 0, &mut Vec::new()).is_err());
     }
 }

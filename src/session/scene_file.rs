@@ -46,7 +46,7 @@
 
 use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
 use bv_core::fsio;
-use bv_core::{ModelSpec, ParamKind, ParamValue};
+
 use serde::Deserialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -271,7 +271,7 @@ pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
     // otherwise vanish from the figure without a word.
     for (i, b) in state.brdfs.iter().enumerate() {
         if let Err(e) = b.spec.build() {
-            let reason = format!("the `{}` BRDF cannot be built: {e}", b.spec.model);
+            let reason = format!("the `{}` BRDF cannot be built: {e}", b.spec.id());
             match builds {
                 Builds::Required => {
                     return Err(SceneError::BadValue {
@@ -341,26 +341,8 @@ fn clamp_warnings(raw: &AppState, clean: &AppState) -> Vec<String> {
 /// Applies `f` to every file path of the state: the path parameters of
 /// every BRDF (mix components included) and the environment map.
 fn map_paths(state: &mut AppState, f: &dyn Fn(&str) -> String) {
-    fn spec_paths(spec: &mut ModelSpec, f: &dyn Fn(&str) -> String) {
-        let Ok(info) = bv_core::find(&spec.model) else {
-            return;
-        };
-        for d in info.params {
-            match (&d.kind, spec.params.0.get_mut(d.id)) {
-                (ParamKind::Path { .. }, Some(ParamValue::Text(t))) if !t.trim().is_empty() => {
-                    *t = f(t);
-                }
-                (ParamKind::Components { .. }, Some(ParamValue::Components(cs))) => {
-                    for c in cs {
-                        spec_paths(&mut c.spec, f);
-                    }
-                }
-                _ => {}
-            }
-        }
-    }
     for b in &mut state.brdfs {
-        spec_paths(&mut b.spec, f);
+        b.spec.map_paths(f);
     }
     if let Some(m) = &mut state.lighting.env.map
         && !m.trim().is_empty()
@@ -490,15 +472,11 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         "°",
     )?;
     if let Some(v) = &s.maximised
-        && crate::views::entry(v).is_none()
+        && super::views::info(v).is_none()
     {
         warnings.push(format!(
             "`maximised = \"{v}\"`: no such view in this bv (views: {}); showing all views",
-            crate::views::REGISTRY
-                .iter()
-                .map(|e| e.id)
-                .collect::<Vec<_>>()
-                .join(", ")
+            super::views::id_list()
         ));
     }
     for (key, id) in [("selected", s.selected), ("solo", s.solo)] {
@@ -628,7 +606,7 @@ mod tests {
         assert!(text.contains(&abs.display().to_string()), "{text}");
         // Loading resolves them against the folder again, wherever bv runs.
         let back = load(&file).unwrap();
-        let p = back.state.brdfs[0].spec.params.text("path").unwrap();
+        let p = back.state.brdfs[0].spec.params().text("path").unwrap();
         assert_eq!(Path::new(&p), sub.join("t.binary"));
         // A table that is not there refuses the scene, or warns in the window.
         std::fs::remove_file(sub.join("t.binary")).unwrap();

@@ -37,7 +37,7 @@ const SLIDER_WIDTH: f32 = 150.0;
 pub fn params_ui(ui: &mut Ui, salt: Id, decls: &[ParamDecl], params: &Params) -> Vec<Edit> {
     let mut edits = Vec::new();
     for decl in decls {
-        let Some(current) = params.0.get(decl.id) else {
+        let Ok(current) = params.get(decl.id) else {
             continue;
         };
         let mut value = current.clone();
@@ -464,7 +464,7 @@ fn value_ui(
                     .default_open(i == 0)
                     .show(ui, |ui| {
                         for f in fields {
-                            if let Some(v) = item.0.get_mut(f.id) {
+                            if let Some(v) = item.get_mut(f.id) {
                                 let r = value_ui(ui, id.with(i).with(f.id), f, v, depth + 1);
                                 if r.reset {
                                     *v = f.default_value();
@@ -508,9 +508,7 @@ fn value_ui(
             let mut remove = None;
             let can_remove = comps.len() > 1;
             for (i, comp) in comps.iter_mut().enumerate() {
-                let name = bv_core::find(&comp.spec.model)
-                    .map(|m| m.name)
-                    .unwrap_or("?");
+                let name = bv_core::find(comp.spec.id()).map(|m| m.name).unwrap_or("?");
                 let header = format!("{} {}: {name}", singular(decl.label), i + 1);
                 egui::CollapsingHeader::new(&header)
                     .id_salt(id.with(i))
@@ -531,15 +529,21 @@ fn value_ui(
                         });
                         component_model_ui(ui, id.with(i), comp, depth);
                         if depth + 1 < bv_core::params::MAX_NESTING {
-                            if let Ok(info) = bv_core::find(&comp.spec.model) {
-                                for f in info.params {
-                                    if let Some(v) = comp.spec.params.0.get_mut(f.id) {
-                                        let r =
-                                            value_ui(ui, id.with(i).with(f.id), f, v, depth + 1);
-                                        if r.reset {
-                                            *v = f.default_value();
-                                        }
-                                    }
+                            let info = comp.spec.model();
+                            for f in info.params {
+                                let Ok(current) = comp.spec.params().get(f.id) else {
+                                    continue;
+                                };
+                                let mut v = current.clone();
+                                let r = value_ui(ui, id.with(i).with(f.id), f, &mut v, depth + 1);
+                                if r.reset {
+                                    v = f.default_value();
+                                }
+                                // Through the validating setter: a value the
+                                // declaration refuses leaves the component as
+                                // it was.
+                                if comp.spec.params().get(f.id).ok() != Some(&v) {
+                                    let _ = comp.spec.set(f.id, v);
                                 }
                             }
                         } else {
@@ -585,13 +589,13 @@ fn value_ui(
 
 /// The model of a mix component: any catalogue model.
 fn component_model_ui(ui: &mut Ui, id: Id, comp: &mut Component, _depth: usize) {
-    let current = comp.spec.model.clone();
+    let current = comp.spec.id().to_string();
     let name = bv_core::find(&current).map(|m| m.name).unwrap_or("?");
     let mut chosen = current.clone();
     egui::ComboBox::new(id.with("model"), "model")
         .selected_text(name)
         .show_ui(ui, |ui| {
-            for m in bv_core::catalogue() {
+            for m in bv_core::catalogue().iter() {
                 ui.selectable_value(&mut chosen, m.id.to_string(), m.name);
             }
         });

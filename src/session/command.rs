@@ -172,15 +172,16 @@ impl Command {
             }
             Command::ResetParam { brdf, param } => {
                 if let Some(e) = state.entry_mut(brdf)
-                    && let Ok(info) = bv_core::find(&e.spec.model)
+                    && let Ok(info) = bv_core::find(e.spec.id())
                     && let Ok(decl) = info.param(&param)
                 {
-                    e.spec.params.0.insert(param, decl.default_value());
+                    // A declared default always validates.
+                    let _ = e.spec.set(&param, decl.default_value());
                 }
             }
             Command::ResetAllParams(id) => {
                 if let Some(e) = state.entry_mut(id)
-                    && let Ok(spec) = ModelSpec::new(&e.spec.model)
+                    && let Ok(spec) = ModelSpec::new(e.spec.id())
                 {
                     e.spec = spec;
                 }
@@ -191,7 +192,7 @@ impl Command {
                     && let Some(e) = state.entry_mut(id)
                     && !cat.is_empty()
                 {
-                    let cur = cat.iter().position(|m| m.id == e.spec.model).unwrap_or(0) as i64;
+                    let cur = cat.iter().position(|m| m.id == e.spec.id()).unwrap_or(0) as i64;
                     let next = (cur + step as i64).rem_euclid(cat.len() as i64) as usize;
                     match ModelSpec::new(cat[next].id) {
                         Ok(spec) => e.spec = spec,
@@ -238,7 +239,7 @@ impl Command {
             }
             Command::OpenFile { path, into } => {
                 let target = match into.and_then(|id| state.entry(id)) {
-                    Some(e) => match path_param(&e.spec.model) {
+                    Some(e) => match path_param(e.spec.id()) {
                         Some(param) => super::loader::LoadTarget::Into {
                             brdf: e.id,
                             param: param.to_string(),
@@ -246,7 +247,7 @@ impl Command {
                         None => {
                             out.message = Some(format!(
                                 "{} takes no file; opening {path} as a new BRDF",
-                                e.spec.model
+                                e.spec.id()
                             ));
                             super::loader::LoadTarget::New
                         }
@@ -310,7 +311,7 @@ mod tests {
         }
         .apply(&mut s);
         assert_eq!(
-            s.brdfs[0].spec.params.color("albedo").unwrap(),
+            s.brdfs[0].spec.params().color("albedo").unwrap(),
             glam::DVec3::new(0.1, 0.2, 0.3)
         );
         Command::ResetParam {

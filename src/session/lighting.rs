@@ -4,13 +4,12 @@
 //! and change through [`super::Command::SetLitView`] and
 //! [`super::Command::SetEnvView`], like every other part of the state.
 
-use crate::gpu::{Background, ToneMap};
 use serde::{Deserialize, Serialize};
 
 /// Exposure range of the EV controls, in stops.
 pub const EV_RANGE: (f64, f64) = (-12.0, 12.0);
 
-/// Tone map choice (a serialisable mirror of [`ToneMap`]).
+/// Tone map choice (a serialisable mirror of the renderers' tone map).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Tone {
     /// None: exposed radiance is clipped at 1 (what a reading of values wants).
@@ -25,15 +24,6 @@ pub enum Tone {
 impl Tone {
     /// Every choice, in menu order.
     pub const ALL: [Tone; 3] = [Tone::None, Tone::Reinhard, Tone::Aces];
-
-    /// The renderers' tone map.
-    pub fn to_gpu(self) -> ToneMap {
-        match self {
-            Tone::None => ToneMap::None,
-            Tone::Reinhard => ToneMap::Reinhard,
-            Tone::Aces => ToneMap::Aces,
-        }
-    }
 
     /// Menu label.
     pub fn label(self) -> &'static str {
@@ -81,23 +71,6 @@ impl BackgroundChoice {
             BackgroundChoice::Checker => "checker",
         }
     }
-
-    /// The renderer's background; `theme` is the theme's view colour (sRGB 0..1)
-    /// and `pixels_per_point` scales the checker squares to 12 points.
-    pub fn to_gpu(self, theme: [f32; 3], pixels_per_point: f32) -> Background {
-        match self {
-            BackgroundChoice::Theme => Background::Flat(theme),
-            BackgroundChoice::Black => Background::Flat([0.0; 3]),
-            // sRGB encoding of 18 % reflectance.
-            BackgroundChoice::Grey => Background::Flat([0.4613; 3]),
-            BackgroundChoice::White => Background::Flat([1.0; 3]),
-            BackgroundChoice::Checker => Background::Checker {
-                a: [0.32; 3],
-                b: [0.55; 3],
-                size: 12.0 * pixels_per_point,
-            },
-        }
-    }
 }
 
 /// The object under the environment.
@@ -120,14 +93,6 @@ impl EnvObject {
         match self {
             EnvObject::Sphere => "sphere",
             EnvObject::Torus => "torus",
-        }
-    }
-
-    /// The renderer's object.
-    pub fn to_gpu(self) -> crate::gpu::env::Object {
-        match self {
-            EnvObject::Sphere => crate::gpu::env::Object::Sphere,
-            EnvObject::Torus => crate::gpu::env::Object::Torus,
         }
     }
 }

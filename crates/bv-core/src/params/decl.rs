@@ -1,0 +1,213 @@
+//! The vocabulary of parameter declarations: what kind of value a parameter
+//! takes, its range, default and presentation hints. Every model declares its
+//! parameters once, as a static list of [`ParamDecl`]; the CLI, scene files,
+//! the GUI's sliders and the GPU layout all read that one list.
+
+use super::value::{Component, ParamValue, Params};
+use crate::model::FileFormat;
+
+/// A float parameter's range, default and presentation hints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FloatSpec {
+    /// Smallest accepted value.
+    pub min: f64,
+    /// Largest accepted value.
+    pub max: f64,
+    /// Default value.
+    pub default: f64,
+    /// Unit shown next to the value ("" when dimensionless, "rad", "1/sr", …).
+    pub unit: &'static str,
+    /// Whether a slider should move logarithmically (exponents, roughness).
+    pub log: bool,
+    /// Lower end of the slider's default span (within `min..=max`).
+    pub slider_min: f64,
+    /// Upper end of the slider's default span (within `min..=max`).
+    pub slider_max: f64,
+}
+
+impl FloatSpec {
+    /// A linear parameter whose slider covers the whole accepted range.
+    pub const fn linear(min: f64, max: f64, default: f64) -> Self {
+        Self {
+            min,
+            max,
+            default,
+            unit: "",
+            log: false,
+            slider_min: min,
+            slider_max: max,
+        }
+    }
+
+    /// A logarithmic parameter (slider span given separately).
+    pub const fn log(min: f64, max: f64, default: f64, slider_min: f64, slider_max: f64) -> Self {
+        Self {
+            min,
+            max,
+            default,
+            unit: "",
+            log: true,
+            slider_min,
+            slider_max,
+        }
+    }
+
+    /// The same spec with a unit.
+    pub const fn with_unit(mut self, unit: &'static str) -> Self {
+        self.unit = unit;
+        self
+    }
+}
+
+/// A colour parameter: linear RGB, each channel in `min..=max`; a scalar means grey.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ColorSpec {
+    /// Smallest accepted channel value.
+    pub min: f64,
+    /// Largest accepted channel value.
+    pub max: f64,
+    /// Default value.
+    pub default: [f64; 3],
+    /// Unit ("" for reflectances).
+    pub unit: &'static str,
+}
+
+impl ColorSpec {
+    /// A reflectance colour in 0..1.
+    pub const fn unit_range(default: [f64; 3]) -> Self {
+        Self {
+            min: 0.0,
+            max: 1.0,
+            default,
+            unit: "",
+        }
+    }
+
+    /// A colour with an explicit range.
+    pub const fn range(min: f64, max: f64, default: [f64; 3]) -> Self {
+        Self {
+            min,
+            max,
+            default,
+            unit: "",
+        }
+    }
+
+    /// Whether the range is the 0..1 of a reflectance (a colour picker fits it).
+    pub fn is_reflectance(&self) -> bool {
+        self.min == 0.0 && self.max == 1.0
+    }
+}
+
+/// What kind of value a parameter takes.
+#[derive(Debug, Clone, Copy)]
+pub enum ParamKind {
+    /// A real number in a range.
+    Float(FloatSpec),
+    /// A linear-RGB triple.
+    Color(ColorSpec),
+    /// One of a fixed set of names.
+    Choice {
+        /// Accepted names.
+        options: &'static [&'static str],
+        /// Default name.
+        default: &'static str,
+    },
+    /// A flag.
+    Bool {
+        /// Default.
+        default: bool,
+    },
+    /// A list of records, each with the given fields (e.g. Lafortune lobes).
+    List {
+        /// Fields of one item.
+        fields: &'static [ParamDecl],
+        /// Fewest items accepted.
+        min_items: usize,
+        /// Most items accepted.
+        max_items: usize,
+        /// How many items (each all defaults) the default list has.
+        default_items: usize,
+    },
+    /// A file a file-backed model reads (a MERL `.binary`), of a declared
+    /// format.
+    Path {
+        /// Default path ("" for none).
+        default: &'static str,
+        /// How files of this parameter are read.
+        format: &'static dyn FileFormat,
+    },
+    /// A list of `{weight, model, params}` components (the `mix` model).
+    Components {
+        /// Most components accepted.
+        max_items: usize,
+        /// Weight range of one component.
+        weight: FloatSpec,
+        /// Builds the default component list.
+        default: fn() -> Vec<Component>,
+    },
+}
+
+/// One declared parameter of a model.
+#[derive(Debug, Clone, Copy)]
+pub struct ParamDecl {
+    /// Stable id used by the CLI, scene files and tests (`alpha_x`).
+    pub id: &'static str,
+    /// Short label for the GUI (`α x`).
+    pub label: &'static str,
+    /// One-line description (tooltip, `bv models`).
+    pub doc: &'static str,
+    /// The value's kind, range and default.
+    pub kind: ParamKind,
+}
+
+impl ParamDecl {
+    /// The declared default value.
+    pub fn default_value(&self) -> ParamValue {
+        match self.kind {
+            ParamKind::Float(s) => ParamValue::Float(s.default),
+            ParamKind::Color(s) => ParamValue::Color(s.default),
+            ParamKind::Choice { default, .. } => ParamValue::Text(default.to_string()),
+            ParamKind::Bool { default } => ParamValue::Bool(default),
+            ParamKind::List {
+                fields,
+                default_items,
+                ..
+            } => ParamValue::List(vec![Params::defaults(fields); default_items]),
+            ParamKind::Path { default, .. } => ParamValue::Text(default.to_string()),
+            ParamKind::Components { default, .. } => ParamValue::Components(default()),
+        }
+    }
+
+    /// A short human description of the accepted values (`0..10000`, `one of a, b`).
+    pub fn range_text(&self) -> String {
+        match self.kind {
+            ParamKind::Float(s) => format!("{}..{}", s.min, s.max),
+            ParamKind::Color(s) => format!("rgb, each {}..{}", s.min, s.max),
+            ParamKind::Choice { options, .. } => format!("one of {}", options.join(", ")),
+            ParamKind::Bool { .. } => "true or false".to_string(),
+            ParamKind::List {
+                min_items,
+                max_items,
+                fields,
+                ..
+            } => format!(
+                "{min_items}..{max_items} items of {{{}}}",
+                fields.iter().map(|f| f.id).collect::<Vec<_>>().join(", ")
+            ),
+            ParamKind::Path { .. } => "a file path".to_string(),
+            ParamKind::Components { max_items, .. } => {
+                format!("1..{max_items} items of {{weight, model, params}}")
+            }
+        }
+    }
+
+    /// Unit text, empty when none.
+    pub fn unit(&self) -> &'static str {
+        match self.kind {
+            ParamKind::Float(s) => s.unit,
+            ParamKind::Color(s) => s.unit,
+            _ => "",
+        }
+    }
+}

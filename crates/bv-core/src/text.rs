@@ -1,0 +1,14 @@
+//! Numbers as people read them, shared by the panel, the plots and the
+//! reports.
+
+/// Formats a value with about four significant digits (plots, readouts).
+pub fn fmt_value(v: f64) -> String {
+    if v == 0.0 {
+        "0".to_string()
+    } else if !(1e-3..1e4).contains(&v.abs()) {
+        format!("{v:.3e}")
+    } else {
+        let digits = (3 - v.abs().log10().floor() as i32).clamp(0, 6) as usize;
+        format!("{v:.digits$}")
+    }
+}

@@ -1,0 +1,24 @@
+//! The session: everything the viewer knows that is not drawing. The state
+//! that is saved between runs ([`state`], [`lighting`]), the commands that
+//! change it ([`command`]), the evaluators built from it ([`runtime`]), the
+//! background reads of file-backed models ([`loader`]), the scene file format
+//! ([`scene_file`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
+//! and the per-frame scene every view reads ([`frame`]).
+//!
+//! Nothing here draws: no egui, no wgpu. The window (`app`), the views, the
+//! figure export and the command line all build on this layer, and it imports
+//! none of them.
+
+pub mod command;
+pub mod frame;
+pub mod lighting;
+pub mod loader;
+pub mod naming;
+pub mod runtime;
+pub mod scene_file;
+pub mod state;
+pub mod views;
+
+pub use command::Command;
+pub use frame::{Scene, SceneBrdf, build_scene};
+pub use state::AppState;

@@ -1,0 +1,101 @@
+//! Which views the viewer has and what they are called: the ids a saved
+//! session, a scene file (`maximised = "polar"`), the command line
+//! (`bv render --view polar`) and the Num1–9 shortcuts refer to. The views
+//! themselves (drawing code) are in the `views` folder, whose registry pairs
+//! each id here with its constructor, in the same order.
+
+/// The name of one view.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ViewInfo {
+    /// Stable id (saved as the maximised view, used by shortcuts).
+    pub id: &'static str,
+    /// Title in the view's header.
+    pub title: &'static str,
+}
+
+/// Every view, in layout order (the first two share the top row, the others
+/// fill the rows below).
+pub const VIEWS: &[ViewInfo] = &[
+    ViewInfo {
+        id: "lobe",
+        title: "3D lobe",
+    },
+    ViewInfo {
+        id: "lit_sphere",
+        title: "Lit sphere",
+    },
+    ViewInfo {
+        id: "polar",
+        title: "Plane of incidence (polar)",
+    },
+    ViewInfo {
+        id: "cartesian",
+        title: "f versus angle",
+    },
+    ViewInfo {
+        id: "environment",
+        title: "Environment",
+    },
+    ViewInfo {
+        id: "albedo",
+        title: "Directional albedo ρhd(θi)",
+    },
+    ViewInfo {
+        id: "fresnel",
+        title: "Fresnel reflectance",
+    },
+    ViewInfo {
+        id: "slice",
+        title: "Image slice (θh × θd)",
+    },
+];
+
+/// Other names a view answers to on the command line (`bv render --view
+/// lobe3d`).
+pub const ALIASES: &[(&str, &str)] = &[
+    ("lobe3d", "lobe"),
+    ("3d", "lobe"),
+    ("lit", "lit_sphere"),
+    ("sphere", "lit_sphere"),
+    ("lit-sphere", "lit_sphere"),
+    ("env", "environment"),
+];
+
+/// The view with id `id`.
+pub fn info(id: &str) -> Option<&'static ViewInfo> {
+    VIEWS.iter().find(|v| v.id == id)
+}
+
+/// The view with id or alias `name` (case-insensitive).
+pub fn find(name: &str) -> Option<&'static ViewInfo> {
+    let name = name.trim().to_ascii_lowercase();
+    let id = ALIASES
+        .iter()
+        .find(|(a, _)| *a == name)
+        .map_or(name.as_str(), |(_, id)| id);
+    info(id)
+}
+
+/// The ids of every view, comma-separated (for messages).
+pub fn id_list() -> String {
+    VIEWS.iter().map(|v| v.id).collect::<Vec<_>>().join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ids_are_unique_and_aliases_resolve() {
+        let mut ids: Vec<_> = VIEWS.iter().map(|v| v.id).collect();
+        ids.sort_unstable();
+        ids.dedup();
+        assert_eq!(ids.len(), VIEWS.len());
+        for (alias, id) in ALIASES {
+            assert_eq!(find(alias).map(|v| v.id), Some(*id));
+            assert!(info(alias).is_none(), "alias {alias} shadows an id");
+        }
+        assert_eq!(find("LOBE3D").map(|v| v.id), Some("lobe"));
+        assert!(find("nope").is_none());
+    }
+}

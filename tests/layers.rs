@@ -1,0 +1,208 @@
+//! The shape of the code, checked: the top-level folders of `src/` are layers
+//! that import only downwards, and no view, figure-export or command-line code
+//! names a model of the catalogue (what a model is, is declared with the model
+//! in bv-core).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+
+/// The layers, lowest first: a folder may import the folders before it.
+const LAYERS: &[&str] = &["session", "gpu", "widgets", "views", "export", "cli", "app"];
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The code of a file without comments (line and doc comments; string
+/// contents are kept).
+fn without_comments(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let b = text.as_bytes();
+    let mut i = 0;
+    let mut in_str = false;
+    while i < b.len() {
+        let c = b[i];
+        if in_str {
+            out.push(c as char);
+            if c == b'\\' && i + 1 < b.len() {
+                out.push(b[i + 1] as char);
+                i += 2;
+                continue;
+            }
+            if c == b'"' {
+                in_str = false;
+            }
+            i += 1;
+            continue;
+        }
+        if c == b'"' && (i == 0 || b[i - 1] != b'\'') {
+            in_str = true;
+            out.push('"');
+            i += 1;
+            continue;
+        }
+        if c == b'/' && i + 1 < b.len() && b[i + 1] == b'/' {
+            while i < b.len() && b[i] != b'\n' {
+                i += 1;
+            }
+            continue;
+        }
+        out.push(c as char);
+        i += 1;
+    }
+    out
+}
+
+/// The top-level folders of `src/` a piece of code names (`crate::views::…`,
+/// `use crate::{session::…, gpu::…}`).
+fn named_folders(code: &str) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    let mut rest = code;
+    while let Some(k) = rest.find("crate::") {
+        let after = &rest[k + "crate::".len()..];
+        if let Some(group) = after.strip_prefix('{') {
+            // Top-level items of the group: split on commas at depth 0.
+            let mut depth = 0usize;
+            let mut item = String::new();
+            for ch in group.chars() {
+                match ch {
+                    '{' => {
+                        depth += 1;
+                        item.push(ch);
+                    }
+                    '}' if depth == 0 => break,
+                    '}' => {
+                        depth -= 1;
+                        item.push(ch);
+                    }
+                    ',' if depth == 0 => {
+                        out.insert(head(&item));
+                        item.clear();
+                    }
+                    _ => item.push(ch),
+                }
+            }
+            out.insert(head(&item));
+        } else {
+            out.insert(head(after));
+        }
+        rest = after;
+    }
+    out.remove("");
+    out
+}
+
+fn head(path: &str) -> String {
+    path.trim()
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect()
+}
+
+/// Folder → the other folders its files name, with one file as evidence.
+fn folder_graph() -> BTreeMap<String, BTreeMap<String, String>> {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut graph: BTreeMap<String, BTreeMap<String, String>> = BTreeMap::new();
+    for f in files {
+        let rel = f.strip_prefix(&src).unwrap();
+        let Some(folder) = rel
+            .components()
+            .next()
+            .filter(|_| rel.components().count() > 1)
+        else {
+            continue; // lib.rs, main.rs: the crate root wires the layers together
+        };
+        let folder = folder.as_os_str().to_string_lossy().to_string();
+        let code = without_comments(&std::fs::read_to_string(&f).unwrap());
+        for to in named_folders(&code) {
+            if to != folder {
+                graph
+                    .entry(folder.clone())
+                    .or_default()
+                    .entry(to)
+                    .or_insert_with(|| rel.display().to_string());
+            }
+        }
+    }
+    graph
+}
+
+#[test]
+fn the_folder_scanner_reads_imports() {
+    let code = without_comments(
+        "use crate::session::state::AppState; // crate::app::nope\n\
+         use crate::{gpu::Gpu, views::{self, Scene}};\n\
+         let s = \"crate::cli\"; crate::export::save_png(x);",
+    );
+    let got: Vec<_> = named_folders(&code).into_iter().collect();
+    assert_eq!(got, ["cli", "export", "gpu", "session", "views"]);
+}
+
+#[test]
+fn folders_import_only_the_layers_below_them() {
+    let graph = folder_graph();
+    let rank = |f: &str| LAYERS.iter().position(|l| *l == f);
+    let mut wrong = Vec::new();
+    for (from, tos) in &graph {
+        let Some(rf) = rank(from) else {
+            wrong.push(format!(
+                "src/{from}/ is not a declared layer (add it to LAYERS)"
+            ));
+            continue;
+        };
+        for (to, file) in tos {
+            match rank(to) {
+                Some(rt) if rt < rf => {}
+                Some(_) => wrong.push(format!(
+                    "src/{file} ({from}) imports {to}, which is not below it"
+                )),
+                // `crate::X` where X is not a folder (a root item): fine.
+                None => {}
+            }
+        }
+    }
+    assert!(wrong.is_empty(), "layering broken:\n{}", wrong.join("\n"));
+}
+
+#[test]
+fn no_view_export_or_cli_code_names_a_model() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let ids: Vec<String> = bv_core::catalogue()
+        .iter()
+        .map(|m| format!("\"{}\"", m.id))
+        .collect();
+    let mut hits = Vec::new();
+    for folder in ["views", "export", "cli", "widgets", "app", "session", "gpu"] {
+        let mut files = Vec::new();
+        rust_files(&src.join(folder), &mut files);
+        for f in files {
+            let text = std::fs::read_to_string(&f).unwrap();
+            // Tests may build whatever model they like.
+            let code = text.split("#[cfg(test)]").next().unwrap_or("");
+            let code = without_comments(code);
+            for id in &ids {
+                if code.contains(id.as_str()) {
+                    hits.push(format!("{} names {id}", f.display()));
+                }
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "model ids outside bv-core (declare the behaviour with the model instead):\n{}",
+        hits.join("\n")
+    );
+}
