@@ -7,9 +7,11 @@
 //! `wgpu::ShaderSource::Wgsl` (no extra wgpu feature needed).
 //!
 //! Modules (`#define_import_path`) are registered in dependency order; entry
-//! shaders (`parity`, `lit_sphere`, `env`) import what they need. The
-//! `bv::layout` module is generated from the parameter declarations
-//! ([`super::layout`]).
+//! shaders (`parity`, `lit_sphere`, `env`, `env_display`, and the lobe view's
+//! `lobe`, `lines` and `blit`) import what they need. Two modules are
+//! generated: `bv::layout` from the parameter declarations
+//! ([`super::layout`]) and `bv::colormap`, the lobe's colour map table
+//! ([`super::colormap`]).
 
 use anyhow::{Context, Result, anyhow};
 use naga_oil::compose::{
@@ -62,6 +64,9 @@ pub const ENTRIES: &[(&str, (&str, &str))] = &[
     ("lit_sphere", shader!("lit_sphere.wgsl")),
     ("env", shader!("env.wgsl")),
     ("env_display", shader!("env_display.wgsl")),
+    ("lobe", shader!("lobe.wgsl")),
+    ("lines", shader!("lines.wgsl")),
+    ("blit", shader!("blit.wgsl")),
 ];
 
 /// The line of an entry shader that [`ShaderLibrary::specialised_wgsl`]
@@ -83,7 +88,7 @@ impl std::fmt::Debug for ShaderLibrary {
 }
 
 impl ShaderLibrary {
-    /// Registers the generated layout and every module.
+    /// Registers the generated modules and every module of [`MODULES`].
     pub fn new() -> Result<Self> {
         let mut composer = Composer::default();
         let layout = super::layout::layout_module()?;
@@ -98,6 +103,10 @@ impl ShaderLibrary {
                 .map_err(|e| anyhow!("{path}: {}", e.emit_to_string(&composer)))
         };
         add("<generated bv::layout>", &layout)?;
+        add(
+            "<generated bv::colormap>",
+            &super::colormap::colormap_module(),
+        )?;
         for (path, source) in MODULES {
             add(path, source)?;
         }
