@@ -6,6 +6,8 @@
 // Rgba8Unorm target, which egui then copies as it stands (egui-wgpu draws in
 // gamma space to a non-sRGB framebuffer, so this keeps both consistent).
 
+#import bv::colormap::COLORMAP
+
 struct Globals {
     view_proj: mat4x4<f32>,
     // xyz: eye position.
@@ -26,7 +28,6 @@ struct Style {
 @group(0) @binding(0) var<uniform> g: Globals;
 @group(1) @binding(0) var<uniform> s: Style;
 
-const COLORMAP = COLORMAP_TABLE;
 
 struct VsIn {
     @location(0) pos: vec3<f32>,

@@ -12,8 +12,8 @@ use bv::session::Command;
 use bv::session::build_scene;
 use bv::session::runtime::Runtime;
 use bv::session::state::AppState;
+use bv::gpu::lobe::LobeRenderer;
 use bv::views::cartesian::CartesianView;
-use bv::views::lobe_gpu::LobeRenderer;
 use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;
 use bv::views::{Scene, View};
@@ -514,7 +514,7 @@ fn headless_lobe_render_draws_the_mesh() {
         egui_kittest::wgpu::default_wgpu_setup(),
         egui_wgpu_options(),
     );
-    let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format);
+    let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
     let mut s = LobeOnly::new("lambert", serde_json::json!({"albedo": 1.0}));
     let scene = build_scene(&s.state, &s.runtime, false);
     let bg = bv::views::lobe3d::background(true);
@@ -542,7 +542,7 @@ fn lobe_pass_timing() {
         egui_kittest::wgpu::default_wgpu_setup(),
         egui_wgpu_options(),
     );
-    let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format);
+    let mut renderer = LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
     let mut s = LobeOnly::new("lambert", serde_json::json!({}));
     for (w, h) in [(510u32, 680u32), (255, 340)] {
         let mut times = Vec::new();
@@ -672,12 +672,11 @@ fn render_window_states() {
 
 #[test]
 fn lobe_view_shaders_validate() {
-    use bv::views::lobe_gpu::{BLIT_WGSL, LINES_WGSL, lobe_shader_source};
-    for (name, src) in [
-        ("lobe.wgsl", lobe_shader_source()),
-        ("lines.wgsl", LINES_WGSL.to_string()),
-        ("blit.wgsl", BLIT_WGSL.to_string()),
-    ] {
+    // The WGSL wgpu gets: composed by the shader library (the colour map
+    // table imported from its generated module).
+    let mut lib = bv::gpu::shaders::ShaderLibrary::new().unwrap();
+    for name in ["lobe", "lines", "blit"] {
+        let src = lib.wgsl(name).unwrap_or_else(|e| panic!("{name}: {e:#}"));
         let module = naga::front::wgsl::parse_str(&src)
             .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
         naga::valid::Validator::new(

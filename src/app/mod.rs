@@ -28,6 +28,7 @@ use crate::cli::viewer_args::{ViewerArgs, parse_size};
 use crate::session::scene_file as scene;
 use crate::session::{AppState, Command, state};
 
+use crate::gpu::errors::no_gpu_message;
 use anyhow::{Context as _, bail};
 use bv_core::{ParamKind, ParamValue};
 use eframe::egui;
@@ -71,19 +72,6 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
         state.theme = state::Theme::Light;
     }
     Ok(state.sanitised())
-}
-
-/// What to tell a user whose machine has no GPU adapter wgpu can use.
-pub fn no_gpu_message(detail: &str) -> String {
-    format!(
-        "no graphics adapter found ({detail}).\n\
-         bv draws with wgpu (Vulkan, Metal, DirectX 12 or OpenGL). On a Linux machine without a GPU driver,\n\
-         install Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, then start bv again:\n\
-         \x20   Debian/Ubuntu: sudo apt install mesa-vulkan-drivers libvulkan1\n\
-         \x20   Fedora:        sudo dnf install mesa-vulkan-drivers vulkan-loader\n\
-         \x20   Arch:          sudo pacman -S vulkan-swrast\n\
-         WGPU_BACKEND=gl tries OpenGL instead. The command-line tools (`bv eval`, `bv check`, …) need no GPU."
-    )
 }
 
 /// Opens the viewer window and returns when it is closed.

@@ -9,7 +9,7 @@
 //! never upscaled.
 
 use crate::gpu::errors::{self, ErrorLog};
-use anyhow::{Context as _, Result, anyhow, bail};
+use anyhow::{Context as _, Result, bail};
 use eframe::egui::{self, Vec2};
 use eframe::egui_wgpu::{self, ScreenDescriptor};
 use eframe::wgpu;
@@ -60,31 +60,12 @@ impl Frame {
 }
 
 impl Offscreen {
-    /// Opens a device headless: the first adapter wgpu finds, preferring a
-    /// real GPU (lavapipe on a server without one).
+    /// Opens a device headless ([`crate::gpu::Headless::open`]: the first
+    /// adapter wgpu finds, preferring a real GPU; lavapipe on a server
+    /// without one).
     pub fn headless() -> Result<Self> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            ..Default::default()
-        }))
-        .map_err(|e| anyhow!(crate::app::no_gpu_message(&e.to_string())))?;
-        let info = adapter.get_info();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("bv offscreen"),
-            required_features: wgpu::Features::empty(),
-            // What the GPU renderers need (the environment view binds 5
-            // storage buffers), as for `gpu::Gpu::headless`.
-            required_limits: crate::gpu::context::limits(&adapter),
-            experimental_features: wgpu::ExperimentalFeatures::disabled(),
-            memory_hints: wgpu::MemoryHints::Performance,
-            trace: wgpu::Trace::Off,
-        }))
-        .with_context(|| format!("opening a device on {}", info.name))?;
-        Ok(Self::new(instance, adapter, device, queue))
+        let h = crate::gpu::Headless::open()?;
+        Ok(Self::new(h.instance, h.adapter, h.device, h.queue))
     }
 
     /// An offscreen renderer on an existing device: it shares the device and
@@ -309,7 +290,7 @@ impl Offscreen {
         }
         drop(renderer);
         queue.submit(user.into_iter().chain(std::iter::once(encoder.finish())));
-        let image = crate::gpu::context::read_rgba8(device, queue, &texture);
+        let image = crate::gpu::readback::read_rgba8(device, queue, &texture);
         texture.destroy();
         image
     }

@@ -1,8 +1,11 @@
-//! The device the renderers share: opened headless here, or handed over by the
-//! GUI's egui-wgpu render state.
+//! The device the renderers share: opened headless here ([`Headless`], the
+//! one opener of bv, also under `bv render`'s egui renderer), or handed over
+//! by the GUI's egui-wgpu render state; the limits bv asks of it; and the
+//! offscreen colour [`Target`] the renderers draw into.
 
 use super::errors::{self, ErrorLog};
-use anyhow::{Context, Result, anyhow, bail};
+use super::readback;
+use anyhow::{Context, Result, anyhow};
 
 /// Environment variable that lets GPU tests pass without an adapter (for
 /// machines that cannot install lavapipe); CI installs it and must not skip.
@@ -21,10 +24,26 @@ pub struct Gpu {
     pub errors: ErrorLog,
 }
 
-impl Gpu {
-    /// Opens the first adapter wgpu finds (on a machine without a GPU, Mesa's
-    /// lavapipe: `apt-get install libvulkan1 mesa-vulkan-drivers`).
-    pub fn headless() -> Result<Self> {
+/// A device opened headless, with what an egui-wgpu renderer also needs
+/// (the instance and the adapter).
+#[derive(Debug)]
+pub struct Headless {
+    /// The wgpu instance the adapter came from.
+    pub instance: wgpu::Instance,
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device, with [`limits`].
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+}
+
+impl Headless {
+    /// Opens the first adapter wgpu finds, preferring a real GPU (on a
+    /// machine without one, Mesa's lavapipe: `apt-get install libvulkan1
+    /// mesa-vulkan-drivers`); without any, the error is
+    /// [`errors::no_gpu_message`].
+    pub fn open() -> Result<Self> {
         let instance =
             wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
@@ -33,12 +52,7 @@ impl Gpu {
             compatible_surface: None,
             ..Default::default()
         }))
-        .map_err(|e| {
-            anyhow!(
-                "no GPU adapter found ({e}); on a machine without a GPU install Mesa's \
-                 software Vulkan (apt-get install libvulkan1 mesa-vulkan-drivers)"
-            )
-        })?;
+        .map_err(|e| anyhow!(errors::no_gpu_message(&e.to_string())))?;
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("bv"),
@@ -49,7 +63,21 @@ impl Gpu {
             trace: wgpu::Trace::Off,
         }))
         .with_context(|| format!("opening a device on {}", info.name))?;
-        Ok(Self::from_parts(device, queue, info))
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+        })
+    }
+}
+
+impl Gpu {
+    /// Opens a device headless ([`Headless::open`]).
+    pub fn headless() -> Result<Self> {
+        let h = Headless::open()?;
+        let info = h.adapter.get_info();
+        Ok(Self::from_parts(h.device, h.queue, info))
     }
 
     /// Wraps a device opened elsewhere (the GUI's render state); its
@@ -87,9 +115,10 @@ impl Gpu {
             .map_err(|e| anyhow!("waiting for the GPU: {e}"))
     }
 
-    /// Copies a `MAP_READ` buffer's first `len` bytes back to the CPU.
+    /// Copies the first `len` bytes of a `COPY_SRC` buffer back to the CPU
+    /// ([`readback::read_buffer`]).
     pub fn read_buffer(&self, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>> {
-        read_back(&self.device, buffer, len)
+        readback::read_buffer(&self.device, &self.queue, buffer, len)
     }
 }
 
@@ -145,99 +174,11 @@ impl Gpu {
             })
     }
 
-    /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image.
+    /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image
+    /// ([`readback::read_rgba8`]).
     pub fn read_rgba8(&self, texture: &wgpu::Texture) -> Result<image::RgbaImage> {
-        read_rgba8(&self.device, &self.queue, texture)
+        readback::read_rgba8(&self.device, &self.queue, texture)
     }
-}
-
-/// Waits for `device` and copies a `MAP_READ` buffer's first `len` bytes back.
-fn read_back(device: &wgpu::Device, buffer: &wgpu::Buffer, len: u64) -> Result<Vec<u8>> {
-    let slice = buffer.slice(..len);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        // The receiver lives until recv() below returns.
-        let _ = tx.send(r);
-    });
-    device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| anyhow!("waiting for the GPU: {e}"))?;
-    rx.recv()
-        .context("the GPU dropped a buffer mapping")?
-        .map_err(|e| anyhow!("mapping a readback buffer: {e}"))?;
-    let bytes = slice
-        .get_mapped_range()
-        .map_err(|e| anyhow!("reading a mapped buffer: {e:?}"))?
-        .to_vec();
-    buffer.unmap();
-    Ok(bytes)
-}
-
-/// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image, in
-/// bands of rows that each fit the device's largest buffer (a 16384-pixel
-/// square is 1 GiB, four times what lavapipe allows in one buffer). Work
-/// already submitted that renders into the texture is waited for.
-pub fn read_rgba8(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    texture: &wgpu::Texture,
-) -> Result<image::RgbaImage> {
-    let (w, h) = (texture.width(), texture.height());
-    let row = 4 * w as usize;
-    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize;
-    let padded = row.div_ceil(align) * align;
-    let max = device.limits().max_buffer_size;
-    let band = (max / padded as u64).clamp(1, u64::from(h.max(1))) as u32;
-    if padded as u64 > max {
-        bail!(
-            "reading back an image {w} pixels wide needs rows of {padded} bytes; this device's \
-             buffers hold at most {max} bytes"
-        );
-    }
-    errors::scoped(device, "reading the image back", || {
-        let mut pixels = Vec::with_capacity(row * h as usize);
-        let mut y = 0;
-        while y < h {
-            let rows = band.min(h - y);
-            let size = padded as u64 * u64::from(rows);
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("bv readback"),
-                size,
-                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            });
-            let mut enc = device.create_command_encoder(&Default::default());
-            enc.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d { x: 0, y, z: 0 },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(padded as u32),
-                        rows_per_image: Some(rows),
-                    },
-                },
-                wgpu::Extent3d {
-                    width: w,
-                    height: rows,
-                    depth_or_array_layers: 1,
-                },
-            );
-            queue.submit([enc.finish()]);
-            let bytes = read_back(device, &buffer, size)?;
-            for r in bytes.chunks_exact(padded) {
-                pixels.extend_from_slice(&r[..row]);
-            }
-            buffer.destroy();
-            y += rows;
-        }
-        image::RgbaImage::from_raw(w, h, pixels).context("readback has the wrong size")
-    })
 }
 
 /// An offscreen colour target that is re-created only when its size changes.

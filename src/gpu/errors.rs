@@ -14,6 +14,9 @@
 //! Limits of a device are checked before a resource is made
 //! ([`check_buffer`], [`check_texture`]), so that the message names the size
 //! asked for and the limit rather than wgpu's internal wording.
+//!
+//! [`no_gpu_message`] is what a user is told when no adapter can be opened
+//! (by the window or by a headless device).
 
 use anyhow::{Result, anyhow, bail};
 use std::collections::HashMap;
@@ -128,6 +131,19 @@ pub fn scoped<T>(device: &wgpu::Device, what: &str, work: impl FnOnce() -> Resul
         return Err(anyhow!("{what}: GPU error: {}", describe(&e)));
     }
     result
+}
+
+/// What to tell a user whose machine has no GPU adapter wgpu can use.
+pub fn no_gpu_message(detail: &str) -> String {
+    format!(
+        "no graphics adapter found ({detail}).\n\
+         bv draws with wgpu (Vulkan, Metal, DirectX 12 or OpenGL). On a Linux machine without a GPU driver,\n\
+         install Mesa's software Vulkan driver (lavapipe) and the Vulkan loader, then start bv again:\n\
+         \x20   Debian/Ubuntu: sudo apt install mesa-vulkan-drivers libvulkan1\n\
+         \x20   Fedora:        sudo dnf install mesa-vulkan-drivers vulkan-loader\n\
+         \x20   Arch:          sudo pacman -S vulkan-swrast\n\
+         WGPU_BACKEND=gl tries OpenGL instead. The command-line tools (`bv eval`, `bv check`, …) need no GPU."
+    )
 }
 
 const MIB: f64 = 1024.0 * 1024.0;

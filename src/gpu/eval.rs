@@ -82,12 +82,6 @@ impl GpuEvaluator {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let rbuf = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         // A fresh buffer per call: the evaluator is a batch tool, not a view.
         let mut tbuf = TableBuffer::default();
         let tbuf = tbuf.get(&self.gpu, &tables)?;
@@ -109,9 +103,8 @@ impl GpuEvaluator {
             pass.set_bind_group(0, &bind, &[]);
             pass.dispatch_workgroups(count.div_ceil(WORKGROUP), 1, 1);
         }
-        enc.copy_buffer_to_buffer(&obuf, 0, &rbuf, 0, size);
         self.gpu.queue.submit([enc.finish()]);
-        let bytes = self.gpu.read_buffer(&rbuf, size)?;
+        let bytes = self.gpu.read_buffer(&obuf, size)?;
         let v: &[f32] = bytemuck::cast_slice(&bytes);
         Ok(v.chunks_exact(4).map(|c| [c[0], c[1], c[2]]).collect())
     }

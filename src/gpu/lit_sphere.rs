@@ -1,12 +1,12 @@
-//! Offscreen renderer of the lit sphere view (issue 4, items 3 and 5): every
-//! given model on its own orthographic sphere, side by side, lit by one
-//! directional light. Built once (device, pipeline), it re-renders on every
+//! Offscreen renderer of the lit sphere view: every given model on its own
+//! orthographic sphere, side by side, lit by one directional light. Built once (device, pipeline), it re-renders on every
 //! call, so a GUI view can call [`LitSphereRenderer::render`] each frame and
 //! show the texture, and `bv render` can call [`LitSphereRenderer::render_image`] once.
 
 use super::context::{Gpu, TARGET_FORMAT, Target};
 use super::display::ToneMap;
 use super::errors;
+use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Result, bail};
@@ -142,27 +142,7 @@ fn pipeline(
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
 ) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("lit sphere"),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
-        multisample: wgpu::MultisampleState::default(),
-        fragment: Some(wgpu::FragmentState {
-            module,
-            entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
-            targets: &[Some(TARGET_FORMAT.into())],
-        }),
-        multiview_mask: None,
-        cache: None,
-    })
+    fullscreen::pipeline(device, "lit sphere", Some(layout), module, TARGET_FORMAT)
 }
 
 /// The first pixel column of tile `k` of `tiles` in an image `width` wide:
@@ -322,42 +302,27 @@ impl LitSphereRenderer {
             ],
         });
         let target = Target::ensure(&mut self.target, &self.gpu, width, height)?;
-        let mut enc = d.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("lit sphere"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target.view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_bind_group(0, &bind, &[]);
-            // One draw per sphere, each clipped to its tile, with its model's
-            // pipeline.
-            for (k, r) in refs.iter().enumerate() {
-                let x0 = tile_start(k, refs.len(), width);
-                let x1 = tile_start(k + 1, refs.len(), width);
-                if x1 <= x0 {
-                    continue;
-                }
-                let p = match self.specialised.get(&r.model) {
-                    Some(Some(p)) => p,
-                    _ => &self.generic,
-                };
-                pass.set_pipeline(p);
-                pass.set_scissor_rect(x0, 0, x1 - x0, height);
-                pass.draw(0..3, 0..1);
+        // One draw per sphere, each clipped to its tile, with its model's
+        // pipeline.
+        let mut draws = Vec::with_capacity(refs.len());
+        for (k, r) in refs.iter().enumerate() {
+            let x0 = tile_start(k, refs.len(), width);
+            let x1 = tile_start(k + 1, refs.len(), width);
+            if x1 <= x0 {
+                continue;
             }
+            let p = match self.specialised.get(&r.model) {
+                Some(Some(p)) => p,
+                _ => &self.generic,
+            };
+            draws.push(fullscreen::Draw {
+                pipeline: p,
+                bind_group: &bind,
+                scissor: Some([x0, 0, x1 - x0, height]),
+            });
         }
+        let mut enc = d.create_command_encoder(&Default::default());
+        fullscreen::pass(&mut enc, "lit sphere", &target.view, &draws);
         self.gpu.queue.submit([enc.finish()]);
         Ok(&target.texture)
     }

@@ -10,8 +10,10 @@
 //! generated `bv::layout` (parameter offsets, [`super::layout`]), the shared
 //! [`COMMON`] modules, every model's own module from its GPU port in the
 //! catalogue, the generated `bv::dispatch` ([`super::dispatch`]) and the
-//! [`DISPATCHERS`] over it. Entry shaders (`parity`, `lit_sphere`, `env`)
-//! import what they need. A library holds the catalogue as it was when it was
+//! [`DISPATCHERS`] over it, and the generated `bv::colormap` (the lobe's colour
+//! map, [`super::colormap`]). Entry shaders (`parity`, `lit_sphere`, `env`,
+//! `env_display`, and the lobe view's `lobe`, `lines` and `blit`) import what
+//! they need. A library holds the catalogue as it was when it was
 //! made ([`ShaderLibrary::catalogue_revision`]).
 
 use anyhow::{Context, Result, anyhow};
@@ -53,6 +55,9 @@ pub const ENTRIES: &[(&str, (&str, &str))] = &[
     ("lit_sphere", shader!("lit_sphere.wgsl")),
     ("env", shader!("env.wgsl")),
     ("env_display", shader!("env_display.wgsl")),
+    ("lobe", shader!("lobe.wgsl")),
+    ("lines", shader!("lines.wgsl")),
+    ("blit", shader!("blit.wgsl")),
 ];
 
 /// The line of an entry shader that [`ShaderLibrary::specialised_wgsl`]
@@ -100,10 +105,16 @@ impl ShaderLibrary {
     /// included, in registration order: (path, source).
     pub fn modules() -> Result<Vec<(String, String)>> {
         let catalogue = bv_core::catalogue();
-        let mut out = vec![(
-            "<generated bv::layout>".to_string(),
-            super::layout::layout_module()?,
-        )];
+        let mut out = vec![
+            (
+                "<generated bv::layout>".to_string(),
+                super::layout::layout_module()?,
+            ),
+            (
+                "<generated bv::colormap>".to_string(),
+                super::colormap::colormap_module(),
+            ),
+        ];
         out.extend(COMMON.iter().map(|(p, s)| (p.to_string(), s.to_string())));
         for (_, m) in super::dispatch::ported(&catalogue) {
             if let Some(port) = &m.gpu {

@@ -1,23 +1,10 @@
-//! The colour map of lobe values (viridis: perceptually uniform, readable in
-//! grey on a printed handout and by most colour-blind viewers). One table feeds
-//! both the shader and the colour bar, so they cannot disagree.
+//! The colour map of lobe values as egui colours (the colour bar, mesh
+//! export). The table is [`crate::gpu::colormap::VIRIDIS`], the one the lobe
+//! shader gets, so they cannot disagree.
 
 use eframe::egui::Color32;
 
-/// Viridis at t = 0, 0.1, …, 1 (sRGB), from matplotlib's `_viridis_data`.
-pub const VIRIDIS: [[u8; 3]; 11] = [
-    [0x44, 0x01, 0x54],
-    [0x48, 0x24, 0x75],
-    [0x41, 0x44, 0x87],
-    [0x35, 0x5f, 0x8d],
-    [0x2a, 0x78, 0x8e],
-    [0x21, 0x91, 0x8c],
-    [0x22, 0xa8, 0x84],
-    [0x44, 0xbf, 0x70],
-    [0x7a, 0xd1, 0x51],
-    [0xbd, 0xdf, 0x26],
-    [0xfd, 0xe7, 0x25],
-];
+pub use crate::gpu::colormap::VIRIDIS;
 
 /// The colour of `t ∈ [0, 1]` (clamped), interpolated in sRGB like the shader.
 pub fn viridis(t: f32) -> Color32 {
@@ -33,22 +20,6 @@ pub fn viridis(t: f32) -> Color32 {
     let b = VIRIDIS[i + 1];
     let mix = |k: usize| (a[k] as f32 + (b[k] as f32 - a[k] as f32) * f).round() as u8;
     Color32::from_rgb(mix(0), mix(1), mix(2))
-}
-
-/// The table as a WGSL array literal (`array<vec3<f32>, 11>(…)`) in 0..1 sRGB.
-pub fn wgsl_table() -> String {
-    let items: Vec<String> = VIRIDIS
-        .iter()
-        .map(|c| {
-            format!(
-                "vec3<f32>({:.6}, {:.6}, {:.6})",
-                c[0] as f32 / 255.0,
-                c[1] as f32 / 255.0,
-                c[2] as f32 / 255.0
-            )
-        })
-        .collect();
-    format!("array<vec3<f32>, {}>({})", VIRIDIS.len(), items.join(", "))
 }
 
 #[cfg(test)]
@@ -69,6 +40,5 @@ mod tests {
         for k in 0..20 {
             assert!(l(k as f32 / 20.0) <= l((k + 1) as f32 / 20.0) + 2);
         }
-        assert!(wgsl_table().starts_with("array<vec3<f32>, 11>(vec3<f32>(0.266667"));
     }
 }

@@ -11,11 +11,12 @@
 
 use super::BrdfColor as _;
 use super::camera::{self, CameraMatrices};
-use super::lobe_gpu::{LineSeg, LobeCallback, LobeFrame, MeshDraw, MeshStyle};
+use super::lobe_gpu::LobeCallback;
 use super::sh_overlay::{self, ShDone};
 use super::{Scene, View, colormap, curves};
 use crate::session::command::Command;
 use crate::session::state::{Camera, Display, Incident};
+use crate::gpu::lobe::{LineSeg, LobeCamera, LobeFrame, MeshDraw, MeshStyle};
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use eframe::egui::{self, Align2, Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, Vec2};
 use glam::Vec3;
@@ -294,7 +295,10 @@ impl Lobe3dView {
             }
         }
         let frame = Arc::new(LobeFrame {
-            camera: cam,
+            camera: LobeCamera {
+                view_proj: cam.view_proj,
+                eye: cam.eye,
+            },
             background,
             meshes,
             lines,
@@ -592,8 +596,11 @@ impl View for Lobe3dView {
             .shape(),
         );
 
-        handle_input(ui, &response, rect, scene, &frame.camera, out);
-        self.overlays(ui, rect, scene, &frame.camera, dark);
+        // The frame's camera, with the viewport in points that projecting
+        // labels and pointer rays needs.
+        let cam = CameraMatrices::new(&scene.state.camera, rect.width(), rect.height());
+        handle_input(ui, &response, rect, scene, &cam, out);
+        self.overlays(ui, rect, scene, &cam, dark);
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

@@ -1,0 +1,351 @@
+//! The lobe view's renderer (the GPU side of the 3D lobe): a [`LobeFrame`]
+//! (camera matrices, meshes, line segments) is drawn into an offscreen
+//! multisampled colour + depth target, which is then either read back
+//! ([`LobeRenderer::render_to_image`], what `bv render` and the snapshot
+//! tests use) or copied into a render pass someone else began
+//! ([`LobeRenderer::paint`]: egui's, through the paint callback in
+//! `views::lobe_gpu`). Drawing offscreen gives the lobe a depth buffer and
+//! MSAA whatever egui's own pass has (eframe's window has neither; kittest's
+//! has neither).
+//!
+//! Per view (a key chosen by the caller) it keeps the uniform, line and mesh
+//! buffers and the target, re-uploading only what changed and redrawing only
+//! when the frame's fingerprint changes. It depends on bv-core's meshes and
+//! wgpu only: what the view computes (camera, colours) arrives as plain data.
+
+mod frame;
+mod mesh;
+mod pipelines;
+mod target;
+
+pub use frame::{LineSeg, LobeCamera, LobeFrame, MeshDraw, MeshStyle};
+pub use mesh::wire_indices;
+pub use target::fit_texture;
+
+use super::{errors, fullscreen, readback};
+use frame::StyleUniform;
+use mesh::{GpuMesh, upload_mesh};
+use pipelines::Pipelines;
+use std::collections::HashMap;
+use target::{Target, create_target};
+
+/// Colour format of the offscreen target (gamma-encoded, like egui's).
+pub const OFFSCREEN_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// Depth format of the offscreen target.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Globals {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    viewport: [f32; 4],
+}
+
+struct ViewResources {
+    globals: wgpu::Buffer,
+    globals_bg: wgpu::BindGroup,
+    lines: Option<(wgpu::Buffer, u64)>,
+    line_count: u32,
+    target: Option<Target>,
+    meshes: HashMap<u64, GpuMesh>,
+}
+
+/// The size of a lobe view's image in pixels, and pixels per point (which
+/// scales line widths).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PixelSize {
+    /// Width and height in pixels.
+    pub size: [u32; 2],
+    /// Pixels per point.
+    pub ppp: f32,
+}
+
+/// Pipelines and per-view GPU resources of every lobe view.
+pub struct LobeRenderer {
+    /// Pipelines at the full sample count, then (software renderers only) at one
+    /// sample for frames drawn while something is dragged.
+    sets: Vec<Pipelines>,
+    globals_layout: wgpu::BindGroupLayout,
+    style_layout: wgpu::BindGroupLayout,
+    blit_layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    blit: wgpu::RenderPipeline,
+    views: HashMap<u64, ViewResources>,
+}
+
+impl LobeRenderer {
+    /// The offscreen sample count of frames drawn at rest.
+    pub fn samples(&self) -> u32 {
+        self.sets[0].samples
+    }
+
+    /// Uploads what changed in `frame` and records its offscreen pass for view
+    /// `view` at the given pixel size.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        view: u64,
+        frame: &LobeFrame,
+        pixels: PixelSize,
+    ) {
+        let PixelSize { size: asked, ppp } = pixels;
+        let size = fit_texture(asked, device.limits().max_texture_dimension_2d);
+        // Line widths follow a target made smaller than asked.
+        let ppp = ppp * size[0] as f32 / asked[0].max(1) as f32;
+        let set = match self.sets.get(1) {
+            Some(fast) if frame.interacting => fast,
+            _ => &self.sets[0],
+        };
+        let samples = set.samples;
+        let fingerprint = frame.fingerprint(size, ppp) ^ u64::from(samples);
+        let (style_layout, blit_layout, sampler) =
+            (&self.style_layout, &self.blit_layout, &self.sampler);
+        let (opaque, blended, wire, lines_pl) = (&set.opaque, &set.blended, &set.wire, &set.lines);
+        let vr = {
+            let layout = &self.globals_layout;
+            self.views.entry(view).or_insert_with(|| {
+                let globals = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("bv lobe globals"),
+                    size: std::mem::size_of::<Globals>() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let globals_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("bv lobe globals"),
+                    layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: globals.as_entire_binding(),
+                    }],
+                });
+                ViewResources {
+                    globals,
+                    globals_bg,
+                    lines: None,
+                    line_count: 0,
+                    target: None,
+                    meshes: HashMap::new(),
+                }
+            })
+        };
+
+        // Target textures follow the viewport's pixel size.
+        if vr
+            .target
+            .as_ref()
+            .is_none_or(|t| t.size != size || t.samples != samples)
+        {
+            vr.target = Some(create_target(device, blit_layout, sampler, size, samples));
+        }
+
+        let cam = &frame.camera;
+        let globals = Globals {
+            view_proj: cam.view_proj.to_cols_array_2d(),
+            eye: cam.eye.extend(1.0).to_array(),
+            viewport: [size[0] as f32, size[1] as f32, 0.0, 0.0],
+        };
+        queue.write_buffer(&vr.globals, 0, bytemuck::bytes_of(&globals));
+
+        // Lines: widths in pixels.
+        let segs: Vec<LineSeg> = frame
+            .lines
+            .iter()
+            .map(|s| LineSeg {
+                width: [s.width[0] * ppp, 0.0, 0.0, 0.0],
+                ..*s
+            })
+            .collect();
+        vr.line_count = segs.len() as u32;
+        if !segs.is_empty() {
+            let bytes = bytemuck::cast_slice(&segs);
+            let need = bytes.len() as u64;
+            if vr.lines.as_ref().is_none_or(|(_, cap)| *cap < need) {
+                let cap = need.next_power_of_two().max(4096);
+                let buf = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("bv lobe lines"),
+                    size: cap,
+                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                vr.lines = Some((buf, cap));
+            }
+            if let Some((buf, _)) = &vr.lines {
+                queue.write_buffer(buf, 0, bytes);
+            }
+        }
+
+        // Meshes: upload new revisions, refresh styles, drop the ones not drawn.
+        for m in vr.meshes.values_mut() {
+            m.used = false;
+        }
+        for d in &frame.meshes {
+            let stale = vr
+                .meshes
+                .get(&d.key)
+                .is_none_or(|g| g.revision != d.revision);
+            if stale {
+                vr.meshes
+                    .insert(d.key, upload_mesh(device, style_layout, d));
+            }
+            if let Some(g) = vr.meshes.get_mut(&d.key) {
+                g.used = true;
+                queue.write_buffer(
+                    &g.style,
+                    0,
+                    bytemuck::bytes_of(&StyleUniform::new(&d.style)),
+                );
+            }
+        }
+        vr.meshes.retain(|_, m| m.used);
+
+        let Some(target) = &mut vr.target else { return };
+        if target.drawn == Some(fingerprint) {
+            // Same image as last time: egui repainted for something else.
+            return;
+        }
+        target.drawn = Some(fingerprint);
+        let target = &*target;
+        let bg = frame.background;
+        let (color_view, resolve) = match &target.msaa_color {
+            Some(ms) => (ms, Some(&target.resolve_view)),
+            None => (&target.resolve_view, None),
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("bv lobe offscreen"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: color_view,
+                depth_slice: None,
+                resolve_target: resolve,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: bg[0] as f64,
+                        g: bg[1] as f64,
+                        b: bg[2] as f64,
+                        a: bg[3] as f64,
+                    }),
+                    store: if resolve.is_some() {
+                        wgpu::StoreOp::Discard
+                    } else {
+                        wgpu::StoreOp::Store
+                    },
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &target.depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        pass.set_bind_group(0, &vr.globals_bg, &[]);
+
+        let draw_mesh = |pass: &mut wgpu::RenderPass<'_>, d: &MeshDraw, wire_pass: bool| {
+            let Some(g) = vr.meshes.get(&d.key) else {
+                return;
+            };
+            pass.set_bind_group(1, &g.style_bg, &[]);
+            pass.set_vertex_buffer(0, g.vertices.slice(..));
+            if wire_pass {
+                pass.set_index_buffer(g.wire_indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..g.wire_count, 0, 0..1);
+            } else {
+                pass.set_index_buffer(g.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..g.index_count, 0, 0..1);
+            }
+        };
+
+        // 1. Opaque surfaces write depth.
+        pass.set_pipeline(opaque);
+        for d in frame
+            .meshes
+            .iter()
+            .filter(|d| d.style.alpha >= 1.0 && !d.style.wireframe)
+        {
+            draw_mesh(&mut pass, d, false);
+        }
+        // 2. Wireframes.
+        pass.set_pipeline(wire);
+        for d in frame.meshes.iter().filter(|d| d.style.wireframe) {
+            draw_mesh(&mut pass, d, true);
+        }
+        // 3. Lines, tested against the surfaces.
+        if vr.line_count > 0
+            && let Some((buf, _)) = &vr.lines
+        {
+            pass.set_pipeline(lines_pl);
+            pass.set_vertex_buffer(0, buf.slice(..));
+            pass.draw(0..6, 0..vr.line_count);
+        }
+        // 4. Translucent surfaces (overlaid BRDFs, ground disc), no depth write.
+        pass.set_pipeline(blended);
+        pass.set_bind_group(0, &vr.globals_bg, &[]);
+        for d in frame
+            .meshes
+            .iter()
+            .filter(|d| d.style.alpha < 1.0 && !d.style.wireframe)
+        {
+            draw_mesh(&mut pass, d, false);
+        }
+    }
+
+    /// Blits view `view`'s offscreen image into the current pass (whose viewport
+    /// egui has set to the callback's rectangle).
+    pub fn paint(&self, view: u64, pass: &mut wgpu::RenderPass<'static>) {
+        let Some(target) = self.views.get(&view).and_then(|v| v.target.as_ref()) else {
+            return;
+        };
+        fullscreen::draw(
+            pass,
+            &fullscreen::Draw {
+                pipeline: &self.blit,
+                bind_group: &target.blit_bg,
+                scissor: None,
+            },
+        );
+    }
+
+    /// Renders `frame` headless at `width × height` pixels and reads it back
+    /// (for `bv render` and tests). `ppp` scales line widths.
+    pub fn render_to_image(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &LobeFrame,
+        width: u32,
+        height: u32,
+        ppp: f32,
+    ) -> Result<image::RgbaImage, String> {
+        // A view key of its own, so a window's targets are left alone.
+        const HEADLESS: u64 = u64::MAX;
+        errors::scoped(device, "drawing the lobe", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("bv lobe headless"),
+            });
+            self.prepare(
+                device,
+                queue,
+                &mut encoder,
+                HEADLESS,
+                frame,
+                PixelSize {
+                    size: [width, height],
+                    ppp,
+                },
+            );
+            queue.submit(std::iter::once(encoder.finish()));
+            let target = self
+                .views
+                .get(&HEADLESS)
+                .and_then(|v| v.target.as_ref())
+                .ok_or_else(|| anyhow::anyhow!("no target"))?;
+            readback::read_rgba8(device, queue, &target.resolve)
+        })
+        .map_err(|e| format!("{e:#}"))
+    }
+}
