@@ -22,6 +22,7 @@ pub mod lobe;
 pub mod measured;
 pub mod microfacet;
 pub mod models;
+pub mod optics;
 pub mod params;
 pub mod registry;
 pub mod represent;
