@@ -26,6 +26,7 @@ pub mod optics;
 pub mod params;
 pub mod registry;
 pub mod represent;
+pub mod rotated;
 pub mod sampling;
 
 pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, Ndf};
