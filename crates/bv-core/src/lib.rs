@@ -24,6 +24,7 @@ pub mod microfacet;
 pub mod models;
 pub mod optics;
 pub mod params;
+pub mod presets;
 pub mod registry;
 pub mod represent;
 pub mod rotated;

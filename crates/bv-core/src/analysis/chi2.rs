@@ -114,7 +114,7 @@ pub fn ln_gamma(x: f64) -> f64 {
 /// the series for `P = 1 − Q` when `x < a + 1`, Lentz's continued fraction
 /// for `Q` otherwise (Numerical Recipes, 3rd ed., §6.2).
 pub fn gamma_q(a: f64, x: f64) -> f64 {
-    if !(a > 0.0) || x.is_nan() {
+    if a.is_nan() || a <= 0.0 || x.is_nan() {
         return f64::NAN;
     }
     if x <= 0.0 {

@@ -20,7 +20,7 @@
 use super::chi2::{ChiSquare, chi_square};
 use crate::represent::sh::gauss_legendre;
 use crate::{Brdf, BvError, Result, sampling};
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use std::f64::consts::PI;
 
 /// Most bins per axis accepted.
@@ -98,7 +98,7 @@ impl SampleHistogram {
 }
 
 fn bin_of(w: DVec3, n_theta: usize, n_phi: usize) -> Option<(usize, usize)> {
-    if !(w.z > 0.0) || !w.is_finite() {
+    if w.z.is_nan() || w.z <= 0.0 || !w.is_finite() {
         return None;
     }
     let t = (((1.0 - w.z.min(1.0)) * n_theta as f64) as usize).min(n_theta - 1);
@@ -213,6 +213,7 @@ mod tests {
     use super::*;
     use crate::frame::from_spherical;
     use crate::{Claims, ModelSpec, Rgb};
+    use glam::DVec2;
     use serde_json::json;
     use std::sync::Arc;
 
@@ -268,7 +269,7 @@ mod tests {
         assert_eq!(h.failed, 0);
         assert_eq!(h.observed.iter().sum::<u64>(), 20_000);
         assert_eq!(h.points.len(), 2_000);
-        assert_eq!(h.bin_of(h.points[0]).is_some(), true);
+        assert!(h.bin_of(h.points[0]).is_some());
         assert_eq!(h.chi2.dof, 128 - 1);
     }
 

@@ -416,7 +416,7 @@ mod tests {
         // rows), b1 = 2, b2 = (−1)^j (orthogonal over 60 columns): σ1 = √8 √240,
         // σ2 = √8 √60, so the one-term error is σ2/√(σ1² + σ2²) = 1/√5, and two
         // terms are exact. Values are 1 or 3, positive as a table must be.
-        let sign = |n: usize| if n % 2 == 0 { 1.0 } else { -1.0 };
+        let sign = |n: usize| if n.is_multiple_of(2) { 1.0 } else { -1.0 };
         let t = table(|c, ih, j| (2.0 + sign(ih) * sign(j)) * [1.0, 0.5, 2.0][c]);
         let f = factor(&t, 5, FactorSpace::Linear).unwrap();
         assert!(
