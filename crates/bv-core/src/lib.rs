@@ -23,9 +23,12 @@ pub mod measured;
 pub mod microfacet;
 pub mod model;
 pub mod models;
+pub mod optics;
 pub mod params;
+pub mod presets;
 pub mod registry;
 pub mod represent;
+pub mod rotated;
 pub mod sampling;
 pub mod text;
 

@@ -10,6 +10,7 @@
 //! - [`ndf`]: `∫ D cos θh dωh` for microfacet models.
 
 pub mod albedo;
+pub mod chi2;
 pub mod directions;
 pub mod gauss_kronrod;
 pub mod isotropy;
@@ -17,6 +18,8 @@ pub mod ndf;
 pub mod positivity;
 pub mod quadrature;
 pub mod reciprocity;
+pub mod reciprocity_map;
+pub mod sample_histogram;
 
 use crate::{Brdf, Rgb};
 use albedo::{AlbedoCurve, Estimate};

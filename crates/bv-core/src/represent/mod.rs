@@ -2,6 +2,7 @@
 //! The tabulated form lives in [`crate::measured`]; this module holds the
 //! basis-function form: projection of a lobe onto spherical harmonics.
 
+pub mod factor;
 pub mod sh;
 
 pub use sh::{Domain, ShLobe};
