@@ -8,11 +8,11 @@
 //! Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p bv --test gui`.
 
 use bv::app::Viewer;
+use bv::gpu::lobe::LobeRenderer;
 use bv::session::Command;
 use bv::session::build_scene;
 use bv::session::runtime::Runtime;
 use bv::session::state::AppState;
-use bv::gpu::lobe::LobeRenderer;
 use bv::views::cartesian::CartesianView;
 use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;

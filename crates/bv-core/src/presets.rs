@@ -289,8 +289,8 @@ mod tests {
         let l = shipped();
         for (name, want) in rows {
             let p = l.presets.iter().find(|p| p.name == name).unwrap();
-            let eta = p.spec.params.color("eta").unwrap();
-            let k = p.spec.params.color("k").unwrap();
+            let eta = p.spec.params().color("eta").unwrap();
+            let k = p.spec.params().color("k").unwrap();
             for c in 0..3 {
                 let got = f0(eta[c], k[c]);
                 let reference = f0(want[c].0, want[c].1);
@@ -306,8 +306,8 @@ mod tests {
         let refl = |n: &str| {
             let p = l.presets.iter().find(|p| p.name == n).unwrap();
             let (e, k) = (
-                p.spec.params.color("eta").unwrap(),
-                p.spec.params.color("k").unwrap(),
+                p.spec.params().color("eta").unwrap(),
+                p.spec.params().color("k").unwrap(),
             );
             Rgb::new(f0(e.x, k.x), f0(e.y, k.y), f0(e.z, k.z))
         };
@@ -321,7 +321,7 @@ mod tests {
         let l = shipped();
         let eta = |n: &str| {
             let p = l.presets.iter().find(|p| p.name == n).unwrap();
-            p.spec.params.color("eta").unwrap().x
+            p.spec.params().color("eta").unwrap().x
         };
         assert!((crate::optics::dielectric_f0(eta("Glass")) - 0.04).abs() < 1e-12);
         let w = crate::optics::snell_window_half_angle(eta("Water")).unwrap();

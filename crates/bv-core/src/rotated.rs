@@ -10,7 +10,6 @@
 //! a rotation preserves solid angle, so densities carry over unchanged, and
 //! sampled, delta and peak directions are rotated back by `R`.
 
-use crate::measured::{Interpolation, MerlTable};
 use crate::{Brdf, Claims, DeltaLobe, Ndf, Rgb};
 use glam::{DVec2, DVec3};
 use std::sync::Arc;
@@ -139,10 +138,17 @@ impl Brdf for Rotated {
     // No batch kernel: the inner one would evaluate in the unrotated frame;
     // the default `eval_batch` goes through `eval`.
 
-    /// A measured table is isotropic (the MERL layout ignores φh), so turning
-    /// it changes nothing and views may upload the inner table as it is.
-    fn measured(&self) -> Option<(&Arc<MerlTable>, Interpolation)> {
-        self.inner.measured()
+    /// The inner model's file data: a measured table is isotropic (the MERL
+    /// layout ignores φh), so turning it changes nothing and views may upload
+    /// the inner table as it is.
+    fn file_data(&self) -> Option<Arc<dyn crate::model::FileData>> {
+        self.inner.file_data()
+    }
+
+    /// A turn about the normal does not change the angle of incidence, so
+    /// the Fresnel term is the inner model's.
+    fn fresnel_term(&self) -> Option<crate::FresnelTerm> {
+        self.inner.fresnel_term()
     }
 }
 
