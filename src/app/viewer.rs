@@ -192,14 +192,12 @@ impl Viewer {
                             Command::SetParam { brdf, param, value }
                         }
                         LoadTarget::New => {
-                            let mut spec = match bv_core::ModelSpec::new("merl") {
-                                Ok(s) => s,
-                                Err(e) => {
-                                    self.status = Some(e.to_string());
-                                    continue;
-                                }
+                            let Some((model, param, _)) = loader::file_model_for(&path) else {
+                                self.status = Some("no model of this bv reads files".into());
+                                continue;
                             };
-                            if let Err(e) = spec.set("path", value) {
+                            let mut spec = bv_core::ModelSpec::defaults(model);
+                            if let Err(e) = spec.set(param, value) {
                                 self.status = Some(e.to_string());
                                 continue;
                             }

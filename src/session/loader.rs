@@ -1,26 +1,50 @@
-//! Opening measured tables from the GUI (issue 5, item 7).
+//! Opening the files of file-backed models from the GUI.
 //!
-//! Every way of opening a `.binary` file (the “Load MERL…” dialog, a file
-//! dropped on the window, a path typed into a BRDF's file field, `bv --open`)
-//! becomes a [`Command::OpenFile`](super::Command::OpenFile), which starts a
-//! [`Loader`] job: the file is read on a background thread through bv-core's
-//! table cache, with the bytes read published for a progress bar. Only when
-//! the table has been read and validated does the job turn into the state
-//! change (a new `merl` BRDF, or a new path for an existing one); the BRDF is
-//! then built from the cache at once. A file the reader refuses changes
+//! Every way of opening a file (the "Load…" dialog, a file dropped on the
+//! window, a path typed into a BRDF's file field, `bv --open`) becomes a
+//! [`Command::OpenFile`](super::Command::OpenFile), which starts a [`Loader`]
+//! job: the file is read on a background thread by its model's file format
+//! ([`bv_core::model::FileFormat`], through the format's cache), with the
+//! bytes read published for a progress bar. Which model reads a file is
+//! [`file_model_for`]: the one whose format lists its extension. Only when
+//! the data has been read and validated does the job turn into the state
+//! change (a new BRDF of that model, or a new path for an existing one); the
+//! BRDF is then built from the cache at once. A file the reader refuses changes
 //! nothing: its message goes to an error dialog, and everything already
 //! loaded stays as it was.
 
-use bv_core::measured::merl::{self, MerlTable};
+use bv_core::model::{FileData, FileFormat, ModelInfo};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, mpsc};
 use std::time::{Duration, Instant};
 
-/// Where a loaded table goes.
+/// The catalogue's file-backed model that reads `path`, with its file
+/// parameter's id and format: the first whose format lists the file's
+/// extension, else the first file-backed model (a table saved under another
+/// name). `None` when no model reads files.
+pub fn file_model_for(
+    path: &Path,
+) -> Option<(&'static ModelInfo, &'static str, &'static dyn FileFormat)> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let catalogue = bv_core::catalogue();
+    let backed = || {
+        catalogue
+            .iter()
+            .filter_map(|m| m.file_param().map(|(d, f)| (*m, d.id, f)))
+    };
+    backed()
+        .find(|(_, _, f)| f.extensions().contains(&ext.as_str()))
+        .or_else(|| backed().next())
+}
+
+/// Where loaded data goes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum LoadTarget {
-    /// A new `merl` BRDF.
+    /// A new BRDF of the model that reads the file ([`file_model_for`]).
     New,
     /// The path parameter `param` of the BRDF with id `brdf`.
     Into {
@@ -43,7 +67,7 @@ pub struct LoadJob {
     read: Arc<AtomicU64>,
     total: Arc<AtomicU64>,
     done: Arc<AtomicBool>,
-    rx: mpsc::Receiver<Result<Arc<MerlTable>, String>>,
+    rx: mpsc::Receiver<Result<Arc<dyn FileData>, String>>,
 }
 
 impl LoadJob {
@@ -68,8 +92,8 @@ pub struct Finished {
     pub path: PathBuf,
     /// Where the table goes.
     pub target: LoadTarget,
-    /// The table, or the reader's message.
-    pub result: Result<Arc<MerlTable>, String>,
+    /// The data, or the reader's message.
+    pub result: Result<Arc<dyn FileData>, String>,
     /// How long the read took.
     pub elapsed: Duration,
     /// The file size.
@@ -103,11 +127,15 @@ impl Loader {
         let spawned = std::thread::Builder::new()
             .name("bv load".into())
             .spawn(move || {
-                let result = merl::read_cached_with_progress(&p, &mut |a, b| {
-                    t.store(b, Ordering::Relaxed);
-                    r.store(a, Ordering::Relaxed);
-                })
-                .map_err(|e| e.to_string());
+                let result = match file_model_for(&p) {
+                    Some((_, _, format)) => format
+                        .load(&p, &mut |a, b| {
+                            t.store(b, Ordering::Relaxed);
+                            r.store(a, Ordering::Relaxed);
+                        })
+                        .map_err(|e| e.to_string()),
+                    None => Err("no model of this bv reads files".to_string()),
+                };
                 // The receiver is gone only if the viewer closed meanwhile.
                 let _ = tx.send(result);
                 d.store(true, Ordering::Release);
@@ -203,7 +231,7 @@ pub fn progress_text(read: u64, total: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bv_core::measured::merl::{MerlDims, tabulate};
+    use bv_core::measured::merl::{self, MerlDims, tabulate};
 
     fn wait_done(l: &mut Loader) -> Vec<Finished> {
         let t0 = Instant::now();

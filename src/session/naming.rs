@@ -5,23 +5,27 @@ use super::state::{AppState, BrdfEntry};
 /// The name shown for an entry: the model's name, numbered when the same
 /// model is loaded more than once ("Lambert", "Lambert 2").
 pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
-    // A model read from a file is named after the file ("gold-paint (MERL)").
-    if let Some(param) = super::command::path_param(e.spec.id())
-        && let Ok(path) = e.spec.params().text(param)
+    // A model read from a file is named after the file, tagged with its
+    // format and any choice not at its default ("gold-paint (MERL)", "gold-paint
+    // (MERL, nearest)": two lookups of one file side by side).
+    let info = e.spec.model();
+    if let Some((decl, format)) = info.file_param()
+        && let Ok(path) = e.spec.params().text(decl.id)
         && let Some(stem) = std::path::Path::new(path).file_stem()
     {
-        let kind = if e.spec.id() == "merl" {
-            // Nearest and trilinear lookups of one file side by side.
-            match e.spec.params().text("interpolation") {
-                Ok("nearest") => "MERL, nearest".to_string(),
-                _ => "MERL".to_string(),
+        let mut kind = format.tag().to_string();
+        for d in info.params {
+            if let bv_core::ParamKind::Choice { default, .. } = d.kind
+                && let Ok(v) = e.spec.params().text(d.id)
+                && v != default
+            {
+                kind.push_str(", ");
+                kind.push_str(v);
             }
-        } else {
-            e.spec.id().to_string()
-        };
+        }
         return format!("{} ({kind})", stem.to_string_lossy());
     }
-    let name = bv_core::find(e.spec.id()).map(|m| m.name).unwrap_or("?");
+    let name = info.name;
     let has_file = |b: &BrdfEntry| {
         super::command::path_param(b.spec.id())
             .and_then(|p| b.spec.params().text(p).ok())
