@@ -1,4 +1,4 @@
-//! GPU view benchmarks (issue 4): lit-sphere frame time at 1024² and
+//! GPU view benchmarks: lit-sphere frame time at 1024² and
 //! environment samples per second, on whatever adapter wgpu finds (lavapipe on
 //! machines without a GPU). `cargo bench --bench gpu`.
 

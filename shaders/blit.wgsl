@@ -1,4 +1,4 @@
-// Copies the lobe view's offscreen image into egui's render pass (bv, issue 3).
+// Copies the lobe view's offscreen image into egui's render pass.
 // One triangle covers the viewport egui sets for the paint callback.
 
 @group(0) @binding(0) var src: texture_2d<f32>;

@@ -1,4 +1,4 @@
-// Environment lighting (issue 4, item 4): spheres under an equirectangular
+// Environment lighting: spheres under an equirectangular
 // environment, one BRDF sample and one environment sample per pixel and pass,
 // combined with the power heuristic (Veach & Guibas 1995), accumulated into a
 // float buffer across frames. Models with delta lobes (their GPU ports

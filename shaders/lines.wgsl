@@ -1,5 +1,5 @@
 // Screen-space thick lines for the lobe view's axes, rays, spikes and grid
-// (bv, issue 3). Each instance is one segment; six vertices make its quad,
+//. Each instance is one segment; six vertices make its quad,
 // widened in pixels after projection so widths do not depend on the zoom.
 
 struct Globals {

@@ -1,4 +1,4 @@
-// Lit sphere view (issue 4, item 3): each model on an orthographic sphere lit
+// Lit sphere view: each model on an orthographic sphere lit
 // by a directional light; radiance f(wi, wo) cosθi E, then exposure, tone map
 // and sRGB encoding.
 #import bv::brdf

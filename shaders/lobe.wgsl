@@ -1,4 +1,4 @@
-// Lobe surfaces of the 3D view (bv, issue 3).
+// Lobe surfaces of the 3D view.
 //
 // Positions arrive in radius units (1/sr, or ln(1 + f) on the log scale) and
 // are scaled to the view's world units here, so a scale change needs no

@@ -1,4 +1,4 @@
-//! End-to-end tests of the `bv` command line (SPEC §5): the built binary is run
+//! End-to-end tests of the `bv` command line : the built binary is run
 //! as a user or a script would run it.
 
 use serde_json::Value;

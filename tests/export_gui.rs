@@ -1,4 +1,4 @@
-//! The viewer's side of issue 6 with egui_kittest: the export dialog
+//! The viewer's side of figures and scenes with egui_kittest: the export dialog
 //! (Ctrl+Shift+S), figures at 1×/2×/4×, transparent backgrounds, scene
 //! shortcuts, toasts, and the albedo and Fresnel views.
 

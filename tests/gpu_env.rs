@@ -1,4 +1,4 @@
-//! Environment lighting (issue 4, item 4): the white furnace, and every model's
+//! Environment lighting: the white furnace, and every model's
 //! multiple-importance-sampled estimate against a quadrature by bv-core.
 
 use bv::gpu::sphere::sphere_at;

@@ -1,5 +1,5 @@
-//! The GPU lit sphere against the CPU reference rendering from bv-core (issue
-//! 4, image test): same pixels, same geometry (src/gpu/sphere.rs and
+//! The GPU lit sphere against the CPU reference rendering from bv-core:
+//! same pixels, same geometry (src/gpu/sphere.rs and
 //! shaders/common/sphere.wgsl), same display transform.
 //!
 //! Tolerance: every channel of every pixel within 1 level of 255 (the f32 and

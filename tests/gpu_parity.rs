@@ -1,4 +1,4 @@
-//! Parity of the WGSL ports with bv-core (issue 4, item 2), on whatever
+//! Parity of the WGSL ports with bv-core, on whatever
 //! adapter wgpu finds (lavapipe in CI).
 //!
 //! Every model of the catalogue is evaluated by the `parity` compute shader on

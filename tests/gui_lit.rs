@@ -1,4 +1,4 @@
-//! The rendered views of issue 4 in the viewer (kittest on the GPU; lavapipe
+//! The rendered views in the viewer (kittest on the GPU; lavapipe
 //! on machines without one): the lit sphere follows the sliders and the light
 //! drag, the environment view accumulates samples across frames and restarts
 //! on a change, errors show in the view, and small snapshots of both.

@@ -1,4 +1,4 @@
-//! Measured BRDFs in the viewer window (issue 5, items 5–7), with
+//! Measured BRDFs in the viewer window, with
 //! egui_kittest: a table dropped on the window is read in the background and
 //! appears as a BRDF with its lobe; a bad file shows the reader's message in a
 //! dialog and changes nothing; the image slice view draws and follows φd; the

@@ -1,4 +1,4 @@
-//! `bv tabulate` and `bv info` from the outside (issue 5, items 3–4).
+//! `bv tabulate` and `bv info` from the outside.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};

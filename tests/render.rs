@@ -1,4 +1,4 @@
-//! `bv render`, `bv slice --csv` and the vector/mesh exports (issue 6), run as
+//! `bv render`, `bv slice --csv` and the vector/mesh exports, run as
 //! a user runs them: the binary, on lavapipe where there is no GPU.
 //!
 //! Snapshots: every view of two models at 160 × 120 pixels is compared with

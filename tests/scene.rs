@@ -1,4 +1,4 @@
-//! Scene files (issue 6): round trips, corrupt and truncated files, atomic
+//! Scene files: round trips, corrupt and truncated files, atomic
 //! saves, unknown keys, and the `bv scene` / `bv --scene` command lines.
 
 use bv::app::viewer::Viewer;

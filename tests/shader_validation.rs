@@ -1,4 +1,4 @@
-//! naga validation of every shader in `shaders/` (issue 4, item 2): each entry
+//! naga validation of every shader in `shaders/`: each entry
 //! shader composed with naga_oil and validated, written back to WGSL and
 //! re-parsed and re-validated (the exact text wgpu receives), and each
 //! composable module composed and validated on its own.

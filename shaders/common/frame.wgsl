@@ -1,4 +1,4 @@
-// The local shading frame of SPEC §1 (n = +z, t = +x) and the f32 direction
+// The local shading frame (n = +z, t = +x) and the f32 direction
 // algebra the model ports share. Mirrors bv_core::frame and
 // bv_core::models::lobes; formulations are chosen so that f32 keeps the
 // relative accuracy the parity test demands (see `pow_from_sin2`).

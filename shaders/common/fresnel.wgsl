@@ -1,4 +1,4 @@
-// Fresnel terms (SPEC §2 "F"), ports of bv_core::fresnel in f32. The choice
+// Fresnel terms, ports of bv_core::fresnel in f32. The choice
 // indices are those of bv_core::fresnel::FRESNEL_OPTIONS, taken from the
 // generated layout of `cook-torrance` (every model with a Fresnel choice
 // declares it through fresnel_param, which a test checks).

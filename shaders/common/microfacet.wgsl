@@ -1,4 +1,4 @@
-// Microfacet terms (SPEC §2 "Microfacet parts"), ports of bv_core::microfacet
+// Microfacet terms, ports of bv_core::microfacet
 // in f32. Distribution indices are bv_core::microfacet::DISTRIBUTION_OPTIONS
 // and GEOMETRY_OPTIONS, from the generated layout of `cook-torrance`.
 #define_import_path bv::microfacet
@@ -26,7 +26,7 @@ fn alpha2_tan2(w: vec3<f32>, ax: f32, ay: f32) -> f32 {
     return num / (w.z * w.z);
 }
 
-// Beckmann D (SPEC eq.; bv_core::microfacet::beckmann_d). exp underflows in
+// Beckmann D (Walter et al. 2007, eq. 25; bv_core::microfacet::beckmann_d). exp underflows in
 // f32 beyond e ≈ 87, where D is far below any value that matters.
 fn beckmann_d(h: vec3<f32>, ax: f32, ay: f32) -> f32 {
     if (h.z <= 0.0) {
@@ -119,7 +119,7 @@ fn scale_d(s: Scale, h: vec3<f32>) -> f32 {
     return blinn_d(h, s.ax, s.blinn_c);
 }
 
-// Λ of one scale; Blinn uses Beckmann's Λ with α = alpha_x (SPEC).
+// Λ of one scale; Blinn uses Beckmann's Λ with α = alpha_x (Walter et al. 2007, eq. 27).
 fn scale_lambda(s: Scale, w: vec3<f32>) -> f32 {
     if (s.dist == COOK_TORRANCE_DISTRIBUTION_GGX) {
         return ggx_lambda(w, s.ax, s.ay);

@@ -47,7 +47,7 @@ fn sphere_at(p: vec2<f32>, size: vec2<f32>, tiles: u32) -> SpherePoint {
     return out;
 }
 
-// A view-space direction in the point's local shading frame (SPEC §1).
+// A view-space direction in the point's local shading frame .
 fn to_local(s: SpherePoint, w: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(w, s.t), dot(w, s.b), dot(w, s.n));
 }

@@ -1,4 +1,4 @@
-// Disney principled BRDF, Burley 2012, as SPEC §2 fixes it (bv_core::models::disney).
+// Disney principled BRDF, Burley 2012, with bv's fixed choices (bv_core::models::disney).
 #define_import_path bv::models::disney
 
 #import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}

@@ -1,4 +1,4 @@
-//! The GUI of measured tables (issue 5, items 6 and 7): the "Load MERL…"
+//! The GUI of measured tables: the "Load MERL…"
 //! button (its dialog is [`crate::widgets::files`]), the progress of background reads, the error dialog of a
 //! refused file, and the panel section of a `merl` BRDF (its table, the
 //! reader's warnings, and the relative L2 difference to another loaded BRDF,

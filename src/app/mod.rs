@@ -1,4 +1,4 @@
-//! The viewer window (issue 3): an eframe app on wgpu around [`Viewer`].
+//! The viewer window: an eframe app on wgpu around [`Viewer`].
 //!
 //! - The state, commands and evaluators are the session's
 //!   ([`crate::session`]); [`panel`] and [`measured_ui`]: the left panel;

@@ -1,4 +1,4 @@
-//! The viewer's side of issue 6: scene files (Ctrl+O, Ctrl+S), the figure
+//! The viewer's side of figures and scenes: scene files (Ctrl+O, Ctrl+S), the figure
 //! export dialog (Ctrl+Shift+S: a view or the whole window as PNG at 1×, 2×
 //! or 4× the screen's resolution, optionally transparent; 2D plots as SVG;
 //! the lobe as OBJ/PLY), and toasts that say where things went.

@@ -1,5 +1,5 @@
 //! `bv bench`: batch evaluation speed of one model on fixed-seed random
-//! direction pairs (SPEC §5). Prints `<number> M evals/s`.
+//! direction pairs . Prints `<number> M evals/s`.
 //!
 //! The pairs are drawn once, uniformly on the upper hemisphere, from
 //! [`bv_core::sampling::rng`] with a fixed seed, so every run evaluates the same

@@ -1,4 +1,4 @@
-//! `bv check`: the properties of SPEC §3 (positivity, reciprocity, isotropy,
+//! `bv check`: the properties (positivity, reciprocity, isotropy,
 //! energy, D normalisation) for one model and parameter set, each with its
 //! sample or quadrature count and error, beside what the model claims.
 

@@ -1,4 +1,4 @@
-//! `bv eval`: evaluate f(wi, wo) for JSON Lines queries (SPEC §5).
+//! `bv eval`: evaluate f(wi, wo) for JSON Lines queries .
 //!
 //! Each non-blank line of stdin is one query
 //! `{"model": "ward", "params": {...}, "wi": [x, y, z], "wo": [x, y, z]}`

@@ -1,4 +1,4 @@
-//! `bv info FILE`: what is in a MERL `.binary` table (issue 5, item 4).
+//! `bv info FILE`: what is in a MERL `.binary` table.
 
 use anyhow::Result;
 use bv_core::analysis::{albedo, directions, reciprocity};

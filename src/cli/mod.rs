@@ -1,4 +1,4 @@
-//! Command line (SPEC §5).
+//! Command line .
 //!
 //! `bv` with no sub-command opens the viewer (through the [`Shell`] the
 //! binary hands in, so that this layer does not import the window); each
@@ -6,7 +6,7 @@
 //!
 //! - [`eval`]: JSON Lines queries on stdin, one answer per line on stdout;
 //! - [`models`]: the model catalogue with every parameter's range and default;
-//! - [`check`]: the properties of SPEC §3 for one parameter set;
+//! - [`check`]: the properties for one parameter set;
 //! - [`bench`]: batch evaluation speed;
 //! - [`render`]: figures without a window (PNG, SVG, OBJ/PLY);
 //! - [`slice`]: the plotted curves as numbers (CSV);
@@ -55,7 +55,7 @@ pub struct Cli {
     pub viewer: viewer_args::ViewerArgs,
 }
 
-/// The sub-commands of SPEC §5.
+/// The sub-commands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Evaluate f(wi, wo) for JSON Lines queries read from stdin.

@@ -1,5 +1,5 @@
 //! The model and parameter options shared by the sub-commands
-//! (`--model ID --param NAME=VALUE …`, SPEC §5).
+//! (`--model ID --param NAME=VALUE …`).
 
 use anyhow::{Context, bail};
 use bv_core::ModelSpec;

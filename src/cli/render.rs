@@ -1,4 +1,4 @@
-//! `bv render`: figures without a window (issue 6). Any view of the registry
+//! `bv render`: figures without a window. Any view of the registry
 //! drawn offscreen by the viewer's own code (wgpu; lavapipe on a server) to
 //! PNG, the 2D plots to SVG, the lobe to OBJ/PLY; `--view all` writes one file
 //! per view into a folder, with a progress bar on stderr.

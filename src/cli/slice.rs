@@ -1,4 +1,4 @@
-//! `bv slice`: the curves the 2D plots draw, as numbers (issue 6). One row
+//! `bv slice`: the curves the 2D plots draw, as numbers. One row
 //! per sample; `--csv` writes comma-separated values with a header row.
 //!
 //! Columns (stated in `--help` and the README):

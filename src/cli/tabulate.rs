@@ -1,5 +1,5 @@
 //! `bv tabulate`: samples any model into a MERL-layout `.binary` table
-//! (issue 5, item 3), so that users can build tables and tests can build
+//!, so that users can build tables and tests can build
 //! realistic full-size files.
 
 use super::output::{print, warn};
@@ -12,7 +12,7 @@ use std::time::Instant;
 /// Arguments of `bv tabulate`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TabulateArgs {
-    /// Model id (see SPEC §2), e.g. `lambert`.
+    /// Model id, e.g. `lambert` (`bv models` lists them).
     #[arg(long)]
     pub model: String,
     /// A parameter as NAME=VALUE (repeatable); a colour as `kd=0.2,0.5,0.8`.

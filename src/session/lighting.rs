@@ -1,4 +1,4 @@
-//! Saved settings of the two rendered views (issue 4): the lit sphere
+//! Saved settings of the two rendered views: the lit sphere
 //! (`views::lit_sphere`) and the environment-lit object
 //! (`views::environment`). They live in [`super::state::AppState::lighting`]
 //! and change through [`super::Command::SetLitView`] and

@@ -1,4 +1,4 @@
-//! Scene files (issue 6): the viewer's [`AppState`] as TOML, for slides,
+//! Scene files: the viewer's [`AppState`] as TOML, for slides,
 //! papers and `bv render --scene`.
 //!
 //! A scene file is the same serialisable state eframe persists between runs

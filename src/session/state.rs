@@ -67,7 +67,7 @@ impl Incident {
     /// excluded because every reflection model is 0 there.
     pub const MAX_THETA_DEG: f64 = 89.5;
 
-    /// The unit direction towards the light (SPEC §1 frame).
+    /// The unit direction towards the light.
     pub fn direction(&self) -> glam::DVec3 {
         bv_core::frame::from_spherical(self.theta_deg.to_radians(), self.phi_deg.to_radians())
     }
@@ -118,7 +118,7 @@ pub struct Display {
     /// hemisphere; otherwise keep the last scale while parameters change.
     pub auto_scale: bool,
     /// Lobe and polar views: overlay the selected lobe's spherical-harmonics
-    /// reconstruction (issue 5, item 6).
+    /// reconstruction.
     pub sh_overlay: bool,
     /// Its highest order L (0–16).
     pub sh_order: u8,

@@ -1,4 +1,4 @@
-//! The environment view (issue 4, item 4): each drawn BRDF (or the selected
+//! The environment view: each drawn BRDF (or the selected
 //! one) on a sphere or a torus under an equirectangular HDR environment,
 //! rendered by [`crate::gpu::EnvRenderer`] with multiple importance sampling
 //! of the BRDF and of the environment, accumulated across frames.

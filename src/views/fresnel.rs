@@ -1,5 +1,5 @@
 //! The Fresnel view: F against the angle of incidence for the selected BRDF's
-//! Fresnel settings (SPEC §2, "Microfacet parts", F), computed with the
+//! Fresnel settings, computed with the
 //! core's own `bv_core::fresnel` functions.
 //!
 //! - Dielectric (`fresnel = "dielectric"`, and `glass`): r∥², r⊥² and their

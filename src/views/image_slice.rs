@@ -1,4 +1,4 @@
-//! Image slice in half/difference angles (issue 5, item 5; Rusinkiewicz 1998):
+//! Image slice in half/difference angles (Rusinkiewicz 1998):
 //! an image with θh on x (0–90°, optionally on a √θh axis, the spacing of the
 //! MERL table's θh cells) and θd on y (0° at the bottom, 90° at the top) at a
 //! chosen φd, φh = 0, for every drawn BRDF side by side, measured or analytic.

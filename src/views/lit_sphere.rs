@@ -1,4 +1,4 @@
-//! The lit sphere view (issue 4, item 3): every drawn BRDF on its own
+//! The lit sphere view: every drawn BRDF on its own
 //! orthographic sphere (or only the selected one), with a per-pixel normal and
 //! a tangent frame whose tangent follows the parallels (so anisotropy shows),
 //! lit by one directional light from the incident direction; exposure, sRGB

@@ -96,7 +96,7 @@ impl View for PolarView {
         );
         let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
         let (curves, outer) = polar_curves(scene);
-        // The SH reconstruction of the selected lobe, dashed (issue 5, item 6).
+        // The SH reconstruction of the selected lobe, dashed.
         let sh = sh_overlay::request(ui.ctx(), scene).and_then(|done| {
             let r = done.value.as_ref().ok()?;
             let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;

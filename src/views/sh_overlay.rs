@@ -1,4 +1,4 @@
-//! The spherical-harmonics overlay (issue 5, item 6) shared by the 3D lobe and
+//! The spherical-harmonics overlay shared by the 3D lobe and
 //! the polar plot: the selected BRDF's lobe at the current incident direction
 //! projected onto real SH of order ≤ L ([`bv_core::represent::sh::project`]),
 //! drawn as a wireframe surface in the 3D lobe and a dashed curve in the polar

@@ -1,4 +1,4 @@
-//! MERL table benchmarks (issue 5): load time of a full-size 90×90×180 file
+//! MERL table benchmarks: load time of a full-size 90×90×180 file
 //! (34,992,012 bytes, written by `tabulate` + `write`, as `bv tabulate` does)
 //! and lookup throughput, nearest and trilinear.
 //!

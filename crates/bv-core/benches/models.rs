@@ -1,4 +1,4 @@
-//! Speed of every model of the catalogue (issue 2): evaluations per second on
+//! Speed of every model of the catalogue: evaluations per second on
 //! one core, lobe mesh construction, and ρhd curves.
 //!
 //! Targets reported against (never asserted: machines are noisy): a lobe mesh
@@ -39,7 +39,7 @@ fn analytic(m: &ModelInfo) -> bool {
         .any(|d| matches!(d.kind, ParamKind::Path { .. }))
 }
 
-/// A MERL-format table of the public set's size (90 × 90 × 180, SPEC §4)
+/// A MERL-format table of the public set's size (90 × 90 × 180)
 /// with smooth made-up values, for measured models whose defaults name no
 /// file: lookup speed does not depend on the data.
 fn synthetic_table() -> String {

@@ -2,6 +2,7 @@
 
 use crate::{Rgb, sampling};
 use glam::{DVec2, DVec3};
+use std::sync::Arc;
 
 /// What a model claims about itself, for its current parameters. The property
 /// tests hold every model to its claims; `bv check` prints them beside the
@@ -128,11 +129,45 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The model's microfacet terms (D, G1, G2), for plotting them apart.
+    /// `None` for models that are not microfacet models.
+    fn microfacet_terms(&self) -> Option<MicrofacetTerms> {
+        None
+    }
+
     /// The model's Fresnel term, for the Fresnel view: what multiplies its
     /// specular (or delta) lobe as a function of the angle of incidence.
     /// `None` for models without one.
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         None
+    }
+}
+
+/// The microfacet terms of a model, as functions a plot can sample: the
+/// distribution D(h), Smith's masking G1(w) and the masking-shadowing term
+/// G2(wi, wo) the model uses (Heitz 2014, "Understanding the
+/// Masking-Shadowing Function", eqs. 2, 43 and 98), with their names.
+#[derive(Clone)]
+pub struct MicrofacetTerms {
+    /// The distribution's name ("GGX").
+    pub distribution: String,
+    /// The masking-shadowing term's name ("height-correlated Smith").
+    pub geometry: String,
+    /// D(h) for a unit `h` in the upper hemisphere (1/sr).
+    pub d: Arc<dyn Fn(DVec3) -> f64 + Send + Sync>,
+    /// G1(w) of the distribution (Smith masking for `w` at the macro normal's
+    /// side; the v-groove G has no separate G1 and reports Smith's).
+    pub g1: Arc<dyn Fn(DVec3) -> f64 + Send + Sync>,
+    /// G2(wi, wo, h), the term the model multiplies by.
+    pub g2: Arc<dyn Fn(DVec3, DVec3, DVec3) -> f64 + Send + Sync>,
+}
+
+impl std::fmt::Debug for MicrofacetTerms {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MicrofacetTerms")
+            .field("distribution", &self.distribution)
+            .field("geometry", &self.geometry)
+            .finish_non_exhaustive()
     }
 }
 

@@ -1,4 +1,4 @@
-//! The local shading frame of SPEC §1 and the direction algebra every model uses.
+//! The local shading frame and the direction algebra every model uses.
 //!
 //! Normal `n = +z`, tangent `t = +x`, bitangent `b = +y`. Both `wi` (towards the
 //! light) and `wo` (towards the viewer) point away from the surface. θ is measured
@@ -17,7 +17,7 @@ pub const BITANGENT: DVec3 = DVec3::Y;
 /// `(sin θ, cos θ)`, exact at the horizon θ = π/2 and at θ = π. `cos(π/2)` in
 /// floating point is 6e-17, not 0: a direction meant to lie in the surface would
 /// then be just above it, where a model with a 1/cos θ factor (Ward, Phong)
-/// returns thousands instead of the 0 of SPEC §1.
+/// returns thousands instead of the 0.
 #[inline]
 pub fn sin_cos_theta(theta: f64) -> (f64, f64) {
     if theta == FRAC_PI_2 {
@@ -77,7 +77,7 @@ pub fn cos2_sin2_phi(w: DVec3) -> (f64, f64) {
     }
 }
 
-/// Mirror direction about the normal: `R(w) = 2 (w·n) n − w` (SPEC §1).
+/// Mirror direction about the normal: `R(w) = 2 (w·n) n − w` .
 #[inline]
 pub fn reflect(w: DVec3) -> DVec3 {
     DVec3::new(-w.x, -w.y, w.z)
@@ -148,7 +148,7 @@ fn rotate_y(v: DVec3, a: f64) -> DVec3 {
     DVec3::new(c * v.x + s * v.z, v.y, -s * v.x + c * v.z)
 }
 
-/// Half/difference angles of `(wi, wo)` (SPEC §1): θh, φh are the angles of
+/// Half/difference angles of `(wi, wo)` : θh, φh are the angles of
 /// `h`; θd, φd those of `wi` after rotating by −φh about z and −θh about y.
 /// `None` when `wi = −wo`.
 pub fn to_half_diff(wi: DVec3, wo: DVec3) -> Option<HalfDiff> {
@@ -174,7 +174,7 @@ pub fn from_half_diff(hd: HalfDiff) -> (DVec3, DVec3) {
 }
 
 /// Checks a user-given direction: finite, normalised when within 1e-3 of unit
-/// length (SPEC §5), refused otherwise.
+/// length , refused otherwise.
 pub fn checked_direction(name: &str, v: [f64; 3]) -> crate::Result<DVec3> {
     let w = DVec3::from_array(v);
     if !w.is_finite() {

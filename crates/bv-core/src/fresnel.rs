@@ -1,4 +1,4 @@
-//! Fresnel reflectance (SPEC §2, "Microfacet parts", F): exact dielectric and
+//! Fresnel reflectance: exact dielectric and
 //! conductor interfaces, Schlick's approximation, the seed lecture's simplified
 //! conductor formulas and its inverses from a measured normal-incidence F(0).
 //!

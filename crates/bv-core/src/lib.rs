@@ -32,7 +32,7 @@ pub mod rotated;
 pub mod sampling;
 pub mod text;
 
-pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, Ndf};
+pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, MicrofacetTerms, Ndf};
 pub use error::{BvError, Result};
 pub use model::ModelInfo;
 pub use params::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};

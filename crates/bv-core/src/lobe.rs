@@ -1,4 +1,4 @@
-//! Lobe meshes (issue 2, item 7): the surface `r(wo) · wo` over the outgoing
+//! Lobe meshes: the surface `r(wo) · wo` over the outgoing
 //! hemisphere (the whole sphere for transmitting models), where `r` is `f` or
 //! `f · cos θo`, on a linear or logarithmic scale. The 3D view and the headless
 //! export draw this mesh; it carries a per-vertex value for colouring.
@@ -439,7 +439,7 @@ mod tests {
     #[test]
     fn the_horizon_ring_is_in_the_surface() {
         // Ward divides by √cos θo: a horizon ring a hair above the surface would
-        // be thousands of 1/sr; in the surface it is 0 (SPEC §1).
+        // be thousands of 1/sr; in the surface it is 0 .
         let b = crate::ModelSpec::new("ward").unwrap().build().unwrap();
         let m = build(b.as_ref(), DVec3::Z, &LobeOptions::default());
         let k = m.n_theta * m.n_phi;

@@ -1,4 +1,4 @@
-//! Microfacet theory (SPEC §2, "Microfacet parts"): normal distributions D,
+//! Microfacet theory: normal distributions D,
 //! Smith's Λ, the masking-shadowing terms G and the sampling of microfacet
 //! normals, shared by `cook-torrance` and `disney`.
 //!
@@ -90,7 +90,7 @@ pub fn beckmann_lambda_a(a: f64) -> f64 {
 }
 
 /// Smith's Λ of the anisotropic Beckmann distribution for direction `w`
-/// (SPEC §2: `a = 1/(α(w) tanθ)`); +∞ at and below the horizon, 0 on the normal.
+/// (`a = 1/(α(w) tanθ)`); +∞ at and below the horizon, 0 on the normal.
 pub fn beckmann_lambda(w: DVec3, ax: f64, ay: f64) -> f64 {
     let t = alpha2_tan2(w, ax, ay);
     if t == 0.0 {
@@ -383,7 +383,7 @@ impl Scale {
         }
     }
 
-    /// Smith's Λ(w); Blinn uses Beckmann's (SPEC §2), which is exact only for
+    /// Smith's Λ(w); Blinn uses Beckmann's , which is exact only for
     /// Beckmann's slope distribution.
     pub fn lambda(&self, w: DVec3) -> f64 {
         match self.dist {
@@ -942,7 +942,7 @@ pub(crate) mod tests {
                 assert!((s / w.z - 1.0).abs() < 1e-4, "{m:?} θ {th}: {}", s / w.z);
             }
         }
-        // Blinn's D with Beckmann's Λ (SPEC's pairing) breaks the Smith relation.
+        // Blinn's D with Beckmann's Λ (bv's pairing) breaks the Smith relation.
         let m = Microfacet::new(Distribution::Blinn, 1.0, 1.0);
         let w = from_spherical(1.3, 0.0);
         let s = hemisphere_integral(|h| m.d(h) * w.dot(h).max(0.0), 1024) * m.g1(w);

@@ -1,4 +1,4 @@
-//! Generic property tests over EVERY model of the catalogue (SPEC §3): each
+//! Generic property tests over EVERY model of the catalogue : each
 //! test iterates `bv_core::catalogue()`, draws random parameters from the
 //! model's own declaration and random directions (grazing ones included), and
 //! holds the model to the physics and to its own claims.
@@ -40,7 +40,7 @@ fn synthetic_table(full: bool) -> String {
         let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
         let name = format!("bv-properties-{}x{}x{}.binary", dims[0], dims[1], dims[2]);
         let path = dir.join(&name);
-        // SPEC §4: three little-endian int32 dims, then 3·n float64 values
+        // MERL layout: three little-endian int32 dims, then 3·n float64 values
         // (channel-major, index (iθh·nθd + iθd)·nφd + iφd). Random cells give
         // the largest possible steps, so an index or fold error cannot hide;
         // about 3 % are negative ("not measured"); the rest give f up to

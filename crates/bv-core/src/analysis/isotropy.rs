@@ -1,6 +1,6 @@
 //! Isotropy: an isotropic BRDF depends on `wi` and `wo` only through θi, θo
 //! and φi − φo, so rotating both about the normal by a common angle leaves it
-//! unchanged (SPEC §3).
+//! unchanged .
 
 use super::PairSample;
 use super::directions::stream_seed;

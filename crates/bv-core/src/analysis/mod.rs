@@ -1,4 +1,4 @@
-//! Property analysis (SPEC §3, issue 2 item 6): what `bv check` prints and the
+//! Property analysis : what `bv check` prints and the
 //! GUI shows. Every number comes with the sample or quadrature count it used
 //! and an error estimate, and every verdict is printed beside what the model
 //! claims about itself ([`Brdf::claims`]).
@@ -187,7 +187,7 @@ pub struct NdfReport {
     pub normalised: bool,
 }
 
-/// Everything `bv check` reports for one model (SPEC §3).
+/// Everything `bv check` reports for one model .
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PropertyReport {
     /// Model id.
@@ -218,7 +218,7 @@ impl PropertyReport {
     }
 }
 
-/// Runs every check of SPEC §3 on `brdf`.
+/// Runs every property check on `brdf`.
 pub fn check(brdf: &dyn Brdf, opts: &CheckOptions) -> PropertyReport {
     let c = brdf.claims();
     let claims = ClaimsReport {

@@ -1,6 +1,6 @@
 //! D normalisation: a microfacet distribution must satisfy
 //! `∫ D(h) cos θh dωh = 1` (the projected microfacet area equals the
-//! macro-surface area; Walter et al. 2007, eq. 4; SPEC §2).
+//! macro-surface area; Walter et al. 2007, eq. 4).
 //!
 //! Computed as `∫₀^{2π} ∫₀^{π/2} D(θ, φ) cos θ sin θ dθ dφ` by nested global
 //! adaptive Gauss–Kronrod (7/15) quadrature. The θ axis starts from

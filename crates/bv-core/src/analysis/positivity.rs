@@ -1,5 +1,5 @@
 //! Positivity: a BRDF is a density of scattered radiance, so it must be finite
-//! and non-negative everywhere (SPEC §3).
+//! and non-negative everywhere .
 
 use super::PairSample;
 use crate::{Brdf, Rgb};

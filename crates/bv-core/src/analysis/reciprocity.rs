@@ -1,5 +1,5 @@
 //! Helmholtz reciprocity: `f(wi, wo) = f(wo, wi)` for a physically based
-//! reflection model (SPEC §3). Measured as the largest channel difference
+//! reflection model . Measured as the largest channel difference
 //! between the two orders, relative to the largest `f` seen over the set, so
 //! that a value is meaningful whatever the model's scale.
 

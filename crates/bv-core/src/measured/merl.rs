@@ -1,4 +1,4 @@
-//! MERL `.binary` tables (SPEC §4): reader, writer, index mapping, lookups and
+//! MERL `.binary` tables : reader, writer, index mapping, lookups and
 //! tabulation of analytic models.
 //!
 //! # File layout

@@ -1,6 +1,6 @@
 //! Ashikhmin-Shirley: the anisotropic Phong BRDF of Ashikhmin & Shirley 2000,
 //! "An anisotropic Phong BRDF model" (J. Graphics Tools 5(2)), eqs. 4–5 for the
-//! value and eqs. 9–10 for importance sampling. SPEC §2 fixes the seed's typos
+//! value and eqs. 9–10 for importance sampling. bv fixes the seed's typos
 //! (`cos²φ` written twice in D, the missing `/2` in the diffuse term).
 
 use crate::frame::half_vector;
@@ -11,7 +11,7 @@ use crate::{Brdf, Claims, FresnelTerm, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// Parameter declaration (SPEC §2: colours 0..1, exponents 0..10000).
+/// Parameter declaration (colours 0..1, exponents 0..10000).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "rd",

@@ -1,4 +1,4 @@
-//! Banks' anisotropic fibre model (SPEC §2 `banks`), fibre along the tangent
+//! Banks' anisotropic fibre model, fibre along the tangent
 //! `t = +x`:
 //! `f = kd · √(1 − (wi·t)²) + ks · max(0, √(1 − (wi·t)²) √(1 − (wo·t)²) − (wi·t)(wo·t))^e`.
 //!
@@ -21,7 +21,7 @@ use crate::{Brdf, Claims, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
-/// Parameter declaration (exponent 0..10000 per SPEC §2, log slider 1..1000).
+/// Parameter declaration (exponent 0..10000, log slider 1..1000).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "kd",

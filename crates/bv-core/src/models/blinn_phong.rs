@@ -1,4 +1,4 @@
-//! Blinn-Phong cast as a BRDF (SPEC §2 `blinn-phong`):
+//! Blinn-Phong cast as a BRDF:
 //! `f = kd + ks · max(0, h·n)^e / cosθi`, `h = normalize(wi + wo)`.
 //!
 //! Blinn 1977, "Models of light reflection for computer synthesized pictures"
@@ -17,7 +17,7 @@ use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
-/// Parameter declaration (exponent 0..10000 per SPEC §2, log slider 1..1000).
+/// Parameter declaration (exponent 0..10000, log slider 1..1000).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "kd",

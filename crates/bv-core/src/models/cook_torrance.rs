@@ -1,7 +1,7 @@
 //! Cook-Torrance: a Lambertian base plus a microfacet specular lobe,
 //! `f = kd/π + ks · F(wi·h) D(h) G(wi, wo) / (4 cosθi cosθo)` (Cook & Torrance
 //! 1982, eq. in §"The reflectance model"; Walter et al. 2007, eq. 20), with the
-//! choices of D, G and F of SPEC §2 ("Microfacet parts").
+//! choices of D, G and F of `crate::microfacet` and `crate::fresnel`.
 
 use crate::batch::{self, Dirs, Kernel, LaneKernel, Out, math};
 use crate::fresnel::{self, Fresnel, FresnelLanes};
@@ -11,9 +11,10 @@ use crate::microfacet::{
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
-use crate::{Brdf, Claims, FresnelTerm, Ndf, Result, Rgb, mean_rgb, sampling};
+use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::FRAC_1_PI;
+use std::sync::Arc;
 
 /// Roughness range and slider span shared by `alpha_x`, `alpha_y`, `alpha2`.
 const ALPHA: FloatSpec = FloatSpec::log(0.001, 2.0, 0.3, 0.005, 1.0);
@@ -192,6 +193,28 @@ impl Brdf for CookTorrance {
         INFO.id
     }
 
+    fn microfacet_terms(&self) -> Option<MicrofacetTerms> {
+        let (ndf, geometry) = (self.ndf, self.geometry);
+        Some(MicrofacetTerms {
+            distribution: match ndf.first.dist {
+                Distribution::Beckmann => "Beckmann",
+                Distribution::Blinn => "Blinn",
+                Distribution::Ggx => "GGX",
+            }
+            .to_string()
+                + if ndf.w2 > 0.0 { " (two scales)" } else { "" },
+            geometry: match geometry {
+                Geometry::VGroove => "v-groove (Cook & Torrance 1982)",
+                Geometry::Smith => "separable Smith",
+                Geometry::SmithCorrelated => "height-correlated Smith",
+            }
+            .to_string(),
+            d: Arc::new(move |h| ndf.d(h)),
+            g1: Arc::new(move |w| if w.z > 0.0 { ndf.g1(w) } else { 0.0 }),
+            g2: Arc::new(move |wi, wo, h| ndf.g(geometry, wi, wo, h)),
+        })
+    }
+
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         Some(FresnelTerm {
             fresnel: self.fresnel,
@@ -223,7 +246,7 @@ impl Brdf for CookTorrance {
         //   ∫ D (w·h) dω_h = wz: the V-cavity G1 satisfies the relation exactly for
         //   every D (Heitz 2014, §5.2: "the V-cavity masking function is exact";
         //   checked by quadrature in `microfacet::tests`).
-        // - blinn with smith or smith-correlated: SPEC pairs Blinn's D with
+        // - blinn with smith or smith-correlated: bv pairs Blinn's D with
         //   Beckmann's Λ, which is the Λ of Beckmann's slopes, not Blinn's; the
         //   masking relation fails (∫ D G1 ⟨wi·h⟩ exceeds cosθi by up to ~6 % at
         //   α = 1) and the albedo does exceed 1 (test below), so no claim.
@@ -429,6 +452,36 @@ impl Kernel for CtKernel {
 mod tests {
     use super::*;
     use crate::ModelSpec;
+
+    #[test]
+    fn microfacet_terms_are_the_models_own() {
+        let a = 0.3;
+        let b = ModelSpec::from_json(
+            "cook-torrance",
+            &json!({"alpha": a, "distribution": "ggx", "geometry": "smith-correlated",
+                    "fresnel": "none", "kd": 0.0, "ks": 1.0}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let t = b.microfacet_terms().unwrap();
+        assert_eq!(t.distribution, "GGX");
+        assert_eq!(t.geometry, "height-correlated Smith");
+        // GGX at the normal: D = 1/(π α²) (Walter et al. 2007, eq. 33).
+        assert!(((t.d)(DVec3::Z) - 1.0 / (PI * a * a)).abs() < 1e-12);
+        // No masking seen straight down; none below the horizon.
+        assert!(((t.g1)(DVec3::Z) - 1.0).abs() < 1e-15);
+        assert_eq!((t.g1)(DVec3::new(1.0, 0.0, -0.1).normalize()), 0.0);
+        // f = D G2 / (4 cos θi cos θo) with F = 1 and ks = 1 (Walter eq. 20).
+        let wi = from_spherical(0.7, 0.3);
+        let wo = from_spherical(0.4, 2.9);
+        let h = (wi + wo).normalize();
+        let want = (t.d)(h) * (t.g2)(wi, wo, h) / (4.0 * wi.z * wo.z);
+        assert!((b.eval(wi, wo).x - want).abs() < 1e-12 * want.max(1.0));
+        // Models that are not microfacet models have none.
+        let l = ModelSpec::new("lambert").unwrap().build().unwrap();
+        assert!(l.microfacet_terms().is_none());
+    }
     use crate::frame::from_spherical;
     use crate::microfacet::tests::hemisphere_integral;
     use proptest::prelude::*;

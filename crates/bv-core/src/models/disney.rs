@@ -1,6 +1,6 @@
 //! Disney's principled BRDF (Burley 2012, "Physically Based Shading at Disney",
 //! SIGGRAPH course notes, and its public reference shader `disney.brdf` in
-//! BRDF Explorer), with SPEC §2's fixed choices: linear `base_color`,
+//! BRDF Explorer), with these fixed choices: linear `base_color`,
 //! `Cdlum = 0.3R + 0.6G + 0.1B`, specular G = separable Smith GGX with (αx, αy).
 
 use crate::fresnel::schlick_weight;
@@ -178,7 +178,7 @@ pub struct Disney {
 const CLEARCOAT_G_ALPHA: f64 = 0.25;
 
 impl Disney {
-    /// The model for the given parameters (names as in SPEC §2).
+    /// The model for the given parameters.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         base: Rgb,

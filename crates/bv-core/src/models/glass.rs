@@ -1,6 +1,6 @@
 //! Smooth dielectric interface: delta reflection with the exact dielectric
 //! Fresnel term plus delta transmission `(ηo²/ηi²)(1 − F) δ(wo − T(wi))/|cosθi|`
-//! (SPEC §2; the seed's "ideal specular" summary; PBRT 3rd ed. §8.2).
+//! (the seed's "ideal specular" summary; PBRT 3rd ed. §8.2).
 
 use crate::fresnel;
 use crate::model::{Build, DeltaPort, GpuPort, ModelInfo};

@@ -1,6 +1,6 @@
 //! Hapke: the planetary-regolith BRDF of Hapke 1981, "Bidirectional reflectance
 //! spectroscopy 1. Theory" (J. Geophys. Res. 86), without the macroscopic
-//! roughness correction (SPEC §2): single scattering with a Henyey-Greenstein
+//! roughness correction : single scattering with a Henyey-Greenstein
 //! phase function and the opposition surge, plus multiple scattering through
 //! Hapke's closed-form approximation of Chandrasekhar's H function. The lecture
 //! uses it for the Moon's flat, retro-reflective look.
@@ -12,7 +12,7 @@ use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// Parameter declaration (SPEC §2: w 0..1, b0 0..10, h 0.001..1, g −1..1).
+/// Parameter declaration (w 0..1, b0 0..10, h 0.001..1, g −1..1).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "w",
@@ -115,8 +115,8 @@ impl Hapke {
 }
 
 /// Henyey-Greenstein phase function in Hapke's normalisation (∫ P dω = 4π),
-/// `P = (1 − g²)/(1 + 2g cos g_ph + g²)^{3/2}` with `cos g_ph = wi·wo` (SPEC §2;
-/// g < 0 peaks at g_ph = 0, back towards the light).
+/// `P = (1 − g²)/(1 + 2g cos g_ph + g²)^{3/2}` with `cos g_ph = wi·wo`
+/// (g < 0 peaks at g_ph = 0, back towards the light).
 ///
 /// The denominator is computed as `(1 + g cos)² + g² sin²` with `1 + g cos` from
 /// `|wi ∓ wo|²` so that it never cancels: for |g| < 1 it is ≥ (1 − |g|)² > 0 and P

@@ -1,4 +1,4 @@
-//! Lafortune's generalised cosine lobes (SPEC §2 `lafortune`):
+//! Lafortune's generalised cosine lobes:
 //! `f = kd/π + Σ_j ks_j (n_j+2)/(2π) · max(0, cx wi.x wo.x + cy wi.y wo.y + cz wi.z wo.z)^n_j`.
 //!
 //! Lafortune, Foo, Torrance & Greenberg 1997, "Non-linear approximation of
@@ -8,7 +8,7 @@
 //! `(1, 1, 1)` is retro-reflective, `|cz| < |cx|` gives off-specular peaks, and
 //! `cx ≠ cy` anisotropy.
 //!
-//! Coefficient range −1..1 (SPEC gives none). The paper's fitted magnitudes
+//! Coefficient range −1..1 (the paper gives none). The paper's fitted magnitudes
 //! are near 1; a lobe `s·(cx, cy, cz)` is the lobe `(cx, cy, cz)` scaled by
 //! `s^n`, so a magnitude beyond 1 is a brightness that `ks` (0..10) already
 //! provides. Keeping `|c| ≤ 1` bounds the base of the power by 1

@@ -33,7 +33,7 @@ pub const COS_FLOOR: f64 = 1e-150;
 
 /// The lobe `max(0, x)^e`.
 ///
-/// Decision for `e = 0` (SPEC leaves it open): the lobe is 0 wherever
+/// Decision for `e = 0` (the formula leaves it open): the lobe is 0 wherever
 /// `x ≤ 0`, for every `e`, including `x = 0` exactly. So `e = 0` gives the
 /// indicator of the open hemisphere around the lobe axis rather than the
 /// `0⁰ = 1` of `powf`; this is the limit of `x^e` as `e → 0⁺` at `x = 0`,
@@ -175,7 +175,7 @@ pub mod testing {
     use proptest::prelude::*;
     use std::f64::consts::PI;
 
-    /// Builds model `id` from SPEC §5 JSON parameters.
+    /// Builds model `id` from JSON parameters.
     pub fn build_model(id: &str, params: serde_json::Value) -> Box<dyn Brdf> {
         ModelSpec::from_json(id, &params).unwrap().build().unwrap()
     }

@@ -1,4 +1,4 @@
-//! `merl`: a measured BRDF from a MERL `.binary` table (SPEC §4; Matusik et al.
+//! `merl`: a measured BRDF from a MERL `.binary` table (Matusik et al.
 //! 2003, "A Data-Driven Reflectance Model").
 
 use crate::measured::merl::{self as table, Interpolation, MerlTable};

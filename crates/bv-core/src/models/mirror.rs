@@ -1,5 +1,5 @@
-//! Ideal mirror: a single delta lobe `F(cosθi) δ(wi − R(wo)) / cosθi` (SPEC §2;
-//! the seed's "ideal specular" summary; PBRT 3rd ed. §8.2.2).
+//! Ideal mirror: a single delta lobe `F(cosθi) δ(wi − R(wo)) / cosθi`
+//! (the seed's "ideal specular" summary; PBRT 3rd ed. §8.2.2).
 
 use crate::fresnel::{self, Fresnel};
 use crate::model::{Build, DeltaPort, GpuPort, ModelInfo};

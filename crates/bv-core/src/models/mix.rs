@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 /// Most components one mix accepts.
 pub const MAX_COMPONENTS: usize = 8;
 
-/// Weight range of one component (SPEC §2: `mix` weights 0..10).
+/// Weight range of one component (`mix` weights 0..10).
 const WEIGHT: FloatSpec = FloatSpec::linear(0.0, 10.0, 1.0);
 
 /// Parameter declaration.

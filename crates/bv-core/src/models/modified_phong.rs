@@ -1,4 +1,4 @@
-//! Modified Phong (SPEC §2 `modified-phong`):
+//! Modified Phong:
 //! `f = kd/π + ks (e+2)/(2π) · max(0, R(wo)·wi)^e`.
 //!
 //! Lafortune & Willems 1994, "Using the modified Phong reflectance model for
@@ -15,7 +15,7 @@ use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
 
-/// Parameter declaration (exponent 0..10000 per SPEC §2, log slider 1..1000).
+/// Parameter declaration (exponent 0..10000, log slider 1..1000).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "kd",

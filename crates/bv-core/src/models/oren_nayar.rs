@@ -10,7 +10,7 @@ use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
 use std::f64::consts::{FRAC_1_PI, FRAC_PI_2};
 
-/// Parameter declaration (SPEC §2: albedo 0..1, σ 0..π/2 radians).
+/// Parameter declaration (albedo 0..1, σ 0..π/2 radians).
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {
         id: "albedo",

@@ -1,4 +1,4 @@
-//! Classical Phong cast as a BRDF (SPEC §2 `phong`):
+//! Classical Phong cast as a BRDF:
 //! `f = kd + ks · max(0, R(wo)·wi)^e / cosθi`.
 //!
 //! Phong's (1975, "Illumination for computer generated pictures") shading
@@ -20,7 +20,7 @@ use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
-/// Parameter declaration. Exponent range 0..10000 per SPEC §2 ("Phong-family
+/// Parameter declaration. Exponent range 0..10000 ("Phong-family
 /// exponents"), shown on a logarithmic slider over 1..1000.
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {

@@ -1,4 +1,4 @@
-//! Ward's anisotropic Gaussian model (SPEC §2 `ward`):
+//! Ward's anisotropic Gaussian model:
 //! `f = kd/π + ks · exp(−tan²θh (cos²φh/αx² + sin²φh/αy²)) / (4π αx αy √(cosθi cosθo))`.
 //!
 //! Ward 1992, "Measuring and modeling anisotropic reflection", eq. 5 (the
@@ -15,7 +15,7 @@ use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
 
-/// Parameter declaration. Roughness range 0.001..1 as SPEC §2 gives for Ward
+/// Parameter declaration. Roughness range 0.001..1 for Ward
 /// (the Gaussian is a small-slope model; Ward fitted α ≤ 0.5), log sliders.
 pub const PARAMS: &[ParamDecl] = &[
     ParamDecl {

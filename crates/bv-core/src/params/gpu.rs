@@ -1,4 +1,4 @@
-//! The GPU layout of a parameter declaration (issue 4, item 1).
+//! The GPU layout of a parameter declaration.
 //!
 //! Shaders read a model's parameters from one flat `array<f32>` storage buffer.
 //! Where each parameter sits is derived here from the model's one declaration

@@ -16,7 +16,7 @@ impl ModelSpec {
         Ok(Self::defaults(registry::find(model)?))
     }
 
-    /// The model with the given JSON parameters over its defaults (SPEC §5 form:
+    /// The model with the given JSON parameters over its defaults (the JSON form:
     /// scalars for grey colours, `alpha` for `alpha_x = alpha_y`).
     pub fn from_json(model: &str, params: &Value) -> Result<Self> {
         Self::from_json_nested(model, params, 0)

@@ -1,5 +1,5 @@
 //! Real spherical harmonics up to order 16, and the projection of a BRDF lobe
-//! onto them (issue 5, item 6).
+//! onto them.
 //!
 //! The lobe `g(wo) = f(wi, wo)` (times `cos θo` on request) at a fixed `wi` is
 //! a function on the outgoing hemisphere; it is extended by 0 to the sphere
