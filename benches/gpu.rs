@@ -2,6 +2,9 @@
 //! environment samples per second, on whatever adapter wgpu finds (lavapipe on
 //! machines without a GPU). `cargo bench --bench gpu`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::{
     EnvRenderer, EnvSettings, EnvironmentMap, Gpu, LitSphereRenderer, LitSphereSettings,
     shaders::ShaderLibrary,

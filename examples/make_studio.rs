@@ -2,6 +2,9 @@
 //! (256×128, Radiance RGBE), so that the environment view works on a fresh
 //! machine: `cargo run --example make_studio [-- PATH [WIDTH HEIGHT]]`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::EnvironmentMap;
 
 fn main() -> anyhow::Result<()> {

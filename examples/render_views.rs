@@ -2,6 +2,9 @@
 //! `cargo run --release --example render_views -- OUT_DIR [SIZE] [SPP]`.
 //! Writes `lit_sphere.png` and `environment.png` of three models side by side.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::{
     EnvRenderer, EnvSettings, EnvironmentMap, Gpu, LitSphereRenderer, LitSphereSettings,
     shaders::ShaderLibrary,

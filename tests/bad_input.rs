@@ -5,6 +5,8 @@
 //! and every case checks the exit status, the message, that nothing
 //! panicked, and what is left on disk.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 #![cfg(unix)]
 
 use std::fs::{self, File};

@@ -1,6 +1,9 @@
 //! End-to-end tests of the `bv` command line : the built binary is run
 //! as a user or a script would run it.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use serde_json::Value;
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Output, Stdio};

@@ -2,6 +2,9 @@
 //! (Ctrl+Shift+S), figures at 1×/2×/4×, transparent backgrounds, scene
 //! shortcuts, toasts, and the albedo and Fresnel views.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::Viewer;
 use bv::app::screenshot::{FigureSettings, Format, ScreenGeometry, Target};
 use bv::session::Command;

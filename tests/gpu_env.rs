@@ -1,6 +1,9 @@
 //! Environment lighting: the white furnace, and every model's
 //! multiple-importance-sampled estimate against a quadrature by bv-core.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::sphere::sphere_at;
 use bv::gpu::{EnvRenderer, EnvSettings, EnvironmentMap, gpu_for_test, shaders::ShaderLibrary};
 use bv_core::ModelSpec;

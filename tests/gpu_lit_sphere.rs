@@ -7,6 +7,9 @@
 //! lies within 1e-5 (in units of the radius²) of the silhouette, where f32 and
 //! f64 may disagree on inside/outside; at most 0.1 % of the pixels may be those.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::sphere::{FILL, sphere_at};
 use bv::gpu::{
     Background, LitSphereRenderer, LitSphereSettings, ToneMap, gpu_for_test,

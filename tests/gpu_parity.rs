@@ -23,6 +23,9 @@
 //! it has its own test ([`merl_port_matches_bv_core`]) on small tables
 //! written for it.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::{GpuEvaluator, gpu_for_test, shaders::ShaderLibrary};
 use bv_core::measured::merl;
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};

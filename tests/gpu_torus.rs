@@ -6,6 +6,9 @@
 //! the environment: 1 where nothing of the torus is above its tangent plane,
 //! less where the ring hides part of the sky, never more.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::env::Object;
 use bv::gpu::sphere::FILL;
 use bv::gpu::{EnvRenderer, EnvSettings, EnvironmentMap, gpu_for_test, shaders::ShaderLibrary};

@@ -7,6 +7,9 @@
 //! machines without one) and compare small images with `tests/snapshots/`.
 //! Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p bv --test gui`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::Viewer;
 use bv::gpu::lobe::LobeRenderer;
 use bv::session::Command;

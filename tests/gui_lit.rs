@@ -4,6 +4,9 @@
 //! on a change, errors show in the view, and small snapshots of both.
 //! Regenerate the snapshots with `UPDATE_SNAPSHOTS=1 cargo test --test gui_lit`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::Viewer;
 use bv::session::Command;
 use bv::session::lighting::{EnvObject, Lighting};

@@ -9,6 +9,9 @@
 //! compares with `tests/snapshots/image_slice_cook_torrance.png`
 //! (regenerate with `UPDATE_SNAPSHOTS=1 cargo test --test gui_merl`).
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::Viewer;
 use bv::session::Command;
 use bv::session::build_scene;

@@ -3,6 +3,9 @@
 //! names a model of the catalogue (what a model is, is declared with the model
 //! in bv-core).
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 

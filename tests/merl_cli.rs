@@ -1,5 +1,8 @@
 //! `bv tabulate` and `bv info` from the outside.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 

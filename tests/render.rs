@@ -10,6 +10,9 @@
 //! with `UPDATE_SNAPSHOTS=1 cargo test --test render`; a missing or failing
 //! snapshot writes `<name>.new.png` beside it.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

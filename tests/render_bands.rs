@@ -3,6 +3,9 @@
 //! validation error (a buffer beyond the device's limit) is an `Err`, not a
 //! panic, both inside an error scope and outside one.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::errors;
 use bv::gpu::{EnvRenderer, EnvSettings, EnvironmentMap, gpu_for_test, shaders::ShaderLibrary};
 use bv_core::ModelSpec;

@@ -8,6 +8,9 @@
 //! environment view is drawn with `--spp 1` so that the largest size stays
 //! within seconds on a software renderer.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::Instant;

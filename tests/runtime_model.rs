@@ -4,6 +4,9 @@
 //! (through the generated dispatch) and every view. It runs in its own test
 //! process because the catalogue is process-wide.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::export::{self, Frame, Offscreen};
 use bv::gpu::eval::GpuEvaluator;
 use bv::gpu::shaders::ShaderLibrary;

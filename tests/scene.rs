@@ -1,6 +1,9 @@
 //! Scene files: round trips, corrupt and truncated files, atomic
 //! saves, unknown keys, and the `bv scene` / `bv --scene` command lines.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::viewer::Viewer;
 use bv::session::scene_file::{self as scene, END_MARKER, SceneError};
 use bv::session::state::{AppState, CartesianAxis, Incident, Theme};

@@ -3,6 +3,9 @@
 //! re-parsed and re-validated (the exact text wgpu receives), and each
 //! composable module composed and validated on its own.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::gpu::shaders::{ENTRIES, ShaderLibrary, to_wgsl, validate};
 
 #[test]

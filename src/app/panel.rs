@@ -283,7 +283,7 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui,
         egui::Id::unique(("bv params", e.id)),
         info.params,
-        &e.spec.params(),
+        e.spec.params(),
     );
     for edit in edits {
         out.push(match edit {

@@ -4,6 +4,9 @@
 //!
 //! `cargo bench -p bv-core --bench merl`
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv_core::measured::merl::{self, Interpolation, MerlTable, STANDARD_DIMS};
 use bv_core::models::lambert::Lambert;
 use bv_core::{Rgb, frame, sampling};

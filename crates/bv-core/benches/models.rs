@@ -7,6 +7,9 @@
 //!
 //! Run: `cargo bench -p bv-core -- --quick` (or a filter such as `eval/`).
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv_core::analysis::albedo;
 use bv_core::lobe::{self, LobeOptions};
 use bv_core::params::ParamKind;

@@ -34,13 +34,16 @@ pub const ALPHA_ALIAS: Alias = Alias {
     sets: &["alpha_x", "alpha_y"],
 };
 
+/// A run-time model's constructor, with what it captured (a compiled file).
+pub type SharedBuild = Arc<dyn Fn(&Params) -> Result<Box<dyn Brdf>> + Send + Sync>;
+
 /// The builder of an evaluator from a complete, validated parameter set.
 #[derive(Clone)]
 pub enum Build {
     /// A built-in model's constructor.
     Static(fn(&Params) -> Result<Box<dyn Brdf>>),
-    /// A model built at run time (a user file), with what it captured.
-    Shared(Arc<dyn Fn(&Params) -> Result<Box<dyn Brdf>> + Send + Sync>),
+    /// A model built at run time (a user file).
+    Shared(SharedBuild),
 }
 
 impl Build {

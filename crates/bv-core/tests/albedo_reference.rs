@@ -10,6 +10,9 @@
 //! - Calibration of the Monte Carlo error bars: over many independent seeds
 //!   and every catalogue model, the distribution of `(estimate − truth)/σ`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv_core::analysis::albedo::{self, Estimate, Method};
 use bv_core::analysis::quadrature::{self, QuadratureOptions};
 use bv_core::{Brdf, Claims, ModelSpec, Rgb, catalogue, frame};

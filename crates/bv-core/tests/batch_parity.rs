@@ -6,6 +6,9 @@
 //! value must be within 1e-4 relative or 1e-6 absolute of `Brdf::eval` at the
 //! same (f32) directions.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 use bv_core::batch::{self, Dirs, Kernel, LaneKernel, Out, PairBuf};
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
@@ -45,7 +48,7 @@ fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Option<Params> {
             ParamKind::Bool { .. } => ParamValue::Bool(rng.random()),
             _ => return None,
         };
-        p.set_unvalidated(&d.id.to_string(), v);
+        p.set_unvalidated(d.id, v);
     }
     Some(p)
 }

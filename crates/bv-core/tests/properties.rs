@@ -7,6 +7,9 @@
 //! set) so that CI is repeatable; each model gets its own runner so a failure
 //! names the model and the parameters as JSON.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 mod common;
 use bv_core::analysis::{self, CheckOptions, albedo, directions};
 use bv_core::params::{Component, ParamDecl, ParamKind, ParamValue, Params};
@@ -158,7 +161,7 @@ fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Params {
                 )
             }
         };
-        p.set_unvalidated(&d.id.to_string(), v);
+        p.set_unvalidated(d.id, v);
     }
     p
 }

@@ -1,6 +1,9 @@
 //! Helpers shared by the catalogue-wide tests (`properties.rs`,
 //! `batch_parity.rs`).
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv_core::params::FloatSpec;
 use bv_core::sampling::BvRng;
 use rand::Rng;
