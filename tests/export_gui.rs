@@ -101,6 +101,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
                 &path,
                 geometry(1.0),
                 Some(egui::vec2(300.0, 200.0)),
+                bv::app::viewer::figure_window,
             )
             .unwrap();
         assert!(msg.contains(&path.display().to_string()), "{msg}");
@@ -118,7 +119,14 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
         transparent: true,
     };
     v.export
-        .export_figure(&state, &s, &path, geometry(1.0), None)
+        .export_figure(
+            &state,
+            &s,
+            &path,
+            geometry(1.0),
+            None,
+            bv::app::viewer::figure_window,
+        )
         .unwrap();
     let img = image::open(&path).unwrap().to_rgba8();
     assert_eq!(img.dimensions(), (1280, 800));
@@ -144,6 +152,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
                 &path,
                 geometry(1.0),
                 Some(egui::vec2(400.0, 300.0)),
+                bv::app::viewer::figure_window,
             )
             .unwrap();
         assert!(std::fs::metadata(&path).unwrap().len() > 1000, "{name}");

@@ -339,6 +339,7 @@ impl ExportUi {
         path: &Path,
         geometry: ScreenGeometry,
         view_size: Option<egui::Vec2>,
+        window: export::MakeWindow,
     ) -> anyhow::Result<String> {
         let entry = match &settings.target {
             Target::Window => None,
@@ -362,9 +363,7 @@ impl ExportUi {
                 let mut off = self.offscreen()?;
                 let img = match entry {
                     Some(e) => export::render_view(&mut off, state, e, frame)?,
-                    None => {
-                        export::render_window(&mut off, state, frame, super::viewer::figure_window)?
-                    }
+                    None => export::render_window(&mut off, state, frame, window)?,
                 };
                 export::save_png(&img, path)?;
                 Ok(format!(

@@ -143,10 +143,14 @@ impl Viewer {
                     screenshot::Target::View(id) => view_rect(ctx, id).map(|r| r.size()),
                     screenshot::Target::Window => None,
                 };
-                match self
-                    .export
-                    .export_figure(&self.state, &settings, &path, geometry, view_size)
-                {
+                match self.export.export_figure(
+                    &self.state,
+                    &settings,
+                    &path,
+                    geometry,
+                    view_size,
+                    figure_window,
+                ) {
                     Ok(line) => self.export.toast(line, false),
                     Err(e) => self
                         .export

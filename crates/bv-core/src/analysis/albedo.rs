@@ -45,91 +45,25 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// plus one).
 pub const REPLICAS: usize = 16;
 
-/// How an [`Estimate`] was computed, and so what its error means.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum Method {
-    /// Monte Carlo: `std_error` is a standard error (one σ).
-    MonteCarlo {
-        /// Independent replicas behind the standard error.
-        replicas: usize,
-    },
-    /// Deterministic Gauss–Kronrod quadrature: `std_error` is the error
-    /// estimate `|K15 − G7|` summed over panels (a bound-like estimate).
-    Quadrature {
-        /// Whether the tolerance was met within the panel budget.
-        converged: bool,
-    },
-}
+pub use super::estimate::{Estimate, Method};
 
-impl Method {
-    /// A short name for reports: `quadrature` or `monte carlo`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Method::MonteCarlo { .. } => "monte carlo",
-            Method::Quadrature { .. } => "quadrature",
-        }
-    }
-}
-
-/// An estimate with its error (per linear-RGB channel).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Estimate {
-    /// The estimate.
-    pub value: Rgb,
-    /// Its error: the standard error (one σ) for Monte Carlo, the error
-    /// estimate for quadrature (see [`Estimate::method`]).
-    pub std_error: Rgb,
-    /// Samples (`f` evaluations) it used.
-    pub samples: usize,
-    /// Samples discarded because `f` or the density was NaN or infinite (a
-    /// model bug: positivity reports it too).
-    pub rejected: usize,
-    /// How it was computed.
-    pub method: Method,
-}
-
-impl Estimate {
-    /// The error allowance of a verdict: `sigmas` standard errors for Monte
-    /// Carlo, the error estimate itself for quadrature (per channel).
-    pub fn allowance(&self, sigmas: f64) -> Rgb {
-        match self.method {
-            Method::MonteCarlo { .. } => self.std_error * sigmas,
-            Method::Quadrature { .. } => self.std_error,
-        }
-    }
-
-    /// The largest channel: `(value, its std_error, channel index)`.
-    pub fn max_channel(&self) -> (f64, f64, usize) {
-        let v = self.value.to_array();
-        let e = self.std_error.to_array();
-        let mut c = 0;
-        for i in 1..3 {
-            if v[i] > v[c] {
-                c = i;
-            }
-        }
-        (v[c], e[c], c)
-    }
-
-    /// Mean of replica means, and their standard error.
-    fn from_replicas(means: &[Rgb], samples: usize, rejected: usize, exact: Rgb) -> Self {
-        let k = means.len().max(1) as f64;
-        let mean = means.iter().copied().sum::<Rgb>() / k;
-        let var = if means.len() > 1 {
-            means.iter().map(|&m| (m - mean) * (m - mean)).sum::<Rgb>() / (k - 1.0)
-        } else {
-            Rgb::ZERO
-        };
-        Estimate {
-            value: mean + exact,
-            std_error: (var / k).map(f64::sqrt),
-            samples,
-            rejected,
-            method: Method::MonteCarlo {
-                replicas: means.len(),
-            },
-        }
+/// Mean of replica means, and their standard error.
+fn from_replicas(means: &[Rgb], samples: usize, rejected: usize, exact: Rgb) -> Estimate {
+    let k = means.len().max(1) as f64;
+    let mean = means.iter().copied().sum::<Rgb>() / k;
+    let var = if means.len() > 1 {
+        means.iter().map(|&m| (m - mean) * (m - mean)).sum::<Rgb>() / (k - 1.0)
+    } else {
+        Rgb::ZERO
+    };
+    Estimate {
+        value: mean + exact,
+        std_error: (var / k).map(f64::sqrt),
+        samples,
+        rejected,
+        method: Method::MonteCarlo {
+            replicas: means.len(),
+        },
     }
 }
 
@@ -267,7 +201,7 @@ pub fn rho_hd_dir(brdf: &dyn Brdf, wi: DVec3, samples: usize, seed: u64) -> Esti
         means.push(m);
         rejected += bad;
     }
-    Estimate::from_replicas(&means, 2 * n * REPLICAS, rejected, delta_weight(brdf, wi))
+    from_replicas(&means, 2 * n * REPLICAS, rejected, delta_weight(brdf, wi))
 }
 
 /// ρhd for light from polar angle `theta_i` and azimuth `phi_i` (radians).
@@ -422,7 +356,7 @@ pub fn rho_hh(brdf: &dyn Brdf, samples: usize, seed: u64) -> Estimate {
         .collect();
     let means: Vec<Rgb> = results.iter().map(|r| r.0).collect();
     let rejected = results.iter().map(|r| r.1).sum();
-    Estimate::from_replicas(&means, 2 * n * REPLICAS, rejected, Rgb::ZERO)
+    from_replicas(&means, 2 * n * REPLICAS, rejected, Rgb::ZERO)
 }
 
 #[cfg(test)]

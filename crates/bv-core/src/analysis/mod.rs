@@ -12,6 +12,7 @@
 pub mod albedo;
 pub mod chi2;
 pub mod directions;
+pub mod estimate;
 pub mod gauss_kronrod;
 pub mod isotropy;
 pub mod ndf;

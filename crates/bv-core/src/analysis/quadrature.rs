@@ -33,7 +33,7 @@
 //! error. Transmitting models add the lower hemisphere in `(cos θo, φo)`.
 //! Delta lobes add their exact weights.
 
-use super::albedo::{Estimate, Method};
+use super::estimate::{Estimate, Method};
 use super::gauss_kronrod::{self, Segment};
 use crate::{Brdf, Rgb, frame};
 use glam::DVec3;
