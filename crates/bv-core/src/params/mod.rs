@@ -16,7 +16,7 @@ pub use gpu::{
     COMPONENT_ENTRY_SLOTS, DerivedSlots, GpuLayout, GpuModelRef, GpuParam, GpuSlot, MAX_SLOTS,
     gpu_layout, gpu_model_index, pack_model, pack_model_with,
 };
-pub use spec::{cli_text_to_json, parse_value};
+pub use spec::{check_value, cli_text_to_json, parse_value};
 pub use value::{Component, ModelSpec, ParamValue, Params};
 
 /// How deeply `mix` components may nest (a mix of mixes of …), so that a hostile

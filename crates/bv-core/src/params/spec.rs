@@ -93,9 +93,151 @@ impl ModelSpec {
         self.set_json(id, &value)
     }
 
-    /// Sets one already-typed value after validating it (what the GUI calls).
+    /// Sets one already-typed value after validating it against the
+    /// declaration (what the GUI calls), without a trip through JSON. An
+    /// alias sets every parameter it stands for. A refused value leaves the
+    /// spec as it was.
     pub fn set(&mut self, id: &str, value: ParamValue) -> Result<()> {
-        self.set_json(id, &value.to_json())
+        let info = self.model();
+        let targets: Vec<&'static ParamDecl> =
+            match info.alias(id).filter(|_| info.param(id).is_err()) {
+                Some(alias) => alias
+                    .sets
+                    .iter()
+                    .map(|t| info.param(t))
+                    .collect::<Result<_>>()?,
+                None => vec![info.param(id)?],
+            };
+        let mut checked = Vec::with_capacity(targets.len());
+        for d in targets {
+            let v = check_value(d, value.clone(), 0).map_err(|e| rename(e, id))?;
+            checked.push((d.id, v));
+        }
+        for (k, v) in checked {
+            self.params_mut().insert(k.to_string(), v);
+        }
+        Ok(())
+    }
+}
+
+/// Levels of mixes inside a spec (0 for a model that is not a mix), counted
+/// without recursion.
+fn mix_depth(spec: &ModelSpec) -> usize {
+    let mut deepest = 0;
+    let mut stack = vec![(spec, 0usize)];
+    while let Some((s, depth)) = stack.pop() {
+        for (_, v) in s.params().iter() {
+            if let ParamValue::Components(cs) = v {
+                deepest = deepest.max(depth + 1);
+                if depth + 1 > MAX_NESTING {
+                    return depth + 1;
+                }
+                stack.extend(cs.iter().map(|c| (&c.spec, depth + 1)));
+            }
+        }
+    }
+    deepest
+}
+
+/// Validates a typed value against its declaration (the typed twin of
+/// [`parse_value`]) and returns it in canonical form (a grey number for a
+/// colour becomes `[x, x, x]`; a list item's missing fields get their
+/// defaults). `depth` counts the mixes around the value.
+pub fn check_value(decl: &ParamDecl, v: ParamValue, depth: usize) -> Result<ParamValue> {
+    let id = decl.id;
+    let bad = |reason: String| BvError::BadValue {
+        param: id.to_string(),
+        reason,
+    };
+    match (decl.kind, v) {
+        (ParamKind::Float(s), ParamValue::Float(x)) => {
+            Ok(ParamValue::Float(check_range(id, x, s.min, s.max)?))
+        }
+        (ParamKind::Color(s), ParamValue::Float(x)) => {
+            check_range(id, x, s.min, s.max)?;
+            Ok(ParamValue::Color([x; 3]))
+        }
+        (ParamKind::Color(s), ParamValue::Color(c)) => {
+            for x in c {
+                check_range(id, x, s.min, s.max)?;
+            }
+            Ok(ParamValue::Color(c))
+        }
+        (ParamKind::Choice { options, .. }, ParamValue::Text(t)) => {
+            if options.contains(&t.as_str()) {
+                Ok(ParamValue::Text(t))
+            } else {
+                Err(bad(format!("`{t}` is not one of {}", options.join(", "))))
+            }
+        }
+        (ParamKind::Bool { .. }, ParamValue::Bool(b)) => Ok(ParamValue::Bool(b)),
+        (ParamKind::Path { .. }, ParamValue::Text(t)) => Ok(ParamValue::Text(t)),
+        (
+            ParamKind::List {
+                fields,
+                min_items,
+                max_items,
+                ..
+            },
+            ParamValue::List(items),
+        ) => {
+            if items.len() < min_items || items.len() > max_items {
+                return Err(bad(format!(
+                    "has {} items; between {min_items} and {max_items} are accepted",
+                    items.len()
+                )));
+            }
+            let mut out = Vec::with_capacity(items.len());
+            for (i, item) in items.into_iter().enumerate() {
+                if let Some((k, _)) = item
+                    .iter()
+                    .find(|(k, _)| !fields.iter().any(|f| f.id == *k))
+                {
+                    return Err(bad(format!(
+                        "item {i} has unknown field `{k}` (fields: {})",
+                        fields.iter().map(|f| f.id).collect::<Vec<_>>().join(", ")
+                    )));
+                }
+                let mut p = Params::defaults(fields);
+                for f in fields {
+                    if let Ok(x) = item.get(f.id) {
+                        let x = check_value(f, x.clone(), depth)
+                            .map_err(|e| rename(e, &format!("{id}[{i}].{}", f.id)))?;
+                        p.insert(f.id.to_string(), x);
+                    }
+                }
+                out.push(p);
+            }
+            Ok(ParamValue::List(out))
+        }
+        (
+            ParamKind::Components {
+                max_items, weight, ..
+            },
+            ParamValue::Components(cs),
+        ) => {
+            if cs.is_empty() || cs.len() > max_items {
+                return Err(bad(format!(
+                    "has {} components; between 1 and {max_items} are accepted",
+                    cs.len()
+                )));
+            }
+            for (i, c) in cs.iter().enumerate() {
+                let key = format!("{id}[{i}].weight");
+                check_range(&key, c.weight, weight.min, weight.max)?;
+                // Components are specs, validated when they were made; only
+                // the nesting is left to bound.
+                if depth + 1 + mix_depth(&c.spec) > MAX_NESTING {
+                    return Err(bad(format!("mixes nest deeper than {MAX_NESTING} levels")));
+                }
+            }
+            Ok(ParamValue::Components(cs))
+        }
+        (_, other) => Err(bad(format!(
+            "expected {}, found {}",
+            decl.range_text(),
+            other.to_json()
+        ))),
     }
 }
 
@@ -358,6 +500,81 @@ mod tests {
             ParamValue::Color([0.25; 3])
         );
         assert!(parse_value(&DECLS[1], &json!([0.1, 2.0, 0.3]), 0).is_err());
+    }
+
+    #[test]
+    fn typed_set_agrees_with_the_json_parser() {
+        // The same values through `set` (typed) and `set_json` (parsed):
+        // accepted or refused alike, and equal when accepted.
+        let cases: Vec<(&str, &str, ParamValue)> = vec![
+            ("cook-torrance", "alpha_x", ParamValue::Float(0.3)),
+            ("cook-torrance", "alpha_x", ParamValue::Float(-1.0)),
+            ("cook-torrance", "alpha_x", ParamValue::Float(f64::NAN)),
+            ("cook-torrance", "alpha", ParamValue::Float(0.2)),
+            ("cook-torrance", "kd", ParamValue::Float(0.5)),
+            ("cook-torrance", "kd", ParamValue::Color([0.1, 0.2, 0.3])),
+            ("cook-torrance", "kd", ParamValue::Color([0.1, 2.0, 0.3])),
+            (
+                "cook-torrance",
+                "distribution",
+                ParamValue::Text("ggx".into()),
+            ),
+            (
+                "cook-torrance",
+                "distribution",
+                ParamValue::Text("gauss".into()),
+            ),
+            ("cook-torrance", "ks", ParamValue::Text("ggx".into())),
+            ("lafortune", "lobes", ParamValue::List(vec![])),
+            ("mix", "components", ParamValue::Components(vec![])),
+        ];
+        for (model, id, v) in cases {
+            let mut a = ModelSpec::new(model).unwrap();
+            let mut b = a.clone();
+            let ra = a.set(id, v.clone());
+            let rb = b.set_json(id, &v.to_json());
+            assert_eq!(
+                ra.is_ok(),
+                rb.is_ok(),
+                "{model}.{id} = {v:?}: {ra:?} vs {rb:?}"
+            );
+            assert_eq!(a, b, "{model}.{id} = {v:?}");
+        }
+        // A list item gets its missing fields' defaults, as the parser does.
+        let mut a = ModelSpec::new("lafortune").unwrap();
+        let mut b = a.clone();
+        let item = serde_json::json!([{"n": 5.0}]);
+        b.set_json("lobes", &item).unwrap();
+        let ParamValue::List(items) = b.params().get("lobes").unwrap().clone() else {
+            panic!("lobes is a list");
+        };
+        a.set("lobes", ParamValue::List(items)).unwrap();
+        assert_eq!(a, b);
+        // A nest deeper than allowed is refused by the typed setter too.
+        let mut deep = ModelSpec::new("lambert").unwrap();
+        for _ in 0..MAX_NESTING {
+            let mut m = ModelSpec::new("mix").unwrap();
+            m.set(
+                "components",
+                ParamValue::Components(vec![Component {
+                    weight: 1.0,
+                    spec: deep.clone(),
+                }]),
+            )
+            .unwrap();
+            deep = m;
+        }
+        let mut top = ModelSpec::new("mix").unwrap();
+        let err = top
+            .set(
+                "components",
+                ParamValue::Components(vec![Component {
+                    weight: 1.0,
+                    spec: deep,
+                }]),
+            )
+            .unwrap_err();
+        assert!(err.to_string().contains("nest deeper"), "{err}");
     }
 
     #[test]
