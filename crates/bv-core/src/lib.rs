@@ -31,6 +31,7 @@ pub mod represent;
 pub mod rotated;
 pub mod sampling;
 pub mod text;
+pub mod user;
 
 pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, MicrofacetTerms, Ndf};
 pub use error::{BvError, Result};
