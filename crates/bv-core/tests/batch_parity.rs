@@ -140,6 +140,7 @@ const WITH_KERNEL: &[&str] = &[
     "modified-phong",
     "ward",
     "oren-nayar",
+    "ashikhmin-shirley",
 ];
 
 #[test]

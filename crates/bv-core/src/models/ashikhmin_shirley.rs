@@ -3,6 +3,7 @@
 //! value and eqs. 9–10 for importance sampling. bv fixes the seed's typos
 //! (`cos²φ` written twice in D, the missing `/2` in the diffuse term).
 
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::frame::half_vector;
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
@@ -69,18 +70,78 @@ pub struct AshikhminShirley {
     norm: f64,
     /// `28 rd (1 − rs) / (23π)`, the diffuse term's constant (eq. 5).
     diffuse_scale: Rgb,
+    kernel: AsLanes,
+}
+
+/// [`AshikhminShirley`]'s f32 batch kernel: eq. 4 and 5 as in `eval`, with
+/// the half vector's `1 − h·n` taken from `v = wi + wo` as
+/// `(vx² + vy²)/(|v| (|v| + vz))` (exact algebra) so that exponents up to
+/// 10⁴ stay accurate, and `E(h)` from `v` directly (it is scale-free).
+#[derive(Debug, Clone, Copy)]
+struct AsLanes {
+    rs: [f32; 3],
+    diffuse_scale: [f32; 3],
+    nu: f32,
+    nv: f32,
+    /// `√((nu+1)(nv+1)) / (8π)`.
+    spec_scale: f32,
+}
+
+impl LaneKernel for AsLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let (x2, y2) = (v[0] * v[0], v[1] * v[1]);
+        let t2 = x2 + y2;
+        let l = (t2 + v[2] * v[2]).sqrt();
+        let hz = v[2] / l;
+        let one_minus = t2 / (l * (l + v[2]));
+        let e = if t2 > 0.0 {
+            (self.nu * x2 + self.nv * y2) / t2
+        } else {
+            0.5 * (self.nu + self.nv)
+        };
+        let lobe = math::pow_1m(hz, one_minus, e);
+        let c = (0.5 * l).min(1.0);
+        let spec = self.spec_scale * lobe / (c * wi[2].max(wo[2]));
+        // Schlick's (1 − c)⁵ and the diffuse factors 1 − (1 − cos/2)⁵.
+        let p5 = |x: f32| {
+            let x2 = x * x;
+            x2 * x2 * x
+        };
+        let fw = p5(1.0 - c);
+        let d = (1.0 - p5(1.0 - 0.5 * wi[2])) * (1.0 - p5(1.0 - 0.5 * wo[2]));
+        let above = wi[2] > 0.0 && wo[2] > 0.0 && l > 0.0;
+        std::array::from_fn(|k| {
+            let f = self.rs[k] + (1.0 - self.rs[k]) * fw;
+            if above {
+                self.diffuse_scale[k] * d + f * spec
+            } else {
+                0.0
+            }
+        })
+    }
 }
 
 impl AshikhminShirley {
     /// A model with the given reflectances and exponents (`nu`, `nv` ≥ 0).
     pub fn new(rd: Rgb, rs: Rgb, nu: f64, nv: f64) -> Self {
+        let norm = ((nu + 1.0) * (nv + 1.0)).sqrt();
+        let diffuse_scale = rd * (Rgb::ONE - rs) * (28.0 / (23.0 * PI));
         Self {
             rd,
             rs,
             nu,
             nv,
-            norm: ((nu + 1.0) * (nv + 1.0)).sqrt(),
-            diffuse_scale: rd * (Rgb::ONE - rs) * (28.0 / (23.0 * PI)),
+            norm,
+            diffuse_scale,
+            kernel: AsLanes {
+                rs: math::rgb(rs),
+                diffuse_scale: math::rgb(diffuse_scale),
+                nu: nu as f32,
+                nv: nv as f32,
+                spec_scale: (norm / (8.0 * PI)) as f32,
+            },
         }
     }
 
@@ -180,6 +241,10 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 impl Brdf for AshikhminShirley {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn fresnel_term(&self) -> Option<FresnelTerm> {
