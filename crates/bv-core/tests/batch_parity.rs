@@ -141,6 +141,7 @@ const WITH_KERNEL: &[&str] = &[
     "ward",
     "oren-nayar",
     "ashikhmin-shirley",
+    "banks",
 ];
 
 #[test]
