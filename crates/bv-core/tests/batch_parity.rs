@@ -23,8 +23,9 @@ const REL: f64 = 1e-4;
 const ABS: f64 = 1e-6;
 const SETS: u64 = 48;
 
-/// Random values for the declared floats, colours, choices and flags; `None`
-/// for a model with lists, components or files (none of those has a kernel).
+/// Random values for the declared floats, colours, choices, flags and lists
+/// (1 to 3 items of random fields); `None` for a model with components or
+/// files (neither has a kernel).
 fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Option<Params> {
     let mut p = Params::default();
     for d in decls {
@@ -46,6 +47,18 @@ fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Option<Params> {
                 ParamValue::Text(options[rng.random_range(0..options.len())].to_string())
             }
             ParamKind::Bool { .. } => ParamValue::Bool(rng.random()),
+            ParamKind::List {
+                fields,
+                min_items,
+                max_items,
+                ..
+            } => {
+                let n = rng.random_range(min_items.max(1)..=max_items.min(3).max(min_items.max(1)));
+                let items = (0..n)
+                    .map(|_| random_params(fields, rng))
+                    .collect::<Option<Vec<_>>>()?;
+                ParamValue::List(items)
+            }
             _ => return None,
         };
         p.set_unvalidated(d.id, v);
@@ -142,6 +155,7 @@ const WITH_KERNEL: &[&str] = &[
     "oren-nayar",
     "ashikhmin-shirley",
     "banks",
+    "lafortune",
 ];
 
 #[test]

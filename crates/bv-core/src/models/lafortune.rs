@@ -16,6 +16,7 @@
 //! overflow for any exponent up to 10000 (`2^10000` would).
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -134,6 +135,60 @@ impl Lobe {
 pub struct Lafortune {
     kd: Rgb,
     lobes: Vec<Lobe>,
+    kernel: LafortuneLanes,
+}
+
+/// [`Lafortune`]'s f32 batch kernel: `kd/π + Σ ks norm clamped_pow(C wi · wo,
+/// n)` over a fixed [`MAX_LOBES`] slots (unused ones have `ks = 0`), so the
+/// lobe loop has a constant trip count and the lane loop vectorises. Each
+/// base is formed in f64 and its power taken from `1 − base`
+/// ([`math::pow_1m`]), which keeps large exponents accurate near the peak.
+#[derive(Debug, Clone, Copy)]
+struct LafortuneLanes {
+    diffuse: [f32; 3],
+    c: [[f64; 3]; MAX_LOBES],
+    n: [f32; MAX_LOBES],
+    /// `ks · norm` per lobe and channel.
+    scale: [[f32; 3]; MAX_LOBES],
+}
+
+impl LafortuneLanes {
+    fn new(kd: Rgb, lobes: &[Lobe]) -> Self {
+        let mut k = Self {
+            diffuse: math::rgb(kd * FRAC_1_PI),
+            c: [[0.0; 3]; MAX_LOBES],
+            n: [0.0; MAX_LOBES],
+            scale: [[0.0; 3]; MAX_LOBES],
+        };
+        for (j, l) in lobes.iter().take(MAX_LOBES).enumerate() {
+            k.c[j] = l.c.to_array();
+            k.n[j] = l.n as f32;
+            k.scale[j] = math::rgb(l.ks * l.norm);
+        }
+        k
+    }
+}
+
+impl LaneKernel for LafortuneLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let p = [
+            f64::from(wi[0]) * f64::from(wo[0]),
+            f64::from(wi[1]) * f64::from(wo[1]),
+            f64::from(wi[2]) * f64::from(wo[2]),
+        ];
+        let mut f = self.diffuse;
+        for j in 0..MAX_LOBES {
+            let c = self.c[j];
+            let x = c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
+            let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.n[j]);
+            for (k, fk) in f.iter_mut().enumerate() {
+                *fk += self.scale[j][k] * lobe;
+            }
+        }
+        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        f.map(|v| if above { v } else { 0.0 })
+    }
 }
 
 fn build(p: &Params) -> Result<Box<dyn Brdf>> {
@@ -150,8 +205,10 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let kd = p.color("kd")?;
     Ok(Box::new(Lafortune {
-        kd: p.color("kd")?,
+        kd,
+        kernel: LafortuneLanes::new(kd, &lobes),
         lobes,
     }))
 }
@@ -187,6 +244,10 @@ impl Lafortune {
 impl Brdf for Lafortune {
     fn id(&self) -> &'static str {
         INFO.id
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
