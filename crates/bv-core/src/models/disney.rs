@@ -4,13 +4,14 @@
 //! `Cdlum = 0.3R + 0.6G + 0.1B`, specular G = separable Smith GGX with (αx, αy).
 
 use crate::fresnel::schlick_weight;
-use crate::microfacet::{self, Distribution, Microfacet};
+use crate::microfacet::{self, Distribution, Geometry, Microfacet};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
-use crate::{Brdf, Claims, FresnelTerm, Ndf, Result, Rgb, mean_rgb, sampling};
+use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
+use std::sync::Arc;
 
 const fn unit(id: &'static str, label: &'static str, doc: &'static str, default: f64) -> ParamDecl {
     ParamDecl {
@@ -255,6 +256,20 @@ impl Brdf for Disney {
         INFO.id
     }
 
+    /// The specular lobe's terms: GTR2 (= GGX) D with Burley's anisotropic
+    /// αx, αy, and separable Smith GGX G (the clearcoat's GTR1 lobe is a
+    /// second, fixed-roughness lobe and is not part of these terms).
+    fn microfacet_terms(&self) -> Option<MicrofacetTerms> {
+        let ndf = self.spec.0;
+        Some(MicrofacetTerms {
+            distribution: "GTR2 (GGX)".to_string(),
+            geometry: "separable Smith".to_string(),
+            d: Arc::new(move |h| ndf.d(h)),
+            g1: Arc::new(move |w| if w.z > 0.0 { ndf.g1(w) } else { 0.0 }),
+            g2: Arc::new(move |wi, wo, h| ndf.g(Geometry::Smith, wi, wo, h)),
+        })
+    }
+
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         Some(FresnelTerm {
             fresnel: crate::fresnel::Fresnel::Schlick { f0: self.cspec0 },
@@ -371,6 +386,27 @@ impl Brdf for Disney {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn specular_terms_are_gtr2_and_separable_smith() {
+        // roughness 0.5, isotropic: α = r² = 0.25; GTR2 at the normal is
+        // 1/(π α²) (Burley 2012, eq. 8 with γ = 2).
+        let b = crate::ModelSpec::from_json(
+            "disney",
+            &serde_json::json!({"roughness": 0.5, "anisotropic": 0.0}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let t = b.microfacet_terms().unwrap();
+        let a: f64 = 0.25;
+        assert!(((t.d)(DVec3::Z) - 1.0 / (PI * a * a)).abs() < 1e-9 * (t.d)(DVec3::Z));
+        let wi = crate::frame::from_spherical(0.6, 0.0);
+        let wo = crate::frame::from_spherical(0.3, 2.0);
+        let h = (wi + wo).normalize();
+        let g2 = (t.g2)(wi, wo, h);
+        assert!((g2 - (t.g1)(wi) * (t.g1)(wo)).abs() < 1e-15, "separable");
+    }
     use crate::ModelSpec;
     use crate::frame::from_spherical;
     use crate::microfacet::tests::hemisphere_integral;

@@ -348,8 +348,8 @@ fn parse_params(section: &Section, out: &mut Vec<FileParam>) -> Result<()> {
             "bool" => {
                 let v = want(1, "0 or 1")?;
                 let default = match v[0] {
-                    x if x == 0.0 => false,
-                    x if x == 1.0 => true,
+                    0.0 => false,
+                    1.0 => true,
                     x => {
                         return Err(at(
                             line,
