@@ -156,6 +156,8 @@ const WITH_KERNEL: &[&str] = &[
     "ashikhmin-shirley",
     "banks",
     "lafortune",
+    "mirror",
+    "glass",
 ];
 
 #[test]
@@ -191,6 +193,29 @@ fn every_kernel_matches_the_scalar_reference() {
     }
     eprintln!("kernels checked: {}", checked.join(", "));
     assert!(checked.len() > WITH_KERNEL.len(), "{checked:?}");
+}
+
+#[test]
+fn mixes_sum_their_parts_batches() {
+    let dirs = pairs(8);
+    for components in [
+        // The default: Lambert + GGX Cook-Torrance, both with kernels.
+        serde_json::Value::Null,
+        // With a part that has no kernel (its scalar fallback runs inside).
+        serde_json::json!({"components": [
+            {"weight": 0.3, "model": "hapke"},
+            {"weight": 0.5, "model": "ward", "params": {"alpha_x": 0.05, "alpha_y": 0.4}},
+            {"weight": 0.2, "model": "mix", "params": {"components": [
+                {"weight": 1.0, "model": "blinn-phong", "params": {"e": 5000.0}}]}}
+        ]}),
+    ] {
+        let spec = ModelSpec::from_json("mix", &components).unwrap();
+        let b = spec.build().unwrap();
+        assert!(b.batch_kernel().is_some(), "{}", spec.to_json());
+        if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
+            panic!("{}: {e}", spec.to_json());
+        }
+    }
 }
 
 #[test]

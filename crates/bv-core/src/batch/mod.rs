@@ -155,6 +155,18 @@ impl<K: LaneKernel> Kernel for K {
     }
 }
 
+/// The kernel of a delta model (mirror, glass): `f = 0` at every finite pair
+/// (all of its energy is in its delta lobes, which no pair hits).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Zero;
+
+impl LaneKernel for Zero {
+    #[inline(always)]
+    fn lane(&self, _wi: math::V3, _wo: math::V3) -> [f32; 3] {
+        [0.0; 3]
+    }
+}
+
 /// Runs `k` over every lane, compiled for the best instruction set this CPU
 /// has (see the module doc).
 #[inline]

@@ -58,6 +58,10 @@ impl Brdf for Glass {
         INFO.id
     }
 
+    fn batch_kernel(&self) -> Option<&dyn crate::batch::Kernel> {
+        Some(&crate::batch::Zero)
+    }
+
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         Some(FresnelTerm {
             fresnel: crate::fresnel::Fresnel::Dielectric {

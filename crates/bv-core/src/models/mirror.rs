@@ -63,6 +63,10 @@ impl Brdf for Mirror {
         INFO.id
     }
 
+    fn batch_kernel(&self) -> Option<&dyn crate::batch::Kernel> {
+        Some(&crate::batch::Zero)
+    }
+
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         Some(FresnelTerm {
             fresnel: self.fresnel,

@@ -82,6 +82,33 @@ struct Part {
     brdf: Box<dyn Brdf>,
 }
 
+/// A mix's batch kernel is the weighted sum of its parts' batches (each
+/// through its own kernel, or its scalar fallback), accumulated in f32.
+impl crate::batch::Kernel for Mix {
+    fn eval(&self, dirs: &crate::batch::Dirs<'_>, out: &mut crate::batch::Out<'_>) {
+        let n = dirs.len().min(out.len());
+        for ch in out.rgb.iter_mut() {
+            ch[..n].fill(0.0);
+        }
+        let mut part = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
+        for p in &self.parts {
+            {
+                let [r, g, b] = &mut part;
+                let mut tmp = crate::batch::Out {
+                    rgb: [r.as_mut_slice(), g.as_mut_slice(), b.as_mut_slice()],
+                };
+                crate::batch::eval(p.brdf.as_ref(), dirs, &mut tmp);
+            }
+            let w = p.weight as f32;
+            for (dst, src) in out.rgb.iter_mut().zip(&part) {
+                for (d, s) in dst[..n].iter_mut().zip(src) {
+                    *d += w * s;
+                }
+            }
+        }
+    }
+}
+
 /// A weighted sum of models.
 #[derive(Debug)]
 pub struct Mix {
@@ -195,6 +222,15 @@ impl Brdf for Mix {
         self.parts
             .iter()
             .fold(Rgb::ZERO, |acc, p| acc + p.weight * p.brdf.eval(wi, wo))
+    }
+
+    /// The sum of the parts' batches, when at least one part has a kernel
+    /// (otherwise the whole-mix scalar fallback is as fast).
+    fn batch_kernel(&self) -> Option<&dyn crate::batch::Kernel> {
+        self.parts
+            .iter()
+            .any(|p| p.brdf.batch_kernel().is_some())
+            .then_some(self as &dyn crate::batch::Kernel)
     }
 
     fn claims(&self) -> Claims {
