@@ -15,11 +15,14 @@ use crate::views::REGISTRY;
 use eframe::egui::{self, Color32, RichText, Ui};
 use std::path::PathBuf;
 
-/// Title size in points (before the presentation scale: 52 pixels at
-/// 1080p).
-pub const TITLE_PT: f32 = 26.0;
+/// Title size in points (50 pixels at 1080p, with the presentation scale).
+pub const TITLE_PT: f32 = 18.0;
 /// Caption size in points (32 pixels at 1080p).
-pub const CAPTION_PT: f32 = 16.0;
+pub const CAPTION_PT: f32 = 11.5;
+/// Text size of the strip of views in points (26 pixels at 1080p): the
+/// presenter's controls, smaller than the slide's text so that they fit one
+/// line.
+pub const STRIP_PT: f32 = 9.5;
 
 /// The open deck and where in it the viewer is.
 #[derive(Debug, Clone)]
@@ -70,15 +73,28 @@ pub fn visuals(theme: Theme, presenting: bool) -> egui::Visuals {
         Theme::Light => egui::Visuals::light(),
     };
     if presenting {
-        let (ground, ink, line) = match theme {
-            Theme::Dark => (Color32::BLACK, Color32::WHITE, Color32::from_gray(170)),
-            Theme::Light => (Color32::WHITE, Color32::BLACK, Color32::from_gray(60)),
+        let (ground, ink, weak, line) = match theme {
+            Theme::Dark => (
+                Color32::BLACK,
+                Color32::WHITE,
+                Color32::from_gray(200),
+                Color32::from_gray(170),
+            ),
+            Theme::Light => (
+                Color32::WHITE,
+                Color32::BLACK,
+                Color32::from_gray(50),
+                Color32::from_gray(60),
+            ),
         };
         v.panel_fill = ground;
         v.window_fill = ground;
         v.extreme_bg_color = ground;
         v.faint_bg_color = ground;
         v.override_text_color = Some(ink);
+        // Weak text (notes, units) a little lighter than the text, not
+        // faded into the ground.
+        v.weak_text_color = Some(weak);
         v.widgets.noninteractive.bg_stroke = egui::Stroke::new(1.0, line);
         v.widgets.noninteractive.fg_stroke = egui::Stroke::new(1.0, ink);
     }
@@ -122,22 +138,23 @@ pub fn bottom_strip(ui: &mut Ui, shown: &str, deck: bool, controls: bool) -> Vec
         .frame(frame)
         .resizable(false)
         .show(ui, |ui| {
-            ui.horizontal_wrapped(|ui| {
+            ui.horizontal(|ui| {
+                let t = |s: &str| RichText::new(s).size(STRIP_PT);
                 let (back, forward) = if deck {
                     ("Previous scene", "Next scene")
                 } else {
                     ("Previous view", "Next view")
                 };
-                if ui.button("⏴").on_hover_text(back).clicked() {
+                if ui.button(t("«")).on_hover_text(back).clicked() {
                     out.push(StripAction::Step(-1));
                 }
-                if ui.button("⏵").on_hover_text(forward).clicked() {
+                if ui.button(t("»")).on_hover_text(forward).clicked() {
                     out.push(StripAction::Step(1));
                 }
                 ui.separator();
                 for e in REGISTRY.iter() {
                     if ui
-                        .selectable_label(e.id == shown, short_name(e.id))
+                        .selectable_label(e.id == shown, t(&short_name(e.id)))
                         .on_hover_text(e.title)
                         .clicked()
                     {
@@ -151,14 +168,14 @@ pub fn bottom_strip(ui: &mut Ui, shown: &str, deck: bool, controls: bool) -> Vec
                     "controls"
                 };
                 if ui
-                    .selectable_label(controls, label)
+                    .selectable_label(controls, t(label))
                     .on_hover_text("Show the BRDFs and parameters to edit the scene live")
                     .clicked()
                 {
                     out.push(StripAction::ToggleControls);
                 }
                 if ui
-                    .button("exit")
+                    .button(t("exit"))
                     .on_hover_text("Leave presentation mode (F5 or Esc)")
                     .clicked()
                 {

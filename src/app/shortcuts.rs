@@ -236,14 +236,22 @@ impl Shortcut {
 }
 
 /// One key combination as the help shows it: egui's modifier names
-/// ("Ctrl+", "Cmd+") and the key's symbol ("?", "1") where it has one.
+/// ("Ctrl+", "Cmd+") and the key's symbol ("?", "1") where it has one
+/// that the default fonts can draw.
 fn key_text(ctx: &egui::Context, k: &KeyboardShortcut) -> String {
     let names = egui::ModifierNames::NAMES;
     let mut s = names.format(&k.modifiers, ctx.os().is_mac());
     if !s.is_empty() {
         s += names.concat;
     }
-    s + k.logical_key.symbol_or_name()
+    // egui's arrow symbols (⏴ ⏵) are in none of its default fonts: the
+    // arrows go by name.
+    let key = k.logical_key;
+    let text = match key {
+        Key::ArrowLeft | Key::ArrowRight | Key::ArrowUp | Key::ArrowDown => key.name(),
+        _ => key.symbol_or_name(),
+    };
+    s + text
 }
 
 /// Whether no widget has the keyboard: shortcuts are for the window only
@@ -328,7 +336,7 @@ mod tests {
         assert_eq!(text(Action::ToggleHelp), "F1 or ?");
         assert_eq!(text(Action::ResetCamera), "R");
         assert_eq!(text(Action::TogglePresentation), "F5");
-        assert_eq!(text(Action::NextSlide), "⏵");
+        assert_eq!(text(Action::NextSlide), "Right");
         if !ctx.os().is_mac() {
             assert_eq!(text(Action::ExportFigure), "Ctrl+Shift+S");
             assert_eq!(text(Action::SaveScene), "Ctrl+S");
