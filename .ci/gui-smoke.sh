@@ -98,6 +98,31 @@ timeout 180 xvfb-run -a -s "-screen 0 $screen" sh -c "
 " || true
 check_png "$out/xroot.png" "X root window"
 
+# 3. The lecture deck as slides at projector size (about 30 s on lavapipe):
+# one PNG per scene, each 1920x1080 and not blank.
+rm -rf "$out/deck"
+scenes="$(grep -c '^\[\[scene\]\]' assets/decks/reflectance.toml)"
+if ! timeout 300 "$bv" render --deck assets/decks/reflectance.toml --out "$out/deck/" \
+    >"$out/deck.log" 2>&1; then
+    echo "gui-smoke: FAIL: bv render --deck exited with an error:" >&2
+    cat "$out/deck.log" >&2
+    fail=1
+fi
+pngs=("$out"/deck/*.png)
+if (( ${#pngs[@]} != scenes )); then
+    echo "gui-smoke: FAIL: bv render --deck wrote ${#pngs[@]} PNGs for $scenes scenes" >&2
+    fail=1
+fi
+for png in "${pngs[@]}"; do
+    [[ -e "$png" ]] || continue
+    read -r w h colours <<<"$(/usr/bin/convert "$png" -format '%w %h %k' info:)"
+    if [[ "$w" != 1920 || "$h" != 1080 ]] || (( colours < 100 )); then
+        echo "gui-smoke: FAIL: $png is ${w}x${h} with $colours colours" >&2
+        fail=1
+    fi
+done
+echo "gui-smoke: deck: ${#pngs[@]} slides for $scenes scenes"
+
 if (( fail )); then
     echo "gui-smoke: FAILED (images in $out)" >&2
     exit 1

@@ -11,6 +11,7 @@
 
 pub mod measured_ui;
 pub mod panel;
+pub mod presentation;
 pub mod screenshot;
 pub mod shortcuts;
 pub mod viewer;
@@ -22,6 +23,7 @@ pub use viewer::Viewer;
 pub const SHELL: crate::cli::Shell = crate::cli::Shell {
     run_viewer: run,
     window: viewer::figure_window,
+    slide: viewer::slide_window,
 };
 
 use crate::cli::viewer_args::{ViewerArgs, parse_size};
@@ -85,6 +87,13 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         // Refuse a bad scene before a window opens.
         scene::load(path).with_context(|| format!("opening {}", path.display()))?;
     }
+    if let Some(path) = &args.deck {
+        let loaded = crate::session::deck::load(path, scene::Builds::Warn)
+            .with_context(|| format!("opening the deck {}", path.display()))?;
+        for w in &loaded.warnings {
+            crate::cli::output::eprint(&format!("bv: {}: {w}\n", path.display()));
+        }
+    }
     let size = match &args.size {
         Some(s) => parse_size(s)?,
         None => [1280.0, 800.0],
@@ -92,7 +101,8 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
     let scripted = args.bench_frames.is_some() || args.screenshot.is_some();
     // Scripted runs (benchmark, screenshot) start from the saved session unless
     // `--fresh`, but never overwrite it.
-    let persist = !(args.fresh || scripted);
+    // A lecture's deck is not the user's session either.
+    let persist = !(args.fresh || scripted || args.deck.is_some());
     let load_saved = !args.fresh;
 
     let mut options = eframe::NativeOptions {
@@ -156,6 +166,16 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 viewer.export.set_gpu(rs.clone());
             }
             viewer.export.scene_path = args2.scene.clone();
+            if let Some(path) = &args2.deck {
+                viewer.open_deck(path).map_err(
+                    |e| -> Box<dyn std::error::Error + Send + Sync> {
+                        format!("opening the deck {}: {e}", path.display()).into()
+                    },
+                )?;
+                if args2.light {
+                    viewer.push(Command::SetTheme(state::Theme::Light));
+                }
+            }
             let mut app = BvApp {
                 viewer,
                 persist,

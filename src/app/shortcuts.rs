@@ -45,6 +45,20 @@ pub enum Action {
     ExportFigure,
     /// Quit.
     Quit,
+    /// Enter or leave presentation mode.
+    TogglePresentation,
+    /// Presenting: the next scene of the deck (or the next view).
+    NextSlide,
+    /// Presenting: the previous scene of the deck (or the previous view).
+    PreviousSlide,
+    /// Presenting: the first scene of the deck (or the first view).
+    FirstSlide,
+    /// Presenting: the last scene of the deck (or the last view).
+    LastSlide,
+    /// Zoom the whole window in, out or back to 1:1: egui itself handles
+    /// these keys before the viewer sees them; they are declared here so
+    /// that the help lists them.
+    Zoom,
 }
 
 /// One shortcut: its keys (any of them), what it does, and its help text.
@@ -143,12 +157,12 @@ pub const SHORTCUTS: &[Shortcut] = &[
     Shortcut {
         keys: &[plain(Key::PageDown)],
         action: Action::NextBrdf,
-        help: "select the next BRDF",
+        help: "select the next BRDF (presenting: the next scene or view)",
     },
     Shortcut {
         keys: &[plain(Key::PageUp)],
         action: Action::PreviousBrdf,
-        help: "select the previous BRDF",
+        help: "select the previous BRDF (presenting: the previous scene or view)",
     },
     Shortcut {
         keys: &[plain(Key::M)],
@@ -170,6 +184,40 @@ pub const SHORTCUTS: &[Shortcut] = &[
         action: Action::ToggleTheme,
         help: "switch between dark and light themes",
     },
+    Shortcut {
+        keys: &[plain(Key::F5)],
+        action: Action::TogglePresentation,
+        help: "presentation mode: one view, large text, the deck's titles",
+    },
+    Shortcut {
+        keys: &[plain(Key::ArrowRight)],
+        action: Action::NextSlide,
+        help: "presenting: the next scene of the deck (or the next view)",
+    },
+    Shortcut {
+        keys: &[plain(Key::ArrowLeft)],
+        action: Action::PreviousSlide,
+        help: "presenting: the previous scene of the deck (or view)",
+    },
+    Shortcut {
+        keys: &[plain(Key::Home)],
+        action: Action::FirstSlide,
+        help: "presenting: the first scene of the deck",
+    },
+    Shortcut {
+        keys: &[plain(Key::End)],
+        action: Action::LastSlide,
+        help: "presenting: the last scene of the deck",
+    },
+    Shortcut {
+        keys: &[
+            egui::gui_zoom::kb_shortcuts::ZOOM_IN,
+            egui::gui_zoom::kb_shortcuts::ZOOM_OUT,
+            egui::gui_zoom::kb_shortcuts::ZOOM_RESET,
+        ],
+        action: Action::Zoom,
+        help: "zoom the whole window in / out / back to 1:1",
+    },
 ];
 
 impl Shortcut {
@@ -181,20 +229,29 @@ impl Shortcut {
             Action::MaximiseView(_) if names.len() > 2 => {
                 format!("{} … {}", names[0], names[names.len() - 1])
             }
+            Action::Zoom => names.join(" / "),
             _ => names.join(" or "),
         }
     }
 }
 
 /// One key combination as the help shows it: egui's modifier names
-/// ("Ctrl+", "Cmd+") and the key's symbol ("?", "1") where it has one.
+/// ("Ctrl+", "Cmd+") and the key's symbol ("?", "1") where it has one
+/// that the default fonts can draw.
 fn key_text(ctx: &egui::Context, k: &KeyboardShortcut) -> String {
     let names = egui::ModifierNames::NAMES;
     let mut s = names.format(&k.modifiers, ctx.os().is_mac());
     if !s.is_empty() {
         s += names.concat;
     }
-    s + k.logical_key.symbol_or_name()
+    // egui's arrow symbols (⏴ ⏵) are in none of its default fonts: the
+    // arrows go by name.
+    let key = k.logical_key;
+    let text = match key {
+        Key::ArrowLeft | Key::ArrowRight | Key::ArrowUp | Key::ArrowDown => key.name(),
+        _ => key.symbol_or_name(),
+    };
+    s + text
 }
 
 /// Whether no widget has the keyboard: shortcuts are for the window only
@@ -278,6 +335,8 @@ mod tests {
         assert_eq!(text(Action::MaximiseView(0)), "1 … 9");
         assert_eq!(text(Action::ToggleHelp), "F1 or ?");
         assert_eq!(text(Action::ResetCamera), "R");
+        assert_eq!(text(Action::TogglePresentation), "F5");
+        assert_eq!(text(Action::NextSlide), "Right");
         if !ctx.os().is_mac() {
             assert_eq!(text(Action::ExportFigure), "Ctrl+Shift+S");
             assert_eq!(text(Action::SaveScene), "Ctrl+S");

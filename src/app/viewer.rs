@@ -7,10 +7,12 @@
 
 use super::measured_ui;
 use super::panel;
+use super::presentation::{self, DeckSession, Presenter, StripAction};
 use super::screenshot::{self, ExportUi, Request, ScreenGeometry};
 use super::shortcuts::{self, Action};
 use crate::session::build_scene;
 use crate::session::command::Command;
+use crate::session::deck::{self, DeckError};
 use crate::session::loader::{self, LoadError, LoadTarget, Loader};
 use crate::session::runtime::Runtime;
 use crate::session::scene_file as scene;
@@ -44,7 +46,9 @@ pub struct Viewer {
     pending: Vec<Command>,
     status: Option<String>,
     help: bool,
-    applied_theme: Option<Theme>,
+    applied_look: Option<(Theme, bool)>,
+    present: Presenter,
+    deck: Option<DeckSession>,
     loader: Loader,
     load_errors: Vec<LoadError>,
     last_load: Option<String>,
@@ -68,7 +72,9 @@ impl Viewer {
             pending: Vec::new(),
             status: None,
             help: false,
-            applied_theme: None,
+            applied_look: None,
+            present: Presenter::default(),
+            deck: None,
             loader: Loader::default(),
             load_errors: Vec::new(),
             last_load: None,
@@ -106,6 +112,195 @@ impl Viewer {
         scene::save(path, &self.state)?;
         self.export.scene_path = Some(path.to_path_buf());
         Ok(())
+    }
+
+    /// Whether the window is in presentation mode.
+    pub fn presenting(&self) -> bool {
+        self.present.on
+    }
+
+    /// Enters or leaves presentation mode: the left panel collapses, one
+    /// view (the maximised one, or the first) fills the window, text and
+    /// lines grow (see `session::presentation`), and the arrow keys step the
+    /// deck or the views.
+    pub fn set_presenting(&mut self, on: bool) {
+        if on == self.present.on {
+            return;
+        }
+        if on {
+            self.present.maximised_before = Some(self.state.maximised.clone());
+            self.present.controls = false;
+            if self.state.maximised.is_none() {
+                self.state.maximised = REGISTRY.first().map(|e| e.id.to_string());
+            }
+        } else if self.deck.is_none()
+            && let Some(m) = self.present.maximised_before.take()
+        {
+            self.state.maximised = m;
+        }
+        self.present.on = on;
+    }
+
+    /// The open deck, if any.
+    pub fn deck(&self) -> Option<&DeckSession> {
+        self.deck.as_ref()
+    }
+
+    /// Opens a deck file at its first slide, in presentation mode; returns
+    /// its warnings. On error nothing changes.
+    pub fn open_deck(&mut self, path: &Path) -> Result<Vec<String>, DeckError> {
+        let loaded = deck::load(path, scene::Builds::Warn)?;
+        self.set_deck(loaded.deck, Some(path.to_path_buf()), 0);
+        Ok(loaded.warnings)
+    }
+
+    /// Shows `deck` at slide `index` in presentation mode; `path` is where
+    /// Ctrl+S saves it.
+    pub fn set_deck(&mut self, deck: deck::Deck, path: Option<std::path::PathBuf>, index: usize) {
+        if deck.slides.is_empty() {
+            return;
+        }
+        self.deck = Some(DeckSession {
+            deck,
+            path,
+            index: 0,
+        });
+        self.set_presenting(true);
+        self.load_slide(index);
+    }
+
+    /// Shows slide `index` of the open deck (clamped to the deck), keeping
+    /// the edits made to the current one.
+    pub fn go_to_slide(&mut self, index: usize) {
+        self.store_slide();
+        self.load_slide(index);
+    }
+
+    /// Writes the viewer's state back into the current slide (the view shown
+    /// becomes the slide's view; the slide keeps its own theme).
+    fn store_slide(&mut self) {
+        let Some(d) = &mut self.deck else { return };
+        let Some(slide) = d.deck.slides.get_mut(d.index) else {
+            return;
+        };
+        if let Some(v) = &self.state.maximised {
+            slide.view = v.clone();
+        }
+        let theme = slide.state.theme;
+        slide.state = AppState {
+            theme,
+            maximised: Some(slide.view.clone()),
+            ..self.state.clone()
+        };
+    }
+
+    fn load_slide(&mut self, index: usize) {
+        let Some(d) = &mut self.deck else { return };
+        let index = index.min(d.deck.slides.len().saturating_sub(1));
+        d.index = index;
+        let Some(slide) = d.deck.slides.get(index) else {
+            return;
+        };
+        // The window keeps the theme the lecturer chose for the room.
+        let theme = if self.applied_look.is_some() {
+            self.state.theme
+        } else {
+            slide.state.theme
+        };
+        let state = AppState {
+            theme,
+            maximised: Some(slide.view.clone()),
+            ..slide.state.clone()
+        };
+        self.replace_state(state);
+    }
+
+    /// Steps the deck by `delta` slides, or (without a deck) the shown view
+    /// through the registry.
+    pub fn step(&mut self, delta: i32) {
+        if let Some(d) = &self.deck {
+            let n = d.deck.slides.len() as i64;
+            let to = (d.index as i64 + i64::from(delta)).clamp(0, n - 1);
+            self.go_to_slide(to as usize);
+            return;
+        }
+        let n = REGISTRY.len() as i64;
+        if n == 0 {
+            return;
+        }
+        let at = self
+            .state
+            .maximised
+            .as_deref()
+            .and_then(|m| REGISTRY.iter().position(|e| e.id == m))
+            .unwrap_or(0) as i64;
+        let to = (at + i64::from(delta)).rem_euclid(n) as usize;
+        self.state.maximised = Some(REGISTRY[to].id.to_string());
+    }
+
+    /// Jumps to the first (`last = false`) or last slide, or view.
+    fn jump(&mut self, last: bool) {
+        if let Some(d) = &self.deck {
+            let to = if last { d.deck.slides.len() } else { 0 };
+            self.go_to_slide(to);
+        } else {
+            let e = if last {
+                REGISTRY.last()
+            } else {
+                REGISTRY.first()
+            };
+            self.state.maximised = e.map(|e| e.id.to_string());
+        }
+    }
+
+    /// Saves the open deck to its file, with the current slide's edits (and
+    /// the scene files of `file` entries that changed).
+    pub fn save_deck(&mut self) -> Result<std::path::PathBuf, DeckError> {
+        self.store_slide();
+        let Some(d) = &mut self.deck else {
+            return Err(DeckError::Syntax("no deck is open".into()));
+        };
+        let Some(path) = d.path.clone() else {
+            return Err(DeckError::Syntax("this deck has no file to save to".into()));
+        };
+        deck::save(&path, &mut d.deck)?;
+        Ok(path)
+    }
+
+    /// Sets the window's zoom for presentation mode from its size in pixels
+    /// (again when the window is resized), and gives the old zoom back
+    /// after. Figures are drawn at the scale their frame gives instead.
+    fn sync_zoom(&mut self, ctx: &egui::Context) {
+        if self.figure {
+            return;
+        }
+        if self.present.on {
+            let px = ctx.content_rect().size() * ctx.pixels_per_point();
+            if self
+                .present
+                .zoom_pixels
+                .is_none_or(|p| (p - px).length() > 4.0)
+            {
+                let native = ctx.native_pixels_per_point().unwrap_or(1.0).max(0.1);
+                self.present.zoom_before.get_or_insert(ctx.zoom_factor());
+                ctx.set_zoom_factor(crate::session::presentation::scale_for([px.x, px.y]) / native);
+                self.present.zoom_pixels = Some(px);
+                ctx.request_repaint();
+            }
+        } else if let Some(z) = self.present.zoom_before.take() {
+            ctx.set_zoom_factor(z);
+            self.present.zoom_pixels = None;
+            ctx.request_repaint();
+        }
+    }
+
+    fn strip_action(&mut self, a: StripAction) {
+        match a {
+            StripAction::Step(d) => self.step(d),
+            StripAction::View(id) => self.state.maximised = Some(id.to_string()),
+            StripAction::ToggleControls => self.present.controls = !self.present.controls,
+            StripAction::Exit => self.set_presenting(false),
+        }
     }
 
     fn handle(&mut self, r: Request, ctx: &egui::Context) {
@@ -302,13 +497,24 @@ impl Viewer {
         // the focus yet when the user starts typing.
         let keyboard_free =
             shortcuts::keyboard_free(&ctx) && !self.files.is_open() && !self.export.files_open();
-        if self.applied_theme != Some(self.state.theme) {
-            ctx.set_theme(match self.state.theme {
+        let look = (self.state.theme, self.present.on);
+        if self.applied_look != Some(look) {
+            let theme = match self.state.theme {
                 Theme::Dark => egui::Theme::Dark,
                 Theme::Light => egui::Theme::Light,
-            });
-            self.applied_theme = Some(self.state.theme);
+            };
+            // egui's own visuals stay untouched until presentation mode is
+            // first used.
+            if self.present.on || self.applied_look.is_some_and(|(_, p)| p) {
+                ctx.set_visuals_of(
+                    theme,
+                    presentation::visuals(self.state.theme, self.present.on),
+                );
+            }
+            ctx.set_theme(theme);
+            self.applied_look = Some(look);
         }
+        self.sync_zoom(&ctx);
         self.apply_pending();
         self.finish_loads();
         if self.loader.busy() {
@@ -318,15 +524,36 @@ impl Viewer {
         self.runtime.sync(&self.state);
         let interacting = self.force_interacting || ctx.input(|i| i.pointer.any_down());
         let mut out = Vec::new();
-        self.top_bar(ui, &mut out);
-        self.left_panel(ui, &mut out);
+        let mut strip = Vec::new();
+        if self.present.on {
+            self.presentation_bands(ui, &mut strip);
+            if self.present.controls {
+                self.left_panel(ui, &mut out);
+            }
+        } else {
+            self.top_bar(ui, &mut out);
+            self.left_panel(ui, &mut out);
+        }
         {
             let mut scene = build_scene(&self.state, &self.runtime, interacting);
             scene.figure = self.figure;
             let views = &mut self.views;
-            egui::CentralPanel::default().show(ui, |ui| {
-                central(ui, views, &scene, &mut out);
-            });
+            if self.present.on {
+                scene.line_scale = crate::session::presentation::LINE_SCALE;
+                egui::CentralPanel::default().show(ui, |ui| {
+                    central_presenting(ui, views, &scene, &mut out);
+                });
+            } else {
+                egui::CentralPanel::default().show(ui, |ui| {
+                    central(ui, views, &scene, &mut out);
+                });
+            }
+        }
+        if !strip.is_empty() {
+            for a in strip {
+                self.strip_action(a);
+            }
+            ctx.request_repaint();
         }
         self.shortcuts(&ctx, keyboard_free, &mut out);
         dropped_files(&ctx, &self.state, &self.runtime, &mut out);
@@ -383,6 +610,13 @@ impl Viewer {
                 {
                     self.export.dialog_open = true;
                 }
+                if ui
+                    .button("Present")
+                    .on_hover_text("Presentation mode: one view, large text (F5)")
+                    .clicked()
+                {
+                    self.set_presenting(true);
+                }
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
                         .button("? help")
@@ -401,6 +635,36 @@ impl Viewer {
                 });
             });
         });
+    }
+
+    /// Presentation mode's title band and strip of views.
+    fn presentation_bands(&mut self, ui: &mut Ui, strip: &mut Vec<StripAction>) {
+        let shown = self
+            .state
+            .maximised
+            .as_deref()
+            .and_then(|m| REGISTRY.iter().find(|e| e.id == m))
+            .or_else(|| REGISTRY.first());
+        let shown_id = shown.map_or("", |e| e.id);
+        match &self.deck {
+            Some(d) => {
+                if let Some(s) = d.deck.slides.get(d.index) {
+                    presentation::top_band(
+                        ui,
+                        &s.title,
+                        &s.caption,
+                        Some((d.index, d.deck.slides.len())),
+                    );
+                }
+            }
+            None => presentation::top_band(ui, shown.map_or("", |e| e.title), "", None),
+        }
+        strip.extend(presentation::bottom_strip(
+            ui,
+            shown_id,
+            self.deck.is_some(),
+            self.present.controls,
+        ));
     }
 
     fn left_panel(&mut self, ui: &mut Ui, out: &mut Vec<Command>) {
@@ -462,8 +726,20 @@ impl Viewer {
                 Action::ToggleWireframe => out.push(Command::ToggleWireframe),
                 Action::NextModel => out.push(Command::StepModel(1)),
                 Action::PreviousModel => out.push(Command::StepModel(-1)),
+                Action::NextBrdf | Action::NextSlide if self.present.on => self.step(1),
+                Action::PreviousBrdf | Action::PreviousSlide if self.present.on => self.step(-1),
+                Action::FirstSlide | Action::LastSlide if self.present.on => {
+                    self.jump(action == Action::LastSlide);
+                }
                 Action::NextBrdf => out.push(Command::SelectStep(1)),
                 Action::PreviousBrdf => out.push(Command::SelectStep(-1)),
+                Action::NextSlide
+                | Action::PreviousSlide
+                | Action::FirstSlide
+                | Action::LastSlide => {}
+                // egui zooms before the viewer sees the keys.
+                Action::Zoom => {}
+                Action::TogglePresentation => self.set_presenting(!self.present.on),
                 Action::MaximiseHovered => {
                     let id = self
                         .hovered_view(ctx)
@@ -474,12 +750,19 @@ impl Viewer {
                 }
                 Action::MaximiseView(k) => {
                     if let Some(e) = REGISTRY.get(k) {
-                        out.push(Command::ToggleMaximise(e.id.to_string()));
+                        // Presenting, one view is always shown.
+                        out.push(if self.present.on {
+                            Command::Maximise(Some(e.id.to_string()))
+                        } else {
+                            Command::ToggleMaximise(e.id.to_string())
+                        });
                     }
                 }
                 Action::Escape => {
                     if self.help {
                         out.push(Command::ToggleHelp);
+                    } else if self.present.on {
+                        self.set_presenting(false);
                     } else {
                         out.push(Command::Maximise(None));
                     }
@@ -489,6 +772,16 @@ impl Viewer {
                     Theme::Light => Theme::Dark,
                 })),
                 Action::OpenScene => self.export.ask_open_scene(),
+                Action::SaveScene if self.deck.is_some() => match self.save_deck() {
+                    Ok(p) => self
+                        .export
+                        .toast(format!("Saved the deck to {}", p.display()), false),
+                    Err(e) => {
+                        let msg = format!("Could not save the deck: {e}");
+                        self.status = Some(msg.clone());
+                        self.export.toast(msg, true);
+                    }
+                },
                 Action::SaveScene => match self.export.scene_path.clone() {
                     Some(p) => self.handle(Request::SaveScene(p), ctx),
                     None => self.export.ask_save_scene(),
@@ -556,6 +849,20 @@ pub fn figure_window(state: &AppState) -> Box<dyn crate::export::WindowUi> {
     Box::new(viewer)
 }
 
+/// Slide `index` of `deck` drawn as a figure, as presentation mode shows it
+/// (what `bv render --deck` draws).
+pub fn slide_window(deck: &deck::Deck, index: usize) -> Box<dyn crate::export::WindowUi> {
+    let state = deck
+        .slides
+        .get(index)
+        .map(|s| s.state.clone())
+        .unwrap_or_default();
+    let mut viewer = Viewer::new(state);
+    viewer.figure = true;
+    viewer.set_deck(deck.clone(), None, index);
+    Box::new(viewer)
+}
+
 /// Where view `id` was drawn in the last frame.
 pub fn view_rect(ctx: &egui::Context, id: &str) -> Option<Rect> {
     ctx.memory(|m| {
@@ -588,6 +895,36 @@ fn central(
             view_frame(ui, entry, view.as_mut(), is_max, scene, out);
         });
     }
+}
+
+/// Presentation mode's central area: the shown view (the maximised one, or
+/// the first) alone, without its header.
+fn central_presenting(
+    ui: &mut Ui,
+    views: &mut [(&'static ViewEntry, Box<dyn View>)],
+    scene: &Scene<'_>,
+    out: &mut Vec<Command>,
+) {
+    let i = scene
+        .state
+        .maximised
+        .as_deref()
+        .and_then(|id| views.iter().position(|(e, _)| e.id == id))
+        .unwrap_or(0);
+    let Some((entry, view)) = views.get_mut(i) else {
+        return;
+    };
+    let rect = ui.available_rect_before_wrap();
+    ui.ctx().data_mut(|d| {
+        d.insert_temp(
+            egui::Id::unique("bv view rects"),
+            vec![(entry.id.to_string(), rect)],
+        );
+    });
+    ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {
+        ui.set_clip_rect(rect.intersect(ui.clip_rect()));
+        view.ui(ui, scene, out);
+    });
 }
 
 /// Files dropped on the window are opened as measured tables (see

@@ -86,6 +86,9 @@ pub struct Shell {
     pub run_viewer: fn(&viewer_args::ViewerArgs) -> anyhow::Result<()>,
     /// The window as a figure (`bv render --view window`).
     pub window: crate::export::MakeWindow,
+    /// One slide of a lecture deck as presentation mode shows it
+    /// (`bv render --deck`).
+    pub slide: crate::export::MakeSlide,
 }
 
 /// Entry point of the binary.
@@ -104,7 +107,7 @@ pub fn main(shell: &Shell) -> ExitCode {
         Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Tabulate(a)) => tabulate::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),
-        Some(Command::Render(a)) => render::run(a, shell.window).map(|()| ExitCode::SUCCESS),
+        Some(Command::Render(a)) => render::run(a, shell).map(|()| ExitCode::SUCCESS),
         Some(Command::Slice(a)) => slice::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Scene(a)) => {
             let argv: Vec<String> = std::env::args().collect();

@@ -5,6 +5,7 @@
 
 use super::params::spec_from_cli;
 use crate::export::{self, Frame, Offscreen};
+use crate::session::deck;
 use crate::session::lighting::MAX_TARGET_SPP;
 use crate::session::scene_file as scene;
 use crate::session::state::{AppState, Incident, Theme};
@@ -28,12 +29,21 @@ use std::path::{Path, PathBuf};
     Example (every figure of a lecture, one shell loop):\n  \
     for m in lambert phong ward cook-torrance; do\n    \
     bv render --model $m --view all --theta-i 45 --out figs/$m --svg\n  \
-    done"
+    done\n\n\
+    With --deck FILE, --out is a folder and gets one numbered PNG per scene of the \
+    lecture deck (01-diffuse.png, …), 1920×1080 unless --width/--height say otherwise: \
+    the whole window in presentation mode, title band and view strip included, as \
+    `bv --deck FILE` shows it in a window of that size."
 )]
 pub struct RenderArgs {
     /// Scene file to draw (TOML: BRDFs, light, camera, display options).
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", conflicts_with = "deck")]
     pub scene: Option<PathBuf>,
+
+    /// A lecture deck: write every scene as a numbered PNG into the folder
+    /// --out, drawn as presentation mode shows it.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["model", "params", "view", "scale", "svg", "transparent", "spp"])]
+    pub deck: Option<PathBuf>,
 
     /// Draw this model (replaces the scene's BRDFs; default: the scene's, or
     /// the first model of the catalogue).
@@ -48,8 +58,8 @@ pub struct RenderArgs {
     /// The view: lobe3d (or lobe), polar, cartesian, albedo, fresnel, any other
     /// view of this build (the error for an unknown one lists them), `all`, or
     /// `window` (the whole viewer window, panels included).
-    #[arg(long, value_name = "VIEW")]
-    pub view: String,
+    #[arg(long, value_name = "VIEW", required_unless_present = "deck")]
+    pub view: Option<String>,
 
     /// Polar angle of the light, degrees (0..89.5).
     #[arg(long = "theta-i", value_name = "DEG", allow_negative_numbers = true)]
@@ -59,13 +69,13 @@ pub struct RenderArgs {
     #[arg(long = "phi-i", value_name = "DEG", allow_negative_numbers = true)]
     pub phi_i: Option<f64>,
 
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 1600)]
-    pub width: u32,
+    /// Image width in pixels (default 1600; 1920 with --deck).
+    #[arg(long)]
+    pub width: Option<u32>,
 
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 1200)]
-    pub height: u32,
+    /// Image height in pixels (default 1200; 1080 with --deck).
+    #[arg(long)]
+    pub height: Option<u32>,
 
     /// Pixels per point: the size of text and lines (default: width / 800,
     /// between 1 and 4, so a 1600-pixel figure reads like the 800-point view
@@ -256,38 +266,37 @@ impl Progress {
 }
 
 /// Runs `bv render`.
-pub fn run(a: &RenderArgs, make_window: export::MakeWindow) -> Result<()> {
-    let window = a.view.trim().eq_ignore_ascii_case("window");
-    let views = if window {
-        Vec::new()
+pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
+    let default_size = if a.deck.is_some() {
+        [1920, 1080]
     } else {
-        views_for(&a.view)?
+        [1600, 1200]
     };
-    let all = !window && (views.len() > 1 || a.view.trim().eq_ignore_ascii_case("all"));
-    if a.width == 0 || a.height == 0 {
-        bail!(
-            "--width {} --height {}: an image needs at least one pixel each way",
-            a.width,
-            a.height
-        );
+    let width = a.width.unwrap_or(default_size[0]);
+    let height = a.height.unwrap_or(default_size[1]);
+    if width == 0 || height == 0 {
+        bail!("--width {width} --height {height}: an image needs at least one pixel each way");
     }
     let max = export::offscreen::MAX_SIDE;
-    if a.width > max || a.height > max {
-        bail!(
-            "--width {} --height {}: at most {max} pixels on a side",
-            a.width,
-            a.height
-        );
+    if width > max || height > max {
+        bail!("--width {width} --height {height}: at most {max} pixels on a side");
     }
+    if let Some(deck) = &a.deck {
+        return render_deck(a, deck, [width, height], shell.slide);
+    }
+    let view = a.view.as_deref().unwrap_or_default();
+    let window = view.trim().eq_ignore_ascii_case("window");
+    let views = if window { Vec::new() } else { views_for(view)? };
+    let all = !window && (views.len() > 1 || view.trim().eq_ignore_ascii_case("all"));
     let scale = a
         .scale
-        .unwrap_or_else(|| (a.width as f32 / 800.0).clamp(1.0, 4.0));
+        .unwrap_or_else(|| (width as f32 / 800.0).clamp(1.0, 4.0));
     if !(scale.is_finite() && (0.25..=8.0).contains(&scale)) {
         bail!("--scale {scale}: expected 0.25..=8");
     }
     let state = state_for(a)?;
     let frame = Frame {
-        size: Vec2::new(a.width as f32 / scale, a.height as f32 / scale),
+        size: Vec2::new(width as f32 / scale, height as f32 / scale),
         pixels_per_point: scale,
         dark: export::is_dark(&state),
         transparent: a.transparent,
@@ -298,7 +307,7 @@ pub fn run(a: &RenderArgs, make_window: export::MakeWindow) -> Result<()> {
             bail!("--view window: only PNG (--out FILE.png)");
         }
         let mut off = open_device(frame)?;
-        let img = export::render_window(&mut off, &state, frame, make_window)?;
+        let img = export::render_window(&mut off, &state, frame, shell.window)?;
         return export::save_png(&img, &a.out);
     }
     if !all {
@@ -358,6 +367,77 @@ pub fn run(a: &RenderArgs, make_window: export::MakeWindow) -> Result<()> {
         write_svg(&state, e, frame, &path)?;
         done += 1;
         progress.step(done, &path.display().to_string());
+    }
+    Ok(())
+}
+
+/// `bv render --deck`: every slide of the deck as `NN-title.png` in the
+/// folder `--out`, drawn as presentation mode draws a window of `pixels`
+/// (the same scale, bands and strip: see `session::presentation`).
+fn render_deck(
+    a: &RenderArgs,
+    path: &Path,
+    [width, height]: [u32; 2],
+    make: export::MakeSlide,
+) -> Result<()> {
+    let loaded = deck::load(path, scene::Builds::Required)
+        .with_context(|| format!("--deck {}", path.display()))?;
+    for w in &loaded.warnings {
+        super::output::eprint(&format!("bv render: {}: {w}\n", path.display()));
+    }
+    let mut d = loaded.deck;
+    for s in &mut d.slides {
+        if a.light {
+            s.state.theme = Theme::Light;
+        }
+        if a.dark {
+            s.state.theme = Theme::Dark;
+        }
+        if a.log {
+            s.state.display.log = true;
+        }
+        if a.cosine {
+            s.state.display.cosine = true;
+        }
+    }
+    if a.out.extension().is_some_and(|e| e == "png") {
+        bail!(
+            "--deck writes one PNG per scene: --out must be a folder, not {}",
+            a.out.display()
+        );
+    }
+    std::fs::create_dir_all(&a.out)
+        .with_context(|| format!("cannot create the folder {}", a.out.display()))?;
+    let scale = crate::session::presentation::scale_for([width as f32, height as f32]);
+    let size = Vec2::new(width as f32 / scale, height as f32 / scale);
+    let progress = Progress {
+        total: d.slides.len(),
+        tty: std::io::stderr().is_terminal(),
+    };
+    let mut off: Option<Offscreen> = None;
+    progress.step(0, "starting");
+    for (i, s) in d.slides.iter().enumerate() {
+        let frame = Frame {
+            size,
+            pixels_per_point: scale,
+            dark: export::is_dark(&s.state),
+            transparent: false,
+        };
+        let off = match &mut off {
+            Some(o) => o,
+            None => off.insert(open_device(frame)?),
+        };
+        let digits = d.slides.len().to_string().len().max(2);
+        let file = a
+            .out
+            .join(format!("{:0digits$}-{}.png", i + 1, deck::slug(&s.title)));
+        let img = export::render_ui(off, &s.state, frame, make(&d, i))
+            .with_context(|| format!("drawing scene {} (\"{}\")", i + 1, s.title))?;
+        if export::is_blank(&img) {
+            bail!("scene {} (\"{}\") came out blank", i + 1, s.title);
+        }
+        export::save_png(&img, &file)?;
+        progress.step(i + 1, &file.display().to_string());
     }
     Ok(())
 }

@@ -44,6 +44,13 @@ pub struct ViewerArgs {
     /// session.
     #[arg(long, value_name = "FILE")]
     pub scene: Option<PathBuf>,
+
+    /// Open this lecture deck (TOML: scenes with titles and captions) in
+    /// presentation mode: arrow keys / PageDown / PageUp step the scenes,
+    /// Home / End jump, Ctrl+S saves the deck with the edits, F5 leaves
+    /// presentation mode. The saved session is left alone.
+    #[arg(long, value_name = "FILE", conflicts_with = "scene")]
+    pub deck: Option<PathBuf>,
 }
 
 /// Parses `WIDTHxHEIGHT`.

@@ -58,6 +58,10 @@ pub trait WindowUi {
 /// finished before drawing, no hover readouts).
 pub type MakeWindow = fn(&AppState) -> Box<dyn WindowUi>;
 
+/// Builds the window's UI showing slide `index` of a deck in presentation
+/// mode, drawn as a figure.
+pub type MakeSlide = fn(&crate::session::deck::Deck, usize) -> Box<dyn WindowUi>;
+
 /// Draws one view of `state` alone, filling a `frame.size` image (no title
 /// bar or toolbar, no hover readouts). Fails, rather than drawing an
 /// incomplete figure, when a drawn BRDF could not be built or the view met
@@ -99,6 +103,17 @@ pub fn render_window(
     frame: Frame,
     make: MakeWindow,
 ) -> Result<image::RgbaImage> {
+    render_ui(off, state, frame, make(state))
+}
+
+/// Draws `window`, a whole window's UI showing `state` (a slide of a deck,
+/// the viewer), after the checks and slow work [`render_window`] does.
+pub fn render_ui(
+    off: &mut Offscreen,
+    state: &AppState,
+    frame: Frame,
+    mut window: Box<dyn WindowUi>,
+) -> Result<image::RgbaImage> {
     // The window's albedo view computes in the background; a figure shows
     // the finished curves, so compute them first (they are cached).
     {
@@ -116,7 +131,6 @@ pub fn render_window(
             crate::views::albedo::curve_now(&scene, b);
         }
     }
-    let mut window = make(state);
     let img = off.render(frame, |ui| window.ui(ui))?;
     if let Some(e) = window.error() {
         bail!("{e}");

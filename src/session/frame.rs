@@ -54,6 +54,10 @@ pub struct Scene<'a> {
     /// Figure with a transparent background: views leave their own
     /// backgrounds unfilled.
     pub transparent: bool,
+    /// Factor on every stroke width the views draw (1; thicker in
+    /// presentation mode, `presentation::LINE_SCALE`): read it through
+    /// [`Scene::stroke`].
+    pub line_scale: f32,
 }
 
 impl Scene<'_> {
@@ -64,6 +68,12 @@ impl Scene<'_> {
             .iter()
             .find(|b| b.selected)
             .or_else(|| self.brdfs.first())
+    }
+
+    /// A stroke width of `points` as this frame draws it (thicker when
+    /// presenting).
+    pub fn stroke(&self, points: f32) -> f32 {
+        points * self.line_scale
     }
 
     /// The unit direction towards the light.
@@ -98,6 +108,7 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
         interacting,
         figure: false,
         transparent: false,
+        line_scale: 1.0,
     }
 }
 

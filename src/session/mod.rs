@@ -2,7 +2,8 @@
 //! that is saved between runs ([`state`], [`lighting`]), the commands that
 //! change it ([`command`]), the evaluators built from it ([`runtime`]), the
 //! background reads of file-backed models ([`loader`]), the scene file format
-//! ([`scene_file`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
+//! ([`scene_file`]) and lecture decks of scenes ([`deck`]), presentation
+//! mode's sizes ([`presentation`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
 //! and the per-frame scene every view reads ([`frame`]).
 //!
 //! Nothing here draws: no egui, no wgpu. The window (`app`), the views, the
@@ -10,10 +11,12 @@
 //! none of them.
 
 pub mod command;
+pub mod deck;
 pub mod frame;
 pub mod lighting;
 pub mod loader;
 pub mod naming;
+pub mod presentation;
 pub mod runtime;
 pub mod scene_file;
 pub mod state;

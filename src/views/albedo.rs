@@ -380,13 +380,13 @@ impl View for AlbedoView {
                 HLine::new("", 1.0)
                     .color(super::mirror_color(dark))
                     .style(LineStyle::Dashed { length: 6.0 })
-                    .width(1.2)
+                    .width(scene.stroke(1.2))
                     .allow_hover(false),
             );
             pui.vline(
                 VLine::new("", theta_i)
                     .color(light)
-                    .width(1.5)
+                    .width(scene.stroke(1.5))
                     .allow_hover(false),
             );
             for s in &shown {
@@ -406,7 +406,7 @@ impl View for AlbedoView {
                     .collect();
                 let mut line = Line::new(legend_label(s), PlotPoints::from(pts))
                     .color(s.brdf.color())
-                    .width(if s.brdf.selected { 2.5 } else { 1.8 });
+                    .width(scene.stroke(if s.brdf.selected { 2.5 } else { 1.8 }));
                 if s.stale {
                     line = line.style(LineStyle::Dashed { length: 8.0 });
                 }

@@ -163,14 +163,14 @@ impl View for CartesianView {
                 pui.vline(
                     VLine::new("", li)
                         .color(light)
-                        .width(2.0)
+                        .width(scene.stroke(2.0))
                         .allow_hover(false),
                 );
                 pui.vline(
                     VLine::new("", theta_i.to_degrees())
                         .color(mirror)
                         .style(LineStyle::Dashed { length: 6.0 })
-                        .width(1.5)
+                        .width(scene.stroke(1.5))
                         .allow_hover(false),
                 );
                 pui.text(
@@ -203,7 +203,7 @@ impl View for CartesianView {
                             VLine::new(format!("{} δ", b.label), a)
                                 .color(b.color())
                                 .style(LineStyle::Dotted { spacing: 4.0 })
-                                .width(2.0),
+                                .width(scene.stroke(2.0)),
                         );
                         pui.text(
                             Text::new(
@@ -228,7 +228,7 @@ impl View for CartesianView {
                 pui.line(
                     Line::new(b.label.clone(), PlotPoints::from(pts))
                         .color(b.color())
-                        .width(if b.selected { 2.5 } else { 1.8 }),
+                        .width(scene.stroke(if b.selected { 2.5 } else { 1.8 })),
                 );
             }
             pui.pointer_coordinate()

@@ -274,7 +274,7 @@ impl View for FresnelView {
             for (k, m) in c.vlines.iter().enumerate() {
                 let mut v = VLine::new("", m.at)
                     .color(m.color)
-                    .width(1.3)
+                    .width(scene.stroke(1.3))
                     .allow_hover(false);
                 if m.dashed {
                     v = v.style(LineStyle::Dashed { length: 6.0 });
@@ -294,7 +294,7 @@ impl View for FresnelView {
             for s in &c.series {
                 let mut l = Line::new(s.label.clone(), PlotPoints::from(s.points.clone()))
                     .color(s.color)
-                    .width(s.width);
+                    .width(scene.stroke(s.width));
                 if let Some(d) = s.dash {
                     l = l.style(LineStyle::Dashed { length: d });
                 }

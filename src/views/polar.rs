@@ -167,7 +167,7 @@ impl View for PolarView {
                 pui.line(
                     Line::new("", PlotPoints::from(pts))
                         .color(grid)
-                        .width(1.0)
+                        .width(scene.stroke(1.0))
                         .allow_hover(false),
                 );
                 // Ring values read along the surface line, like a radial axis.
@@ -189,7 +189,7 @@ impl View for PolarView {
                 pui.line(
                     Line::new("", PlotPoints::from(pts))
                         .color(grid)
-                        .width(1.0)
+                        .width(scene.stroke(1.0))
                         .allow_hover(false),
                 );
                 if deg % 30 == 0 {
@@ -210,7 +210,7 @@ impl View for PolarView {
                     PlotPoints::from(vec![[-outer * 1.15, 0.0], [outer * 1.15, 0.0]]),
                 )
                 .color(text_col.gamma_multiply(0.7))
-                .width(1.5)
+                .width(scene.stroke(1.5))
                 .allow_hover(false),
             );
             // Light (left) and mirror direction (right).
@@ -219,7 +219,7 @@ impl View for PolarView {
             pui.line(
                 Line::new("", PlotPoints::from(vec![lp, [0.0, 0.0]]))
                     .color(light)
-                    .width(2.5)
+                    .width(scene.stroke(2.5))
                     .allow_hover(false),
             );
             pui.text(
@@ -236,7 +236,7 @@ impl View for PolarView {
                 Line::new("", PlotPoints::from(vec![[0.0, 0.0], mp]))
                     .color(mirror)
                     .style(LineStyle::Dashed { length: 6.0 })
-                    .width(1.5)
+                    .width(scene.stroke(1.5))
                     .allow_hover(false),
             );
             pui.text(
@@ -255,7 +255,7 @@ impl View for PolarView {
                 pui.line(
                     Line::new(label.clone(), PlotPoints::from(pts.clone()))
                         .color(*color)
-                        .width(if *selected { 2.5 } else { 1.8 }),
+                        .width(scene.stroke(if *selected { 2.5 } else { 1.8 })),
                 );
             }
             if let Some((label, color, pts)) = &sh {
@@ -263,7 +263,7 @@ impl View for PolarView {
                     Line::new(label.clone(), PlotPoints::from(pts.clone()))
                         .color(*color)
                         .style(LineStyle::Dashed { length: 8.0 })
-                        .width(2.0),
+                        .width(scene.stroke(2.0)),
                 );
             }
             // Delta lobes in the plane, as spikes reaching `weight` of the outer ring.

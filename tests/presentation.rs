@@ -1,0 +1,286 @@
+//! Presentation mode and lecture decks in the viewer, with egui_kittest: F5
+//! on and off, stepping a deck with the keys a presenter's clicker sends,
+//! the title band, live edits saved back with Ctrl+S, the sizes of text at
+//! 1920×1080, and a snapshot (on the GPU; lavapipe where there is none).
+//! `bv render --deck` is tested as the binary in `render_deck.rs`.
+//!
+//! Regenerate the snapshot with
+//! `UPDATE_SNAPSHOTS=1 cargo test -p bv --test presentation`.
+
+use bv::app::Viewer;
+use bv::session::deck::{self, Deck, Slide};
+use bv::session::scene_file::Builds;
+use bv::session::state::AppState;
+use bv_core::ModelSpec;
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+
+fn viewer_sized(state: AppState, size: [f32; 2]) -> Harness<'static, Viewer> {
+    let mut h = Harness::builder()
+        .with_size(size)
+        .with_max_steps(12)
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state));
+    h.run();
+    h
+}
+
+fn state(model: &str, theta: f64) -> AppState {
+    let mut s = AppState::default();
+    s.add(ModelSpec::new(model).unwrap());
+    s.incident.theta_deg = theta;
+    s
+}
+
+/// Three slides told apart by their light angle and view.
+fn three() -> Deck {
+    Deck {
+        title: Some("Test lecture".into()),
+        slides: vec![
+            Slide::inline(
+                "First slide",
+                "one caption",
+                "polar",
+                state("lambert", 10.0),
+            )
+            .unwrap(),
+            Slide::inline(
+                "Second slide",
+                "two caption",
+                "cartesian",
+                state("phong", 20.0),
+            )
+            .unwrap(),
+            Slide::inline(
+                "Third slide",
+                "three caption",
+                "albedo",
+                state("lambert", 30.0),
+            )
+            .unwrap(),
+        ],
+    }
+}
+
+fn theta(h: &Harness<'_, Viewer>) -> f64 {
+    h.state().state().incident.theta_deg
+}
+
+fn index(h: &Harness<'_, Viewer>) -> usize {
+    h.state().deck().expect("a deck is open").index
+}
+
+fn press(h: &mut Harness<'_, Viewer>, key: egui::Key) {
+    h.key_press(key);
+    h.run();
+}
+
+#[test]
+fn f5_enters_and_leaves_presentation_mode() {
+    let mut h = viewer_sized(AppState::first_run(), [1920.0, 1080.0]);
+    assert!(!h.state().presenting());
+    assert!(h.query_by_label("Add BRDF").is_some(), "the panel is shown");
+    press(&mut h, egui::Key::F5);
+    assert!(h.state().presenting());
+    // The panel is collapsed, one view is shown (the first), named in the
+    // band, and the strip lists the views.
+    assert!(
+        h.query_by_label("Add BRDF").is_none(),
+        "the panel is hidden"
+    );
+    let first = &bv::views::REGISTRY[0];
+    assert_eq!(h.state().state().maximised.as_deref(), Some(first.id));
+    h.get_by_label(first.title);
+    h.get_by_label("polar").click();
+    h.run();
+    assert_eq!(h.state().state().maximised.as_deref(), Some("polar"));
+    // The window is scaled for a 1080p projector.
+    assert_eq!(
+        h.ctx.zoom_factor(),
+        bv::session::presentation::scale_for([1920.0, 1080.0])
+    );
+    // The panel can be opened to edit the scene live.
+    h.get_by_label("controls").click();
+    h.run();
+    assert!(h.query_by_label("Add BRDF").is_some());
+    // → and ← step the views without a deck.
+    press(&mut h, egui::Key::ArrowRight);
+    assert_eq!(h.state().state().maximised.as_deref(), Some("cartesian"));
+    press(&mut h, egui::Key::ArrowLeft);
+    assert_eq!(h.state().state().maximised.as_deref(), Some("polar"));
+    // F5 again: back to the layout the window had, at its own zoom.
+    press(&mut h, egui::Key::F5);
+    assert!(!h.state().presenting());
+    assert_eq!(h.state().state().maximised, None);
+    h.run();
+    assert_eq!(h.ctx.zoom_factor(), 1.0);
+    assert!(h.query_by_label("Add BRDF").is_some());
+    // The toolbar button does what F5 does; Esc leaves.
+    h.get_by_label("Present").click();
+    h.run();
+    assert!(h.state().presenting());
+    press(&mut h, egui::Key::Escape);
+    assert!(!h.state().presenting());
+}
+
+#[test]
+fn the_deck_steps_with_the_clicker_keys_and_draws_titles() {
+    let mut h = viewer_sized(AppState::default(), [1280.0, 720.0]);
+    h.state_mut().set_deck(three(), None, 0);
+    h.run();
+    assert!(h.state().presenting());
+    assert_eq!((index(&h), theta(&h)), (0, 10.0));
+    h.get_by_label("First slide");
+    h.get_by_label("one caption");
+    h.get_by_label("1 / 3");
+    assert_eq!(h.state().state().maximised.as_deref(), Some("polar"));
+
+    press(&mut h, egui::Key::ArrowRight);
+    assert_eq!((index(&h), theta(&h)), (1, 20.0));
+    assert_eq!(h.state().state().maximised.as_deref(), Some("cartesian"));
+    h.get_by_label("Second slide");
+    h.get_by_label("two caption");
+    assert!(h.query_by_label("First slide").is_none());
+    press(&mut h, egui::Key::PageDown);
+    assert_eq!((index(&h), theta(&h)), (2, 30.0));
+    // The end of the deck stays there.
+    press(&mut h, egui::Key::ArrowRight);
+    assert_eq!(index(&h), 2);
+    press(&mut h, egui::Key::Home);
+    assert_eq!((index(&h), theta(&h)), (0, 10.0));
+    press(&mut h, egui::Key::End);
+    assert_eq!((index(&h), theta(&h)), (2, 30.0));
+    press(&mut h, egui::Key::ArrowLeft);
+    assert_eq!(index(&h), 1);
+    press(&mut h, egui::Key::PageUp);
+    assert_eq!(index(&h), 0);
+    // PageUp at the start stays there too (and selects no other BRDF).
+    press(&mut h, egui::Key::PageUp);
+    assert_eq!(index(&h), 0);
+    // The strip's buttons step as well.
+    h.get_by_label("»").click();
+    h.run();
+    assert_eq!(index(&h), 1);
+    h.get_by_label("«").click();
+    h.run();
+    assert_eq!(index(&h), 0);
+}
+
+#[test]
+fn live_edits_survive_stepping_and_ctrl_s_saves_the_deck() {
+    let dir = std::env::temp_dir().join(format!("bv-presentation-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("deck.toml");
+    deck::save(&path, &mut three()).unwrap();
+
+    let mut h = viewer_sized(AppState::default(), [1280.0, 720.0]);
+    h.state_mut().open_deck(&path).unwrap();
+    h.run();
+    // An edit of the second slide (what a slider does) …
+    press(&mut h, egui::Key::ArrowRight);
+    h.state_mut().push(bv::session::Command::SetIncident(
+        bv::session::state::Incident {
+            theta_deg: 66.0,
+            phi_deg: 0.0,
+        },
+    ));
+    h.run();
+    assert_eq!(theta(&h), 66.0);
+    // … is still there after going away and back …
+    press(&mut h, egui::Key::ArrowRight);
+    press(&mut h, egui::Key::ArrowLeft);
+    assert_eq!(theta(&h), 66.0);
+    // … and Ctrl+S writes it into the deck file.
+    h.key_press_modifiers(egui::Modifiers::COMMAND, egui::Key::S);
+    h.run();
+    let back = deck::load(&path, Builds::Required).unwrap().deck;
+    assert_eq!(back.slides[1].state.incident.theta_deg, 66.0);
+    assert_eq!(back.slides[0].state.incident.theta_deg, 10.0);
+    assert_eq!(back.slides.len(), 3);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The smallest font size among the text shapes of the last frame inside
+/// `area` (the whole window when `None`), in pixels.
+fn smallest_text_px(h: &Harness<'_, Viewer>, area: Option<egui::Rect>) -> f32 {
+    let area = area.unwrap_or(egui::Rect::EVERYTHING);
+    let walk = |s: &egui::Shape, min: &mut f32| walk_in(s, area, min);
+    fn walk_in(s: &egui::Shape, area: egui::Rect, min: &mut f32) {
+        match s {
+            egui::Shape::Text(t) if area.contains(t.pos) => {
+                for sec in &t.galley.job.sections {
+                    let r = sec.byte_range.start.0..sec.byte_range.end.0;
+                    if !t.galley.job.text[r].trim().is_empty() {
+                        *min = min.min(sec.format.font_id.size);
+                    }
+                }
+            }
+            egui::Shape::Vec(v) => v.iter().for_each(|s| walk_in(s, area, min)),
+            _ => {}
+        }
+    }
+    let mut min = f32::INFINITY;
+    for c in &h.output().shapes {
+        walk(&c.shape, &mut min);
+    }
+    min * h.ctx.pixels_per_point()
+}
+
+#[test]
+fn text_is_at_least_20_pixels_on_a_1080p_window() {
+    // The 2D plots (the GPU views need a renderer; their text is the same
+    // sizes, checked in the rendered deck).
+    let mut s = state("cook-torrance", 45.0);
+    s.add(ModelSpec::new("lambert").unwrap());
+    let mut h = viewer_sized(s, [1920.0, 1080.0]);
+    // Normal mode has small text.
+    assert!(smallest_text_px(&h, None) < 20.0);
+    press(&mut h, egui::Key::F5);
+    for view in ["polar", "cartesian", "albedo", "fresnel", "slice"] {
+        h.state_mut()
+            .push(bv::session::Command::Maximise(Some(view.into())));
+        h.run();
+        // Font sizes are em sizes; digits and capitals are 0.7 em. The
+        // view's text (the strip of view names below is the presenter's,
+        // smaller; the title band is larger).
+        let rect = bv::app::viewer::view_rect(&h.ctx, view).expect("the view was drawn");
+        let px = smallest_text_px(&h, Some(rect));
+        assert!(px.is_finite(), "{view}: no text found");
+        assert!(0.7 * px >= 20.0, "{view}: text of {px} pixels");
+        assert!(px < 40.0, "{view}: the view's own labels are found ({px})");
+    }
+}
+
+#[test]
+fn snapshot_presentation_mode() {
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    bv::views::lobe_gpu::install(&rs);
+    let mut h = Harness::builder()
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(rs))
+        .with_size([960.0, 540.0])
+        .with_max_steps(12)
+        .build_ui_state(
+            |ui, v: &mut Viewer| v.ui(ui),
+            Viewer::new(AppState::default()),
+        );
+    let mut d = three();
+    d.slides[0].state.brdfs[0].spec = ModelSpec::new("oren-nayar").unwrap();
+    h.state_mut().set_deck(d, None, 0);
+    h.run();
+    h.get_by_label("First slide");
+    let img = h.render().expect("render");
+    // Not blank: the black ground, white text and the blue curve.
+    let mut colours: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 50, "{} colours", colours.len());
+    h.snapshot_options(
+        "presentation_polar",
+        &egui_kittest::SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(400),
+    );
+}
