@@ -7,6 +7,9 @@
 //! Regenerate the snapshot with
 //! `UPDATE_SNAPSHOTS=1 cargo test -p bv --test presentation`.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::app::Viewer;
 use bv::session::deck::{self, Deck, Slide};
 use bv::session::scene_file::Builds;

@@ -2,6 +2,9 @@
 //! lavapipe where there is no GPU), one numbered PNG per scene, and the
 //! errors of a bad deck naming the entry and the key.
 
+// Test and benchmark code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::session::deck;
 use bv::session::scene_file::Builds;
 use std::path::{Path, PathBuf};
