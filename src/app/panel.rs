@@ -1,5 +1,5 @@
 //! The left panel: the list of loaded BRDFs (colour, visible, solo, remove,
-//! add), the light direction (sliders and a hemisphere to drag on) and the
+//! add, property badges), the preset browser, the light direction (sliders and a hemisphere to drag on) and the
 //! selected BRDF's parameters, generated from its model's declaration.
 
 use crate::session::command::Command;
@@ -87,7 +87,10 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
                 }
             });
         });
+        super::badges::row(ui, &name, e.id, runtime);
     }
+    super::badges::evidence_window(ui.ctx(), state);
+    super::presets_ui::section(ui, out);
 }
 
 /// θi and φi sliders and the hemisphere widget.
@@ -283,7 +286,7 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui,
         egui::Id::unique(("bv params", e.id)),
         info.params,
-        &e.spec.params(),
+        e.spec.params(),
     );
     for edit in edits {
         out.push(match edit {
