@@ -296,3 +296,19 @@ fn panel_verdicts_agree_with_bv_check_over_the_catalogue() {
     }
     assert!(disagree.is_empty(), "{disagree:#?}");
 }
+
+#[test]
+fn a_preset_name_goes_through_scene_files_and_old_entries_have_none() {
+    let gold = bv::cli::params::find_preset("Gold").unwrap();
+    let mut s = state_of(&["lambert"]);
+    s.add_named(gold.spec.clone(), Some(gold.name.clone()));
+    let text = bv::session::scene_file::to_toml(&s).unwrap();
+    let back = bv::session::scene_file::from_toml(&text).unwrap();
+    assert!(back.warnings.is_empty(), "{:?}", back.warnings);
+    let names: Vec<Option<&str>> = back.state.brdfs.iter().map(|b| b.name.as_deref()).collect();
+    assert_eq!(names, [None, Some("Gold")]);
+    // An entry without a name writes no `name` key: files read by older
+    // builds stay as they were.
+    let lambert_only = bv::session::scene_file::to_toml(&state_of(&["lambert"])).unwrap();
+    assert!(!lambert_only.contains("\nname"), "{lambert_only}");
+}

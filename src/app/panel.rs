@@ -55,7 +55,16 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             if v != e.visible {
                 out.push(Command::SetVisible(e.id, v));
             }
-            let mut text = RichText::new(&name);
+            // Long names (presets, files) are shortened so that "solo" and
+            // "remove" keep their place; the full name is in the hover text.
+            const LIST_CHARS: usize = 22;
+            let shown = if name.chars().count() > LIST_CHARS {
+                let head: String = name.chars().take(LIST_CHARS - 1).collect();
+                format!("{}…", head.trim_end())
+            } else {
+                name.clone()
+            };
+            let mut text = RichText::new(shown);
             if !state.is_drawn(e) {
                 text = text.weak();
             }
@@ -64,7 +73,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             }
             if ui
                 .selectable_label(selected, text)
-                .on_hover_text("Show its parameters")
+                .on_hover_text(format!("{name}: show its parameters"))
                 .clicked()
             {
                 out.push(Command::Select(e.id));

@@ -82,7 +82,7 @@ fn swap_ui(ui: &mut Ui, swap: Option<&SwapReadout>, out: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         ui.spacing_mut().item_spacing.x = 10.0;
         let Some(s) = swap else {
-            ui.weak("hover a direction to compare f(ωi,ωo) with f(ωo,ωi)");
+            ui.weak("hover a direction: f(ωi,ωo) beside f(ωo,ωi)");
             return;
         };
         let (t, _) = bv_core::frame::to_spherical(s.wo);
