@@ -260,7 +260,8 @@ fn a_preset_from_the_browser_adds_a_named_brdf_with_its_parameters() {
 #[test]
 fn badge_time_per_model() {
     // What a badge costs, per model of the catalogue at its defaults (a
-    // file-backed model without its file is skipped).
+    // file-backed model without its file is skipped), printed with
+    // `--nocapture`.
     let mut worst = 0.0f64;
     for m in bv_core::catalogue().iter() {
         let Ok(b) = ModelSpec::new(m.id).and_then(|s| s.build()) else {
@@ -277,6 +278,9 @@ fn badge_time_per_model() {
         eprintln!("{:>20}: {dt:6.2} s  {}", m.id, marks.join(" · "));
     }
     eprintln!("slowest: {worst:.2} s");
+    // A badge that takes longer than this in a debug build (some 5–10× slower
+    // than release) would leave the panel on "…" for too long.
+    assert!(worst < 20.0, "slowest badge {worst:.2} s");
 }
 
 #[test]
