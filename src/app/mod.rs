@@ -9,9 +9,11 @@
 //!   sweep and prints frame-time percentiles; `--screenshot PATH` saves the
 //!   window once it has drawn and exits.
 
+pub mod badges;
 pub mod measured_ui;
 pub mod panel;
 pub mod presentation;
+pub mod presets_ui;
 pub mod screenshot;
 pub mod shortcuts;
 pub mod viewer;
@@ -56,15 +58,23 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
             .and_then(AppState::from_json_str)
             .unwrap_or_else(AppState::first_run)
     };
-    if !args.models.is_empty() {
+    if !args.models.is_empty() || !args.presets.is_empty() {
         // Check all ids first, so a typo is an error rather than a half list.
         for m in &args.models {
             bv_core::find(m)?;
         }
+        let presets = args
+            .presets
+            .iter()
+            .map(|p| crate::cli::params::find_preset(p).with_context(|| format!("--preset {p}")))
+            .collect::<anyhow::Result<Vec<_>>>()?;
         state.brdfs.clear();
         state.solo = None;
         for m in &args.models {
             state.add(bv_core::ModelSpec::new(m)?);
+        }
+        for p in presets {
+            state.add_named(p.spec.clone(), Some(p.name.clone()));
         }
         if let Some(first) = state.brdfs.first() {
             state.selected = Some(first.id);
@@ -82,6 +92,9 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
     // the smoke script relies on to probe the catalogue).
     for m in &args.models {
         bv_core::find(m)?;
+    }
+    for p in &args.presets {
+        crate::cli::params::find_preset(p).with_context(|| format!("--preset {p}"))?;
     }
     if let Some(path) = &args.scene {
         // Refuse a bad scene before a window opens.

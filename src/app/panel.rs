@@ -1,5 +1,5 @@
 //! The left panel: the list of loaded BRDFs (colour, visible, solo, remove,
-//! add), the light direction (sliders and a hemisphere to drag on) and the
+//! add, property badges), the preset browser, the light direction (sliders and a hemisphere to drag on) and the
 //! selected BRDF's parameters, generated from its model's declaration.
 
 use crate::session::command::Command;
@@ -55,7 +55,16 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             if v != e.visible {
                 out.push(Command::SetVisible(e.id, v));
             }
-            let mut text = RichText::new(&name);
+            // Long names (presets, files) are shortened so that "solo" and
+            // "remove" keep their place; the full name is in the hover text.
+            const LIST_CHARS: usize = 22;
+            let shown = if name.chars().count() > LIST_CHARS {
+                let head: String = name.chars().take(LIST_CHARS - 1).collect();
+                format!("{}…", head.trim_end())
+            } else {
+                name.clone()
+            };
+            let mut text = RichText::new(shown);
             if !state.is_drawn(e) {
                 text = text.weak();
             }
@@ -64,7 +73,7 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             }
             if ui
                 .selectable_label(selected, text)
-                .on_hover_text("Show its parameters")
+                .on_hover_text(format!("{name}: show its parameters"))
                 .clicked()
             {
                 out.push(Command::Select(e.id));
@@ -87,7 +96,10 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
                 }
             });
         });
+        super::badges::row(ui, &name, e.id, runtime);
     }
+    super::badges::evidence_window(ui.ctx(), state);
+    super::presets_ui::section(ui, out);
 }
 
 /// θi and φi sliders and the hemisphere widget.

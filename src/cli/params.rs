@@ -1,15 +1,31 @@
 //! The model and parameter options shared by the sub-commands
-//! (`--model ID --param NAME=VALUE …`).
+//! (`--model ID --param NAME=VALUE …`, or `--preset NAME` for a material
+//! preset's model and parameters).
 
 use anyhow::{Context, bail};
 use bv_core::ModelSpec;
+use bv_core::presets::{self, Preset};
+use std::sync::LazyLock;
 
-/// `--model ID [--param NAME=VALUE]…`, flattened into `check` and `bench`.
+/// `--model ID [--param NAME=VALUE]…` or `--preset NAME [--param …]`,
+/// flattened into `check`, `bench` and `slice`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArgs {
     /// Model id (see `bv models`).
-    #[arg(short, long, value_name = "ID")]
-    pub model: String,
+    #[arg(
+        short,
+        long,
+        value_name = "ID",
+        required_unless_present = "preset",
+        conflicts_with = "preset"
+    )]
+    pub model: Option<String>,
+
+    /// A material preset (its model and parameters), by name or file name:
+    /// `--preset Gold`, `--preset ct1982-copper`; `--param` values apply on
+    /// top. `bv models` does not list them; an unknown name lists close ones.
+    #[arg(long, value_name = "NAME")]
+    pub preset: Option<String>,
 
     /// A parameter value, repeatable: `--param alpha=0.3`, a colour as
     /// `--param kd=0.2,0.5,0.8` (one number means grey), a choice by name
@@ -22,8 +38,111 @@ pub struct ModelArgs {
 impl ModelArgs {
     /// The validated model spec these options describe.
     pub fn spec(&self) -> anyhow::Result<ModelSpec> {
-        spec_from_cli(&self.model, &self.params)
+        match (&self.preset, &self.model) {
+            (Some(p), _) => preset_spec_from_cli(p, &self.params),
+            (None, Some(m)) => spec_from_cli(m, &self.params),
+            (None, None) => bail!("give --model ID or --preset NAME"),
+        }
     }
+}
+
+/// The shipped presets with the file name each came from (without `.toml`).
+static SHIPPED: LazyLock<Vec<(String, Preset)>> = LazyLock::new(|| {
+    presets::SHIPPED
+        .iter()
+        .filter_map(|(file, text)| {
+            let stem = file.strip_suffix(".toml").unwrap_or(file).to_string();
+            presets::parse_named(file, text).ok().map(|p| (stem, p))
+        })
+        .collect()
+});
+
+/// The same presets as one slice (what `presets::search` takes).
+static PRESETS: LazyLock<Vec<Preset>> =
+    LazyLock::new(|| SHIPPED.iter().map(|(_, p)| p.clone()).collect());
+
+/// The compiled-in presets (those that parse; the core's tests hold all).
+pub fn shipped_presets() -> &'static [Preset] {
+    &PRESETS
+}
+
+/// The shipped preset called `name` (its display name or its file name,
+/// ignoring case). An unknown name is an error listing the close matches.
+pub fn find_preset(name: &str) -> anyhow::Result<&'static Preset> {
+    let q = name.trim().to_lowercase();
+    if let Some((_, p)) = SHIPPED
+        .iter()
+        .find(|(stem, p)| p.name.to_lowercase() == q || stem.to_lowercase() == q)
+    {
+        return Ok(p);
+    }
+    let close = close_matches(&q);
+    if close.is_empty() {
+        let all: Vec<&str> = SHIPPED.iter().map(|(_, p)| p.name.as_str()).collect();
+        bail!(
+            "unknown preset `{name}`; the presets are: {}",
+            all.join(", ")
+        );
+    }
+    bail!(
+        "unknown preset `{name}`; close matches: {}",
+        close.join(", ")
+    )
+}
+
+/// Names of presets that contain the query, or whose name or file name is
+/// within a few edits of it (closest first).
+fn close_matches(q: &str) -> Vec<String> {
+    let mut scored: Vec<(usize, &str)> = SHIPPED
+        .iter()
+        .filter_map(|(stem, p)| {
+            let n = p.name.to_lowercase();
+            // The bare material word of "Copper (Cook-Torrance 1982)".
+            let head = n.split(" (").next().unwrap_or(&n).to_string();
+            let d = if !q.is_empty() && (n.contains(q) || stem.contains(q)) {
+                0
+            } else {
+                edit_distance(q, &head)
+                    .min(edit_distance(q, &n))
+                    .min(edit_distance(q, stem))
+            };
+            // A third of the query's letters wrong, at least two: a typo,
+            // not another word.
+            (d <= (q.chars().count() / 3).max(2)).then_some((d, p.name.as_str()))
+        })
+        .collect();
+    scored.sort_by_key(|&(d, n)| (d, n.len()));
+    scored
+        .into_iter()
+        .take(8)
+        .map(|(_, n)| n.to_string())
+        .collect()
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions), by
+/// characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
+/// A preset's spec with `NAME=VALUE` strings applied on top (the same
+/// parsing and messages as [`spec_from_cli`]).
+pub fn preset_spec_from_cli(name: &str, params: &[String]) -> anyhow::Result<ModelSpec> {
+    let preset = find_preset(name).with_context(|| format!("--preset {name}"))?;
+    let mut spec = preset.spec.clone();
+    apply_params(&mut spec, params)?;
+    Ok(spec)
 }
 
 /// Builds a validated [`ModelSpec`] from a model id and `NAME=VALUE` strings.
@@ -33,6 +152,12 @@ impl ModelArgs {
 /// same messages naming the parameter and its range.
 pub fn spec_from_cli(model: &str, params: &[String]) -> anyhow::Result<ModelSpec> {
     let mut spec = ModelSpec::new(model.trim()).with_context(|| format!("--model {model}"))?;
+    apply_params(&mut spec, params)?;
+    Ok(spec)
+}
+
+/// Sets `NAME=VALUE` strings on `spec`, naming the offending `--param`.
+fn apply_params(spec: &mut ModelSpec, params: &[String]) -> anyhow::Result<()> {
     for p in params {
         let Some((name, value)) = p.split_once('=') else {
             bail!("--param {p}: expected NAME=VALUE (e.g. --param alpha=0.3)");
@@ -44,7 +169,7 @@ pub fn spec_from_cli(model: &str, params: &[String]) -> anyhow::Result<ModelSpec
         spec.set_str(name, value.trim())
             .with_context(|| format!("--param {p}"))?;
     }
-    Ok(spec)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -90,5 +215,36 @@ mod tests {
         );
         assert!(msg("lambert", &["albedo=abc"]).contains("not a number"));
         assert!(msg("lambert", &["albedo=0.1,0.2"]).contains("albedo"));
+    }
+
+    #[test]
+    fn edit_distance_by_hand() {
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("gold", "gold"), 0);
+        assert_eq!(edit_distance("gld", "gold"), 1);
+    }
+
+    #[test]
+    fn presets_by_name_or_file_and_close_matches() {
+        let gold = find_preset("gold").unwrap();
+        assert_eq!(gold.name, "Gold");
+        assert_eq!(
+            find_preset("ct1982-copper").unwrap().name,
+            "Copper (Cook-Torrance 1982)"
+        );
+        let e = format!("{:#}", find_preset("Gld").unwrap_err());
+        assert!(
+            e.contains("unknown preset `Gld`") && e.contains("Gold"),
+            "{e}"
+        );
+        assert_eq!(find_preset(" COPPER ").unwrap().name, "Copper");
+        let e = format!("{:#}", find_preset("qqqqqqqqqqqq").unwrap_err());
+        assert!(e.contains("the presets are") && e.contains("Water"), "{e}");
+        // --param applies on top of the preset's values.
+        let a = preset_spec_from_cli("Gold", &[]).unwrap();
+        assert_eq!(a, gold.spec);
+        let first = gold.spec.model().params[0].id;
+        assert!(preset_spec_from_cli("Gold", &[format!("{first}=abc")]).is_err());
     }
 }

@@ -50,6 +50,12 @@ pub struct RenderArgs {
     #[arg(short, long, value_name = "ID")]
     pub model: Option<String>,
 
+    /// Draw this material preset (its model and parameters, named after it;
+    /// replaces the scene's BRDFs), e.g. `--preset Gold`; `--param` values
+    /// apply on top.
+    #[arg(long, value_name = "NAME", conflicts_with = "model")]
+    pub preset: Option<String>,
+
     /// A parameter of --model, repeatable: `--param alpha=0.3`, a colour as
     /// `--param kd=0.2,0.5,0.8`.
     #[arg(short, long = "param", value_name = "NAME=VALUE")]
@@ -164,16 +170,22 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
             }
             loaded.state
         }
-        None if a.model.is_none() => AppState::first_run(),
+        None if a.model.is_none() && a.preset.is_none() => AppState::first_run(),
         None => AppState::default(),
     };
-    if let Some(m) = &a.model {
+    if let Some(p) = &a.preset {
+        let spec = super::params::preset_spec_from_cli(p, &a.params)?;
+        let name = super::params::find_preset(p)?.name.clone();
+        state.brdfs.clear();
+        state.solo = None;
+        state.add_named(spec, Some(name));
+    } else if let Some(m) = &a.model {
         let spec = spec_from_cli(m, &a.params)?;
         state.brdfs.clear();
         state.solo = None;
         state.add(spec);
     } else if !a.params.is_empty() {
-        bail!("--param needs --model");
+        bail!("--param needs --model or --preset");
     }
     let mut inc = state.incident;
     if let Some(t) = a.theta_i {

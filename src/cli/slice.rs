@@ -241,7 +241,8 @@ mod tests {
     fn args(curve: Curve) -> SliceArgs {
         SliceArgs {
             model: ModelArgs {
-                model: "lambert".into(),
+                model: Some("lambert".into()),
+                preset: None,
                 params: vec!["albedo=0.5".into()],
             },
             curve,

@@ -12,6 +12,12 @@ pub struct ViewerArgs {
     #[arg(long = "model", value_name = "ID")]
     pub models: Vec<String>,
 
+    /// Open the viewer with these material presets (by name or file name,
+    /// e.g. `--preset Gold`; repeat for several), after any `--model`s,
+    /// instead of the saved list.
+    #[arg(long = "preset", value_name = "NAME")]
+    pub presets: Vec<String>,
+
     /// Start from the defaults: ignore the saved session and do not overwrite it.
     /// (`--screenshot` and `--bench-frames` never overwrite it either.)
     #[arg(long)]

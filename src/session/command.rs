@@ -13,6 +13,14 @@ pub enum Command {
     AddBrdf(String),
     /// Adds a BRDF with the given (validated) parameters, and selects it.
     AddSpec(ModelSpec),
+    /// Adds a BRDF with the given parameters under a name (a material
+    /// preset's), and selects it.
+    AddNamed {
+        /// The name shown for it.
+        name: String,
+        /// Its model and parameters.
+        spec: ModelSpec,
+    },
     /// Removes a BRDF.
     RemoveBrdf(u64),
     /// Shows a BRDF's parameters in the panel.
@@ -116,6 +124,9 @@ impl Command {
             },
             Command::AddSpec(spec) => {
                 state.add(spec);
+            }
+            Command::AddNamed { name, spec } => {
+                state.add_named(spec, Some(name));
             }
             Command::RemoveBrdf(id) => {
                 let pos = state.brdfs.iter().position(|b| b.id == id);

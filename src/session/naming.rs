@@ -5,6 +5,19 @@ use super::state::{AppState, BrdfEntry};
 /// The name shown for an entry: the model's name, numbered when the same
 /// model is loaded more than once ("Lambert", "Lambert 2").
 pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
+    // A chosen name (a material preset's) wins, numbered like a model's name
+    // when two entries carry it ("Gold", "Gold 2").
+    if let Some(name) = &e.name {
+        let k = state
+            .brdfs
+            .iter()
+            .filter(|b| b.name.as_deref() == Some(name.as_str()))
+            .position(|b| b.id == e.id);
+        return match k {
+            Some(0) | None => name.clone(),
+            Some(k) => format!("{name} {}", k + 1),
+        };
+    }
     // A model read from a file is named after the file, tagged with its
     // format and any choice not at its default ("gold-paint (MERL)", "gold-paint
     // (MERL, nearest)": two lookups of one file side by side).
@@ -34,7 +47,7 @@ pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
     let same: Vec<u64> = state
         .brdfs
         .iter()
-        .filter(|b| b.spec.id() == e.spec.id() && !has_file(b))
+        .filter(|b| b.spec.id() == e.spec.id() && !has_file(b) && b.name.is_none())
         .map(|b| b.id)
         .collect();
     match same.iter().position(|&id| id == e.id) {

@@ -41,6 +41,10 @@ pub struct BrdfEntry {
     pub color: [u8; 3],
     /// Whether it is drawn.
     pub visible: bool,
+    /// A name chosen for it (a material preset's), shown instead of the
+    /// model's; absent in sessions and scene files written before names.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
 }
 
 /// The incident (light) direction, in degrees because that is what the sliders
@@ -299,6 +303,13 @@ impl AppState {
     /// Adds a BRDF with the first palette colour not in use; selects it and
     /// returns its id.
     pub fn add(&mut self, spec: ModelSpec) -> u64 {
+        self.add_named(spec, None)
+    }
+
+    /// [`AppState::add`] with a display name (a preset's); an empty name
+    /// counts as none.
+    pub fn add_named(&mut self, spec: ModelSpec, name: Option<String>) -> u64 {
+        let name = name.map(|n| n.trim().to_string()).filter(|n| !n.is_empty());
         let id = self.next_id.max(1);
         self.next_id = id + 1;
         let color = PALETTE
@@ -311,6 +322,7 @@ impl AppState {
             spec,
             color,
             visible: true,
+            name,
         });
         self.selected = Some(id);
         id

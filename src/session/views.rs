@@ -48,6 +48,10 @@ pub const VIEWS: &[ViewInfo] = &[
         id: "slice",
         title: "Image slice (θh × θd)",
     },
+    ViewInfo {
+        id: "reciprocity",
+        title: "Reciprocity map",
+    },
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

@@ -24,6 +24,7 @@ pub mod lit_sphere;
 pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
+pub mod reciprocity;
 pub mod sh_overlay;
 pub mod svg;
 
@@ -102,6 +103,7 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "albedo" => || Box::new(albedo::AlbedoView::default()),
         "fresnel" => || Box::new(fresnel::FresnelView::default()),
         "slice" => || Box::new(image_slice::ImageSliceView::default()),
+        "reciprocity" => || Box::new(reciprocity::ReciprocityView::default()),
         _ => return None,
     };
     Some(make)

@@ -25,6 +25,93 @@ pub struct PolarView {
     pub plot_rect: Option<egui::Rect>,
     /// The SH overlay's curve drawn in the last frame (plot coordinates).
     pub sh_curve: Option<Vec<[f64; 2]>>,
+    /// The outgoing direction last hovered (signed in-plane angle, radians):
+    /// it stays when the pointer leaves the plot, so that the swap button
+    /// below can be reached.
+    pub pinned: Option<f64>,
+    /// Both orders of the selected BRDF at the pinned direction, as shown in
+    /// the last frame.
+    pub swap: Option<SwapReadout>,
+}
+
+/// `f(ωi, ωo)` beside `f(ωo, ωi)` at one outgoing direction: Helmholtz
+/// reciprocity read off at a point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwapReadout {
+    /// The BRDF's label.
+    pub label: String,
+    /// The outgoing direction.
+    pub wo: glam::DVec3,
+    /// `f(ωi, ωo)` (1/sr, r g b).
+    pub forward: bv_core::Rgb,
+    /// `f(ωo, ωi)`.
+    pub swapped: bv_core::Rgb,
+    /// `max_c |forward − swapped| / max(forward, swapped)` (0 where both are
+    /// 0).
+    pub rel_diff: f64,
+}
+
+impl SwapReadout {
+    /// Both orders of `brdf` for light `wi` and outgoing `wo`.
+    pub fn new(label: String, brdf: &dyn bv_core::Brdf, wi: glam::DVec3, wo: glam::DVec3) -> Self {
+        let forward = brdf.eval(wi, wo);
+        let swapped = brdf.eval(wo, wi);
+        let m = forward.max_element().max(swapped.max_element());
+        let d = (forward - swapped).abs().max_element();
+        Self {
+            label,
+            wo,
+            forward,
+            swapped,
+            rel_diff: if m > 0.0 { d / m } else { 0.0 },
+        }
+    }
+
+    /// Whether the light can be put at `wo` (above the surface, within the
+    /// slider's range).
+    pub fn can_swap(&self) -> bool {
+        self.wo.z > 0.0
+            && bv_core::frame::to_spherical(self.wo).0.to_degrees()
+                <= crate::session::state::Incident::MAX_THETA_DEG + 1e-9
+    }
+}
+
+/// The line under the readout: both orders at the pinned direction and the
+/// button that moves the light there.
+fn swap_ui(ui: &mut Ui, swap: Option<&SwapReadout>, out: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        ui.spacing_mut().item_spacing.x = 10.0;
+        let Some(s) = swap else {
+            ui.weak("hover a direction: f(ωi,ωo) beside f(ωo,ωi)");
+            return;
+        };
+        let (t, _) = bv_core::frame::to_spherical(s.wo);
+        let v = |c: bv_core::Rgb| curves::fmt_value(c.max_element());
+        let r = ui
+            .add_enabled(s.can_swap(), egui::Button::new("swap ωi and ωo").small())
+            .on_hover_text("Move the light to this outgoing direction")
+            .on_disabled_hover_text("The light cannot go below the surface or to the horizon");
+        if r.clicked() {
+            out.push(Command::SetIncident(
+                crate::session::state::Incident::from_direction(s.wo),
+            ));
+        }
+        ui.label(
+            RichText::new(format!(
+                "θo {:.1}°: f(ωi,ωo) {}  f(ωo,ωi) {}  rel. diff {}",
+                t.to_degrees(),
+                v(s.forward),
+                v(s.swapped),
+                curves::fmt_value(s.rel_diff)
+            ))
+            .monospace(),
+        )
+        .on_hover_text(format!(
+            "{}: Helmholtz reciprocity says f(ωi,ωo) = f(ωo,ωi). Values are the largest \
+             channel, 1/sr; rel. diff = |f(ωi,ωo) − f(ωo,ωi)| / max of the two.",
+            s.label
+        ));
+    });
 }
 
 /// Exact values at one hovered angle.
@@ -87,7 +174,7 @@ impl View for PolarView {
         sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
     }
 
-    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+    fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
         let d = scene.state.display;
         let (theta_i, phi_i) = (
@@ -120,7 +207,7 @@ impl View for PolarView {
         let text_col = super::strong_text(ui);
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);
-        let readout_h = if scene.figure { 0.0 } else { 22.0 };
+        let readout_h = if scene.figure { 0.0 } else { 46.0 };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         let value_name = super::value_label(d.cosine);
         let log = d.log;
@@ -314,6 +401,7 @@ impl View for PolarView {
                 FRAC_PI_2
             };
             if a.abs() <= limit {
+                self.pinned = Some(a);
                 self.readout = Some(Readout {
                     axis: "θo".into(),
                     x_deg: a.to_degrees(),
@@ -333,6 +421,17 @@ impl View for PolarView {
         }
         if !scene.figure {
             readout_ui(ui, self.readout.as_ref(), d.cosine);
+            self.swap = self.pinned.and_then(|a| {
+                let b = scene.primary()?;
+                let wo = curves::plane_direction(a, phi_i);
+                Some(SwapReadout::new(
+                    b.label.clone(),
+                    b.brdf.as_ref(),
+                    scene.wi(),
+                    wo,
+                ))
+            });
+            swap_ui(ui, self.swap.as_ref(), out);
         }
     }
 
