@@ -48,6 +48,14 @@ pub const VIEWS: &[ViewInfo] = &[
         id: "slice",
         title: "Image slice (θh × θd)",
     },
+    ViewInfo {
+        id: "snell",
+        title: "Snell's law at an interface",
+    },
+    ViewInfo {
+        id: "terms",
+        title: "Microfacet terms D, G, F",
+    },
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

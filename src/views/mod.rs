@@ -25,7 +25,9 @@ pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
 pub mod sh_overlay;
+pub mod snell;
 pub mod svg;
+pub mod terms;
 
 use crate::session::command::Command;
 pub use crate::session::frame::{Scene, SceneBrdf};
@@ -102,6 +104,8 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "albedo" => || Box::new(albedo::AlbedoView::default()),
         "fresnel" => || Box::new(fresnel::FresnelView::default()),
         "slice" => || Box::new(image_slice::ImageSliceView::default()),
+        "snell" => || Box::new(snell::SnellView::default()),
+        "terms" => || Box::new(terms::TermsView::default()),
         _ => return None,
     };
     Some(make)
