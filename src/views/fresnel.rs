@@ -544,8 +544,11 @@ impl View for FresnelView {
         } else {
             fig.strip.len() as f32 * (STRIP_ROW + 2.0) + 4.0
         };
-        let readout_h = fig.readouts.len() as f32 * (ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y);
         let size = ui.available_size();
+        // Small views (thumbnails) keep their height for the curves.
+        let readouts: &[String] = if size.y >= 260.0 { &fig.readouts } else { &[] };
+        let readout_h = readouts.len() as f32
+            * (ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y);
         let plot_h = (size.y - strip_h - readout_h).max(50.0);
         let plot = Plot::new(super::view_id("fresnel"))
             .width(size.x.max(50.0))
@@ -602,7 +605,7 @@ impl View for FresnelView {
             );
             paint_strip(ui, &fig.strip, x0, x1, rect.top() + 2.0);
         }
-        for line in &fig.readouts {
+        for line in readouts {
             ui.label(RichText::new(line).size(11.0));
         }
         self.last = Some(fig.chart.clone());

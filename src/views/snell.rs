@@ -333,9 +333,15 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
         width: 1.5,
         dash: None,
     });
-    // The normal.
+    // The normal; on the light's side it stops short of Snell's window's
+    // label when there is one.
+    let (n_lo, n_hi) = match (d.tir_range.is_some(), s > 0.0) {
+        (true, true) => (y0, 0.74),
+        (true, false) => (-0.74, y1),
+        (false, _) => (y0, y1),
+    };
     p.push(Prim::Line {
-        points: vec![DVec2::new(0.0, y0), DVec2::new(0.0, y1)],
+        points: vec![DVec2::new(0.0, n_lo), DVec2::new(0.0, n_hi)],
         color: c.weak,
         width: 1.0,
         dash: Some(5.0),
@@ -648,6 +654,9 @@ pub struct SnellView {
     pub from_below: bool,
     /// The figure of the last frame (for tests).
     pub last: Option<SnellFigure>,
+    /// Where it was drawn, and the hit point's position and points per
+    /// diagram unit there (for tests that drag the light).
+    pub last_rect: Option<(egui::Rect, Pos2, f32)>,
 }
 
 impl Default for SnellView {
@@ -657,6 +666,7 @@ impl Default for SnellView {
             use_own: false,
             from_below: false,
             last: None,
+            last_rect: None,
         }
     }
 }
@@ -717,9 +727,8 @@ impl View for SnellView {
         }
         if !has_dielectric || self.use_own {
             ui.add(
-                egui::Slider::new(&mut self.eta, 1.0..=3.0)
-                    .text("η")
-                    .max_decimals(3),
+                // No max_decimals: it would round the preset's 4/3 to 1.333.
+                egui::Slider::new(&mut self.eta, 1.0..=3.0).text("η"),
             );
         }
         if ui
@@ -744,6 +753,8 @@ impl View for SnellView {
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, super::figure_fill(ui, scene));
         paint(&painter, rect, &fig);
+        let (centre, scale, _, _) = fit(rect);
+        self.last_rect = Some((rect, centre, scale));
         if !scene.figure {
             let response = response.on_hover_text("Drag to move the light");
             if (response.dragged() || response.clicked())
