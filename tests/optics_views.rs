@@ -206,7 +206,10 @@ fn fresnel_view_overlays_every_brdf_with_a_term() {
     let labels: Vec<&str> = f.chart.series.iter().map(|s| s.label.as_str()).collect();
     // The glass's F, then copper in detail: Rs, Rp (green), F and Schlick per
     // channel.
-    assert!(labels.iter().any(|l| l.starts_with("Glass: F")), "{labels:?}");
+    assert!(
+        labels.iter().any(|l| l.starts_with("Glass: F")),
+        "{labels:?}"
+    );
     assert!(labels.iter().any(|l| l.contains("Rs (g)")), "{labels:?}");
     assert_eq!(
         labels.iter().filter(|l| l.contains("Schlick")).count(),
@@ -220,7 +223,10 @@ fn fresnel_view_overlays_every_brdf_with_a_term() {
     let first = f.strip[0].linear[0];
     let last = *f.strip[0].linear.last().unwrap();
     assert!(first.x > first.y && first.y > first.z, "{first}");
-    assert!((last - bv_core::Rgb::ONE).abs().max_element() < 1e-9, "{last}");
+    assert!(
+        (last - bv_core::Rgb::ONE).abs().max_element() < 1e-9,
+        "{last}"
+    );
     // The readouts give k back from F0 and η: copper's own k.
     assert!(
         f.readouts[1].contains("3.912 / 2.452 / 2.142"),

@@ -172,10 +172,7 @@ pub fn readouts(f: &Fresnel) -> Vec<String> {
             let kk = |c: usize| optics::conductor_k_from_f0(f0[c], eta[c]).unwrap_or(f64::NAN);
             let back = Rgb::new(kk(0), kk(1), kk(2));
             vec![
-                format!(
-                    "F0 = ((η − 1)² + k²)/((η + 1)² + k²) = {}",
-                    fmt3(f0, 4)
-                ),
+                format!("F0 = ((η − 1)² + k²)/((η + 1)² + k²) = {}", fmt3(f0, 4)),
                 format!(
                     "k = √(((η + 1)² F0 − (η − 1)²)/(1 − F0)) = {}, given η = {}",
                     fmt3(back, 3),
@@ -597,12 +594,14 @@ impl View for FresnelView {
         if !fig.strip.is_empty() {
             // Aligned with the plot's own 0° and 90°.
             let t = &response.transform;
-            let x0 = t.position_from_point(&egui_plot::PlotPoint::new(0.0, 0.0)).x;
-            let x1 = t.position_from_point(&egui_plot::PlotPoint::new(90.0, 0.0)).x;
-            let (rect, _) = ui.allocate_exact_size(
-                egui::vec2(size.x.max(50.0), strip_h),
-                egui::Sense::hover(),
-            );
+            let x0 = t
+                .position_from_point(&egui_plot::PlotPoint::new(0.0, 0.0))
+                .x;
+            let x1 = t
+                .position_from_point(&egui_plot::PlotPoint::new(90.0, 0.0))
+                .x;
+            let (rect, _) =
+                ui.allocate_exact_size(egui::vec2(size.x.max(50.0), strip_h), egui::Sense::hover());
             paint_strip(ui, &fig.strip, x0, x1, rect.top() + 2.0);
         }
         for line in readouts {

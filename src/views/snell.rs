@@ -416,7 +416,11 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
     let mut details = vec![
         format!(
             "light from {}",
-            if interface.from_below { "below" } else { "above" }
+            if interface.from_below {
+                "below"
+            } else {
+                "above"
+            }
         ),
         format!(
             "ηi = {}, ηt = {} ({})",
@@ -628,15 +632,7 @@ fn to_svg(fig: &SnellFigure, size: [f32; 2], background: Option<Color32>) -> Str
                     egui::Align::Center => Baseline::Middle,
                     egui::Align::Max => Baseline::Bottom,
                 };
-                svg.text(
-                    at,
-                    text,
-                    *size * text_scale,
-                    *color,
-                    anchor,
-                    baseline,
-                    None,
-                );
+                svg.text(at, text, *size * text_scale, *color, anchor, baseline, None);
             }
         }
     }
@@ -745,7 +741,9 @@ impl View for SnellView {
         let interface = self.interface(scene);
         let Some(fig) = snell_figure(scene.incident.theta_deg.to_radians(), &interface, dark)
         else {
-            ui.label(RichText::new(format!("η = {} is not a refractive index", interface.eta)).weak());
+            ui.label(
+                RichText::new(format!("η = {} is not a refractive index", interface.eta)).weak(),
+            );
             self.last = None;
             return;
         };
@@ -832,7 +830,12 @@ mod tests {
         })
         .unwrap();
         assert!((e - 1.5).abs() < 1e-15);
-        assert_eq!(dielectric_eta(&Fresnel::Schlick { f0: Rgb::splat(0.04) }), None);
+        assert_eq!(
+            dielectric_eta(&Fresnel::Schlick {
+                f0: Rgb::splat(0.04)
+            }),
+            None
+        );
         assert_eq!(dielectric_eta(&Fresnel::None), None);
     }
 

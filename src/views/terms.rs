@@ -245,11 +245,7 @@ fn d_chart(mut series: Vec<Series>, log: bool) -> Chart {
             .filter(|k| k.rem_euclid(every as i32) == 0)
             .map(|k| (f64::from(k), super::decade_label(k)))
             .collect();
-        (
-            (r.bottom, r.top),
-            ticks,
-            "D (1/sr, log scale)".to_string(),
-        )
+        ((r.bottom, r.top), ticks, "D (1/sr, log scale)".to_string())
     } else {
         let top = values().filter(|v| v.is_finite()).fold(0.0, f64::max);
         let top = top.max(1e-6) * 1.15;
@@ -368,10 +364,11 @@ impl View for TermsView {
             ui.label(RichText::new("no term is switched on").weak());
         } else {
             let spacing = ui.spacing().item_spacing.y;
-            let height = (ui.available_height() - spacing * (shown.len() as f32 - 1.0))
-                / shown.len() as f32;
+            let height =
+                (ui.available_height() - spacing * (shown.len() as f32 - 1.0)) / shown.len() as f32;
             for (k, c) in shown.iter().enumerate() {
-                let log_y = self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
+                let log_y =
+                    self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
                 plot_chart(ui, super::view_id("terms").with(k), c, height, log_y);
             }
         }
@@ -456,12 +453,7 @@ mod tests {
         // 2/(1 + √(1 + α² tan²θ)).
         let g = c.g.as_ref().unwrap();
         let g1 = g.series.iter().find(|s| s.label.contains("G1")).unwrap();
-        let at = |s: &Series, x: f64| {
-            s.points
-                .iter()
-                .find(|p| (p[0] - x).abs() < 1e-9)
-                .unwrap()[1]
-        };
+        let at = |s: &Series, x: f64| s.points.iter().find(|p| (p[0] - x).abs() < 1e-9).unwrap()[1];
         let want = 2.0 / (1.0 + (1.0 + 0.09 * 3.0f64).sqrt());
         assert!((at(g1, 60.0) - want).abs() < 1e-12);
         assert!((at(g1, -60.0) - want).abs() < 1e-12);

@@ -465,7 +465,10 @@ mod tests {
             let e = tn * tn * (ph.cos().powi(2) / (ax * ax) + ph.sin().powi(2) / (ay * ay));
             let want = 1.0 / (PI * ax * ay * (1.0 + e).powi(2) * c.powi(4));
             let got = (t.d)(h);
-            assert!((got - want).abs() <= 1e-12 * want, "θ {th}: {got} vs {want}");
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "θ {th}: {got} vs {want}"
+            );
         }
         // Smith G1 of GGX (Heitz 2014, eq. 86):
         // 2/(1 + √(1 + α(φ)² tan²θ)), α(φ)² = cos²φ αx² + sin²φ αy².
@@ -482,8 +485,10 @@ mod tests {
         assert!((g2 - g1(0.9, 0.2) * g1(1.2, 2.5)).abs() < 1e-14);
         // They are the terms eval uses: with everything but the specular lobe
         // off (metallic 1, white base), f = F D G2/(4 cos cos), F from Schlick.
-        let m = plain(json!({"roughness": 0.6, "anisotropic": 0.5, "metallic": 1.0,
-            "base_color": 1.0}));
+        let m = plain(
+            json!({"roughness": 0.6, "anisotropic": 0.5, "metallic": 1.0,
+            "base_color": 1.0}),
+        );
         let tm = m.microfacet_terms().unwrap();
         let want = (tm.d)(h) * (tm.g2)(wi, wo, h) / (4.0 * wi.z * wo.z);
         assert!((m.eval(wi, wo).x - want).abs() < 1e-12 * want, "{want}");
