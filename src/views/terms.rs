@@ -256,9 +256,24 @@ fn d_chart(mut series: Vec<Series>, log: bool) -> Chart {
         )
     };
     if log {
+        // Below the axis' 12 decades a curve leaves through the bottom edge
+        // (an underflowed D would otherwise be a point at −1000 decades).
+        // The first point below the floor is kept on it, the rest break the
+        // line (NaN).
+        let floor = y_range.0 - 1.0;
         for s in &mut series {
+            let mut below = false;
             for p in &mut s.points {
-                p[1] = curves::log_ordinate(p[1]);
+                let y = curves::log_ordinate(p[1]);
+                p[1] = if y >= floor {
+                    below = false;
+                    y
+                } else if below {
+                    f64::NAN
+                } else {
+                    below = true;
+                    floor
+                };
             }
         }
     }
@@ -326,13 +341,20 @@ fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
             pui.vline(v);
         }
         for s in &c.series {
-            let mut l = Line::new(s.label.clone(), PlotPoints::from(s.points.clone()))
-                .color(s.color)
-                .width(s.width);
-            if let Some(d) = s.dash {
-                l = l.style(LineStyle::Dashed { length: d });
+            // Non-finite points break a curve into pieces (one legend entry:
+            // egui_plot merges equal names).
+            for piece in s.points.split(|p| !(p[0].is_finite() && p[1].is_finite())) {
+                if piece.is_empty() {
+                    continue;
+                }
+                let mut l = Line::new(s.label.clone(), PlotPoints::from(piece.to_vec()))
+                    .color(s.color)
+                    .width(s.width);
+                if let Some(d) = s.dash {
+                    l = l.style(LineStyle::Dashed { length: d });
+                }
+                pui.line(l);
             }
-            pui.line(l);
         }
     });
 }
@@ -369,7 +391,9 @@ impl View for TermsView {
             for (k, c) in shown.iter().enumerate() {
                 let log_y =
                     self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
-                plot_chart(ui, super::view_id("terms").with(k), c, height, log_y);
+                // The scale is part of the id: each keeps its own zoom.
+                let id = super::view_id("terms").with((k, log_y));
+                plot_chart(ui, id, c, height, log_y);
             }
         }
         self.last = Some(charts);
@@ -476,6 +500,37 @@ mod tests {
         );
         let dl = &log.d.unwrap().series[0];
         assert!((dl.points[0][1] - d.points[0][1].log10()).abs() < 1e-12);
+        // Beckmann underflows to 0 before the horizon: on the log axis it
+        // leaves through the bottom edge instead of dragging the axis down.
+        let beckmann = ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"alpha": 0.1, "distribution": "beckmann"}),
+        )
+        .unwrap();
+        let scene_b = Scene {
+            brdfs: scene_of(&state, &[beckmann]),
+            ..scene
+        };
+        let c = term_charts(
+            &scene_b,
+            TermToggles {
+                log_d: true,
+                ..TermToggles::default()
+            },
+            true,
+        )
+        .d
+        .unwrap();
+        let pts = &c.series[0].points;
+        let floor = c.y_range.0 - 1.0;
+        let first_gone = pts.iter().position(|p| p[1].is_nan() || p[1] <= floor).unwrap();
+        assert_eq!(pts[first_gone][1], floor);
+        assert!(pts[first_gone + 1..].iter().all(|p| p[1].is_nan()));
+        assert!(
+            c.y_range.1 - c.y_range.0 <= curves::LOG_DECADES + 2.0,
+            "{:?}",
+            c.y_range
+        );
         // Switched off terms have no chart; the list moves to the next one.
         let only_f = term_charts(
             &scene,
