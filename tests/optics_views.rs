@@ -2,6 +2,9 @@
 //! harness: each draws a picture, the toolbar's toggles and presets change
 //! what it shows, and dragging in the Snell view moves the light.
 
+// Test code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::session::frame::{Scene, build_scene};
 use bv::session::runtime::Runtime;
 use bv::session::state::AppState;

@@ -231,6 +231,29 @@ fn fmt_eta(x: f64) -> String {
     super::curves::fmt_tick(super::curves::round_significant(x, 4))
 }
 
+/// Where the label of an angle `a` from the upward normal goes, on the side
+/// `side` (−1 left, +1 right): on the bisector of a wide wedge, else beside
+/// the ray's end of the arc (a narrow wedge has no room inside).
+fn angle_label_place(a: f64, side: f64) -> (DVec2, Align2) {
+    if a > 40f64.to_radians() {
+        let b = 0.5 * a;
+        (
+            DVec2::new(side * 0.45 * b.sin(), 0.45 * b.cos()),
+            Align2::CENTER_CENTER,
+        )
+    } else {
+        let align = if side < 0.0 {
+            Align2::RIGHT_CENTER
+        } else {
+            Align2::LEFT_CENTER
+        };
+        (
+            DVec2::new(side * (0.3 * a.sin() + 0.06), 0.3 * a.cos()),
+            align,
+        )
+    }
+}
+
 /// A label at `at` (line 0, not a detail).
 fn label(at: DVec2, text: String, color: Color32, size: f32, align: Align2) -> Prim {
     Prim::Text {
@@ -397,13 +420,15 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
         width: 1.2,
         dash: None,
     });
-    // Angle labels start where the arc meets the ray, outside the wedge.
+    // Angle labels: inside a wide wedge on its bisector, else just outside
+    // it, where the arc meets the ray.
+    let (at, align) = angle_label_place(ti, -1.0);
     p.push(label(
-        flip(DVec2::new(-0.3 * ti.sin() - 0.06, 0.3 * ti.cos())),
+        flip(at),
         format!("θi = {:.1}°", ti.to_degrees()),
         c.light,
         13.0,
-        Align2::RIGHT_CENTER,
+        align,
     ));
     p.push(label(
         flip(d.reflected * 1.03),
@@ -453,12 +478,13 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
                 width: 1.2,
                 dash: None,
             });
+            let (at, align) = angle_label_place(tt, 1.0);
             p.push(label(
-                flip(DVec2::new(0.3 * tt.sin() + 0.06, -0.3 * tt.cos())),
+                flip(DVec2::new(at.x, -at.y)),
                 format!("θt = {:.1}°", tt.to_degrees()),
                 c.refr,
                 13.0,
-                Align2::LEFT_CENTER,
+                align,
             ));
             p.push(label(
                 flip(t * 1.03),

@@ -523,7 +523,10 @@ mod tests {
         .unwrap();
         let pts = &c.series[0].points;
         let floor = c.y_range.0 - 1.0;
-        let first_gone = pts.iter().position(|p| p[1].is_nan() || p[1] <= floor).unwrap();
+        let first_gone = pts
+            .iter()
+            .position(|p| p[1].is_nan() || p[1] <= floor)
+            .unwrap();
         assert_eq!(pts[first_gone][1], floor);
         assert!(pts[first_gone + 1..].iter().all(|p| p[1].is_nan()));
         assert!(
