@@ -202,11 +202,12 @@ fn the_fresnel_view_follows_the_selected_brdf() {
         .last
         .clone()
         .unwrap();
-    // Cook-Torrance's default is a dielectric of η = 1.5: Rp, Rs, F, F inside;
-    // Brewster's angle atan 1.5 = 56.31°, the critical angle asin(1/1.5) = 41.81°.
+    // Cook-Torrance's default is a dielectric of η = 1.5: Rp, Rs, F, F inside
+    // and Schlick's of the same F0 = 0.04 (dashed); Brewster's angle
+    // atan 1.5 = 56.31°, the critical angle asin(1/1.5) = 41.81°.
     assert_eq!(
         c.series.len(),
-        4,
+        5,
         "{:?}",
         c.series.iter().map(|s| &s.label).collect::<Vec<_>>()
     );
@@ -238,6 +239,18 @@ fn the_fresnel_view_follows_the_selected_brdf() {
         .last
         .clone()
         .unwrap();
-    assert!(c.series.is_empty());
-    assert!(c.note.contains("no Fresnel term"), "{}", c.note);
+    // Lambert selected: it is listed as having no term, and Cook-Torrance,
+    // still drawn, keeps its F alone.
+    assert_eq!(
+        c.series.len(),
+        1,
+        "{:?}",
+        c.series.iter().map(|s| &s.label).collect::<Vec<_>>()
+    );
+    assert!(c.series[0].label.starts_with("F (dielectric)"));
+    assert!(
+        c.note.lines().next().unwrap().contains("no Fresnel term"),
+        "{}",
+        c.note
+    );
 }

@@ -316,7 +316,7 @@ fn bad_requests_fail_with_a_clear_message() {
 #[test]
 fn svg_plots_parse_as_xml_and_carry_the_curves() {
     let dir = out_dir("svg");
-    for v in ["polar", "cartesian", "albedo", "fresnel"] {
+    for v in ["polar", "cartesian", "albedo", "fresnel", "snell", "terms"] {
         let p = dir.join(format!("{v}.svg"));
         run(&[
             "render",
@@ -372,7 +372,7 @@ fn svg_plots_parse_as_xml_and_carry_the_curves() {
         "--out",
         &all.to_string_lossy(),
     ]);
-    for v in ["polar", "cartesian", "albedo", "fresnel"] {
+    for v in ["polar", "cartesian", "albedo", "fresnel", "snell", "terms"] {
         assert!(all.join(format!("{v}.svg")).exists(), "{v}.svg");
     }
     assert!(!all.join("lobe.svg").exists());

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
     drawing code, rendered offscreen with wgpu (on a machine without a GPU, Mesa's lavapipe: \
     apt install mesa-vulkan-drivers libvulkan1).\n\n\
     The output's extension picks the format: .png (any view), .svg (2D plots: polar, \
-    cartesian, albedo, fresnel), .obj or .ply (the lobe's mesh, for Blender). With --view all, \
+    cartesian, albedo, fresnel, snell, terms), .obj or .ply (the lobe's mesh, for Blender). With --view all, \
     --out is a folder and gets one <view>.png per view (and <view>.svg for the 2D plots with \
     --svg).\n\n\
     Example (every figure of a lecture, one shell loop):\n  \

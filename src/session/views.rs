@@ -52,6 +52,14 @@ pub const VIEWS: &[ViewInfo] = &[
         id: "reciprocity",
         title: "Reciprocity map",
     },
+    ViewInfo {
+        id: "snell",
+        title: "Snell's law at an interface",
+    },
+    ViewInfo {
+        id: "terms",
+        title: "Microfacet terms D, G, F",
+    },
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

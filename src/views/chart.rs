@@ -183,13 +183,29 @@ impl Chart {
         if let Some(bg) = pal.background {
             svg.rect([0.0, 0.0], [w, h], Some(bg), None);
         }
-        let font = 12.0;
+        self.draw(&mut svg, [w, h], pal);
+        svg.finish()
+    }
+
+    /// The plot's frame inside a chart of `size` points: its top-left corner
+    /// and size (the axes' labels lie outside it).
+    pub fn plot_area(&self, size: [f32; 2]) -> ([f32; 2], [f32; 2]) {
+        let [w, h] = size;
         let top = if self.title.is_empty() { 10.0 } else { 28.0 };
-        let left = 62.0;
-        let bottom = 44.0;
-        let right = 14.0;
-        let pmin = [left, top];
-        let psize = [(w - left - right).max(20.0), (h - top - bottom).max(20.0)];
+        let (left, bottom, right) = (62.0, 44.0, 14.0);
+        (
+            [left, top],
+            [(w - left - right).max(20.0), (h - top - bottom).max(20.0)],
+        )
+    }
+
+    /// Draws the chart (without a background) into `svg` over `[0, 0]..size`
+    /// of its current coordinates: several charts share one document through
+    /// [`Svg::begin_translate`].
+    pub fn draw(&self, svg: &mut Svg, size: [f32; 2], pal: Palette) {
+        let [w, h] = size;
+        let font = 12.0;
+        let (pmin, psize) = self.plot_area(size);
         let (x0, x1) = self.x_range;
         let (y0, y1) = self.y_range;
         let sx = |x: f64| pmin[0] + ((x - x0) / (x1 - x0)) as f32 * psize[0];
@@ -329,8 +345,7 @@ impl Chart {
                 );
             }
         }
-        legend(&mut svg, &self.series, [pmin[0] + psize[0], pmin[1]], pal);
-        svg.finish()
+        legend(svg, &self.series, [pmin[0] + psize[0], pmin[1]], pal);
     }
 }
 

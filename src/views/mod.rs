@@ -26,7 +26,9 @@ pub mod lobe_gpu;
 pub mod polar;
 pub mod reciprocity;
 pub mod sh_overlay;
+pub mod snell;
 pub mod svg;
+pub mod terms;
 
 use crate::session::command::Command;
 pub use crate::session::frame::{Scene, SceneBrdf};
@@ -104,6 +106,8 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "fresnel" => || Box::new(fresnel::FresnelView::default()),
         "slice" => || Box::new(image_slice::ImageSliceView::default()),
         "reciprocity" => || Box::new(reciprocity::ReciprocityView::default()),
+        "snell" => || Box::new(snell::SnellView::default()),
+        "terms" => || Box::new(terms::TermsView::default()),
         _ => return None,
     };
     Some(make)

@@ -224,6 +224,18 @@ impl Svg {
         );
     }
 
+    /// Starts a group whose contents are shifted by `offset` (end it with
+    /// [`Svg::end_group`]): one figure made of several panels.
+    pub fn begin_translate(&mut self, offset: [f32; 2]) {
+        let _ = writeln!(
+            self.body,
+            r#"<g transform="translate({} {})">"#,
+            n(offset[0]),
+            n(offset[1])
+        );
+        self.open_groups += 1;
+    }
+
     /// Starts a group clipped to a rectangle (end it with [`Svg::end_group`]).
     pub fn begin_clip(&mut self, min: [f32; 2], size: [f32; 2]) {
         self.clips += 1;

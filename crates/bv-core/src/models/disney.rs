@@ -4,7 +4,7 @@
 //! `Cdlum = 0.3R + 0.6G + 0.1B`, specular G = separable Smith GGX with (αx, αy).
 
 use crate::fresnel::schlick_weight;
-use crate::microfacet::{self, Distribution, Geometry, Microfacet};
+use crate::microfacet::{self, Distribution, Microfacet};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -256,17 +256,20 @@ impl Brdf for Disney {
         INFO.id
     }
 
-    /// The specular lobe's terms: GTR2 (= GGX) D with Burley's anisotropic
-    /// αx, αy, and separable Smith GGX G (the clearcoat's GTR1 lobe is a
-    /// second, fixed-roughness lobe and is not part of these terms).
+    /// The specular lobe's terms: D = GTR2, i.e. anisotropic GGX (Burley
+    /// 2012, appendix B.2, eq. 13), and the separable Smith G of GGX,
+    /// `G2 = G1(wi) G1(wo)` with `G1 = 1/(1 + Λ)` (Heitz 2014, eqs. 43, 86 and
+    /// 98), as `eval` multiplies them. The clearcoat's GTR1 lobe is not
+    /// included.
     fn microfacet_terms(&self) -> Option<MicrofacetTerms> {
         let ndf = self.spec.0;
+        let g1 = move |w: DVec3| if w.z > 0.0 { ndf.g1(w) } else { 0.0 };
         Some(MicrofacetTerms {
-            distribution: "GTR2 (GGX)".to_string(),
-            geometry: "separable Smith".to_string(),
+            distribution: "GTR2 (GGX)".into(),
+            geometry: "separable Smith (Burley 2012)".into(),
             d: Arc::new(move |h| ndf.d(h)),
-            g1: Arc::new(move |w| if w.z > 0.0 { ndf.g1(w) } else { 0.0 }),
-            g2: Arc::new(move |wi, wo, h| ndf.g(Geometry::Smith, wi, wo, h)),
+            g1: Arc::new(g1),
+            g2: Arc::new(move |wi, wo, _h| g1(wi) * g1(wo)),
         })
     }
 
@@ -465,6 +468,51 @@ mod tests {
         let gtr1_hand = (0.01 - 1.0) / (PI * (-2.0 * std::f64::consts::LN_10) * 0.01);
         assert!((gtr1_hand - 6.842_891).abs() < 1e-6);
         assert!((f.x - 0.66 / PI - 0.25 * 0.04 * gtr1_hand / 4.0).abs() < 1e-13);
+    }
+
+    #[test]
+    fn microfacet_terms_are_gtr2_and_separable_smith() {
+        // roughness 0.6, anisotropic 0.5: aspect = √0.55, αx = 0.36/aspect,
+        // αy = 0.36 · aspect.
+        let b = plain(json!({"roughness": 0.6, "anisotropic": 0.5}));
+        let t = b.microfacet_terms().unwrap();
+        let aspect = 0.55f64.sqrt();
+        let (ax, ay) = (0.36 / aspect, 0.36 * aspect);
+        // GTR2 (Burley 2012, eq. 13): 1/(π αx αy (tan²θ(cos²φ/αx² + sin²φ/αy²)
+        // + 1)² cos⁴θ), in spherical angles.
+        for (th, ph) in [(0.0, 0.0), (0.4, 0.3), (1.1, 2.0), (1.5, -0.7)] {
+            let h = from_spherical(th, ph);
+            let (c, tn) = (f64::cos(th), f64::tan(th));
+            let e = tn * tn * (ph.cos().powi(2) / (ax * ax) + ph.sin().powi(2) / (ay * ay));
+            let want = 1.0 / (PI * ax * ay * (1.0 + e).powi(2) * c.powi(4));
+            let got = (t.d)(h);
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "θ {th}: {got} vs {want}"
+            );
+        }
+        // Smith G1 of GGX (Heitz 2014, eq. 86):
+        // 2/(1 + √(1 + α(φ)² tan²θ)), α(φ)² = cos²φ αx² + sin²φ αy².
+        let g1 = |th: f64, ph: f64| {
+            let a2 = ph.cos().powi(2) * ax * ax + ph.sin().powi(2) * ay * ay;
+            2.0 / (1.0 + (1.0 + a2 * th.tan().powi(2)).sqrt())
+        };
+        let (wi, wo) = (from_spherical(0.9, 0.2), from_spherical(1.2, 2.5));
+        assert!(((t.g1)(wi) - g1(0.9, 0.2)).abs() < 1e-14);
+        assert_eq!((t.g1)(DVec3::Z), 1.0);
+        assert_eq!((t.g1)(from_spherical(1.7, 0.0)), 0.0);
+        let h = (wi + wo).normalize();
+        let g2 = (t.g2)(wi, wo, h);
+        assert!((g2 - g1(0.9, 0.2) * g1(1.2, 2.5)).abs() < 1e-14);
+        // They are the terms eval uses: with everything but the specular lobe
+        // off (metallic 1, white base), f = F D G2/(4 cos cos), F from Schlick.
+        let m = plain(
+            json!({"roughness": 0.6, "anisotropic": 0.5, "metallic": 1.0,
+            "base_color": 1.0}),
+        );
+        let tm = m.microfacet_terms().unwrap();
+        let want = (tm.d)(h) * (tm.g2)(wi, wo, h) / (4.0 * wi.z * wo.z);
+        assert!((m.eval(wi, wo).x - want).abs() < 1e-12 * want, "{want}");
     }
 
     #[test]
