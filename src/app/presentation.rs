@@ -151,36 +151,46 @@ pub fn bottom_strip(ui: &mut Ui, shown: &str, deck: bool, controls: bool) -> Vec
                 if ui.button(t("»")).on_hover_text(forward).clicked() {
                     out.push(StripAction::Step(1));
                 }
-                ui.separator();
-                for e in REGISTRY.iter() {
+                // The presenter's controls stay at the right edge; the view
+                // names take the width between.
+                ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
-                        .selectable_label(e.id == shown, t(&short_name(e.id)))
-                        .on_hover_text(e.title)
+                        .button(t("exit"))
+                        .on_hover_text("Leave presentation mode (F5 or Esc)")
                         .clicked()
                     {
-                        out.push(StripAction::View(e.id));
+                        out.push(StripAction::Exit);
                     }
-                }
-                ui.separator();
-                let label = if controls {
-                    "hide controls"
-                } else {
-                    "controls"
-                };
-                if ui
-                    .selectable_label(controls, t(label))
-                    .on_hover_text("Show the BRDFs and parameters to edit the scene live")
-                    .clicked()
-                {
-                    out.push(StripAction::ToggleControls);
-                }
-                if ui
-                    .button(t("exit"))
-                    .on_hover_text("Leave presentation mode (F5 or Esc)")
-                    .clicked()
-                {
-                    out.push(StripAction::Exit);
-                }
+                    let label = if controls {
+                        "hide controls"
+                    } else {
+                        "controls"
+                    };
+                    if ui
+                        .selectable_label(controls, t(label))
+                        .on_hover_text("Show the BRDFs and parameters to edit the scene live")
+                        .clicked()
+                    {
+                        out.push(StripAction::ToggleControls);
+                    }
+                    ui.separator();
+                    ui.with_layout(egui::Layout::left_to_right(egui::Align::Center), |ui| {
+                        ui.separator();
+                        // Wrapped onto a second row when there are more
+                        // views than fit: every name stays one click away.
+                        ui.horizontal_wrapped(|ui| {
+                            for e in REGISTRY.iter() {
+                                if ui
+                                    .selectable_label(e.id == shown, t(&short_name(e.id)))
+                                    .on_hover_text(e.title)
+                                    .clicked()
+                                {
+                                    out.push(StripAction::View(e.id));
+                                }
+                            }
+                        });
+                    });
+                });
             });
         });
     out

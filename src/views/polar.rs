@@ -81,8 +81,9 @@ impl SwapReadout {
 fn swap_ui(ui: &mut Ui, swap: Option<&SwapReadout>, out: &mut Vec<Command>) {
     ui.horizontal(|ui| {
         ui.spacing_mut().item_spacing.x = 10.0;
+        // Nothing hovered yet: the line stays empty rather than adding a
+        // second hint under the plot's own "hover a plot" line.
         let Some(s) = swap else {
-            ui.weak("hover a direction: f(ωi,ωo) beside f(ωo,ωi)");
             return;
         };
         let (t, _) = bv_core::frame::to_spherical(s.wo);
@@ -207,7 +208,15 @@ impl View for PolarView {
         let text_col = super::strong_text(ui);
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);
-        let readout_h = if scene.figure { 0.0 } else { 46.0 };
+        // Room for the readout line, and for the swap line once a direction
+        // has been hovered (before that it would be an empty band).
+        let readout_h = if scene.figure {
+            0.0
+        } else if self.pinned.is_some() {
+            46.0
+        } else {
+            22.0
+        };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         let value_name = super::value_label(d.cosine);
         let log = d.log;
@@ -431,7 +440,9 @@ impl View for PolarView {
                     wo,
                 ))
             });
-            swap_ui(ui, self.swap.as_ref(), out);
+            if self.swap.is_some() {
+                swap_ui(ui, self.swap.as_ref(), out);
+            }
         }
     }
 

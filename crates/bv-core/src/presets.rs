@@ -202,8 +202,6 @@ shipped![
     "nickel.toml",
     "sapphire.toml",
     "silver.toml",
-    "tin.toml",
-    "titanium.toml",
     "tungsten.toml",
     "water-from-below.toml",
     "water.toml",
