@@ -448,9 +448,13 @@ impl Viewer {
     /// (building its renderer, or the environment view sampling towards its
     /// target): screenshots wait for them.
     pub fn views_busy(&self) -> bool {
-        // A view is hidden only by another one being maximised.
-        let shown = |id: &str| self.state.maximised.as_deref().is_none_or(|m| m == id);
-        self.views.iter().any(|(e, v)| shown(e.id) && v.busy())
+        // A view is hidden by another one being maximised, or by being
+        // outside the overview grid.
+        let shown = |e: &ViewEntry| match self.state.maximised.as_deref() {
+            Some(m) => m == e.id,
+            None => e.in_grid,
+        };
+        self.views.iter().any(|(e, v)| shown(e) && v.busy())
     }
 
     /// Whether the help overlay is open.
@@ -617,6 +621,19 @@ impl Viewer {
                 {
                     self.set_presenting(true);
                 }
+                ui.menu_button("Views", |ui| {
+                    for e in REGISTRY.iter() {
+                        let on = self.state.maximised.as_deref() == Some(e.id);
+                        if ui
+                            .selectable_label(on, e.title)
+                            .on_hover_text("Show this view alone (again: back to the overview)")
+                            .clicked()
+                        {
+                            out.push(Command::ToggleMaximise(e.id.to_string()));
+                            ui.close();
+                        }
+                    }
+                });
                 ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
                     if ui
                         .button("? help")
@@ -887,7 +904,14 @@ fn central(
         .maximised
         .as_deref()
         .and_then(|id| views.iter().position(|(e, _)| e.id == id));
-    for (i, rect) in layout(area, views.len(), maximised) {
+    // The grid holds the overview views; a view outside it is shown when it
+    // is the maximised one.
+    let shown: Vec<usize> = (0..views.len())
+        .filter(|&i| views[i].0.in_grid || maximised == Some(i))
+        .collect();
+    let max_in_shown = maximised.and_then(|m| shown.iter().position(|&i| i == m));
+    for (k, rect) in layout(area, shown.len(), max_in_shown) {
+        let i = shown[k];
         let (entry, view) = &mut views[i];
         let is_max = maximised == Some(i);
         ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {

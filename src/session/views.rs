@@ -11,6 +11,11 @@ pub struct ViewInfo {
     pub id: &'static str,
     /// Title in the view's header.
     pub title: &'static str,
+    /// Whether the window's overview grid shows it. Views that need the
+    /// whole window to read (the lecture's diagrams) are left out of the
+    /// grid and shown maximised: from the *Views* menu, presentation mode's
+    /// strip, or `bv render --view`.
+    pub in_grid: bool,
 }
 
 /// Every view, in layout order (the first two share the top row, the others
@@ -19,46 +24,57 @@ pub const VIEWS: &[ViewInfo] = &[
     ViewInfo {
         id: "lobe",
         title: "3D lobe",
+        in_grid: true,
     },
     ViewInfo {
         id: "lit_sphere",
         title: "Lit sphere",
+        in_grid: true,
     },
     ViewInfo {
         id: "polar",
         title: "Plane of incidence (polar)",
+        in_grid: true,
     },
     ViewInfo {
         id: "cartesian",
         title: "f versus angle",
+        in_grid: true,
     },
     ViewInfo {
         id: "environment",
         title: "Environment",
+        in_grid: true,
     },
     ViewInfo {
         id: "albedo",
         title: "Directional albedo ρhd(θi)",
+        in_grid: true,
     },
     ViewInfo {
         id: "fresnel",
         title: "Fresnel reflectance",
+        in_grid: true,
     },
     ViewInfo {
         id: "slice",
         title: "Image slice (θh × θd)",
+        in_grid: true,
     },
     ViewInfo {
         id: "reciprocity",
         title: "Reciprocity map",
+        in_grid: false,
     },
     ViewInfo {
         id: "snell",
         title: "Snell's law at an interface",
+        in_grid: false,
     },
     ViewInfo {
         id: "terms",
         title: "Microfacet terms D, G, F",
+        in_grid: false,
     },
 ];
 

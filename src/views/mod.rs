@@ -89,6 +89,9 @@ pub struct ViewEntry {
     pub id: &'static str,
     /// Title in the view's header.
     pub title: &'static str,
+    /// Whether the window's overview grid shows it (see
+    /// [`crate::session::views::ViewInfo::in_grid`]).
+    pub in_grid: bool,
     /// Creates the view.
     pub make: fn() -> Box<dyn View>,
 }
@@ -123,6 +126,7 @@ pub static REGISTRY: std::sync::LazyLock<Vec<ViewEntry>> = std::sync::LazyLock::
             Some(ViewEntry {
                 id: v.id,
                 title: v.title,
+                in_grid: v.in_grid,
                 make: make(v.id)?,
             })
         })
