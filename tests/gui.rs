@@ -1180,3 +1180,39 @@ fn tab_and_a_click_elsewhere_commit_a_typed_value() {
     h.run();
     assert_eq!(albedo(&h).y, 0.2);
 }
+
+#[test]
+fn a_brdf_is_renamed_its_model_changed_and_angles_read_in_degrees() {
+    let mut s = AppState::default();
+    let id = s.add(
+        bv_core::ModelSpec::from_json("oren-nayar", &serde_json::json!({"sigma": 0.5})).unwrap(),
+    );
+    s.selected = Some(id);
+    let mut h = viewer(s);
+    // σ is declared and stored in radians, and read in degrees: 0.5 rad is
+    // 28.648°.
+    let shown = field_text(&h, "σ value");
+    assert!(shown.starts_with("28.6"), "σ shows {shown}");
+    // A name typed into the panel becomes the legend's name on Enter.
+    h.get_by_role_and_label(Role::TextInput, "Name of Oren-Nayar")
+        .click();
+    h.run();
+    type_fast(&mut h, "rough clay");
+    h.key_press(egui::Key::Enter);
+    h.run();
+    let e = &h.state().state().brdfs[0];
+    assert_eq!(e.name.as_deref(), Some("rough clay"));
+    assert_eq!(
+        bv::session::naming::display_name(h.state().state(), e),
+        "rough clay"
+    );
+    // The model drop-down keeps the shared parameter (albedo) and the name.
+    let albedo = e.spec.params().color("albedo").unwrap();
+    h.state_mut()
+        .push(Command::ChangeModel(id, "lambert".into()));
+    h.run();
+    let e = &h.state().state().brdfs[0];
+    assert_eq!(e.spec.id(), "lambert");
+    assert_eq!(e.spec.params().color("albedo").unwrap(), albedo);
+    assert_eq!(e.name.as_deref(), Some("rough clay"));
+}

@@ -285,6 +285,44 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
             }
         });
     });
+    // The row's name and model: a lecturer names BRDFs for legends and
+    // figures, and switches models keeping the parameters both declare.
+    ui.horizontal(|ui| {
+        ui.label("name");
+        let key = egui::Id::unique(("bv rename", e.id));
+        let mut text: String = ui
+            .data(|d| d.get_temp::<String>(key))
+            .unwrap_or_else(|| e.name.clone().unwrap_or_default());
+        let r = ui.add(
+            egui::TextEdit::singleline(&mut text)
+                .hint_text(info.name)
+                .desired_width(120.0),
+        );
+        labelled(&r, Role::TextInput, format!("Name of {name}"));
+        if r.changed() {
+            ui.data_mut(|d| d.insert_temp(key, text.clone()));
+        }
+        if r.lost_focus() {
+            ui.data_mut(|d| d.remove::<String>(key));
+            if Some(text.trim()) != e.name.as_deref() {
+                out.push(Command::Rename(e.id, Some(text)));
+            }
+        }
+        egui::ComboBox::from_id_salt(("bv model of", e.id))
+            .selected_text(info.name)
+            .show_ui(ui, |ui| {
+                for m in bv_core::catalogue().iter() {
+                    let r = ui
+                        .selectable_label(m.id == info.id, m.name)
+                        .on_hover_text(m.summary);
+                    if r.clicked() && m.id != info.id {
+                        out.push(Command::ChangeModel(e.id, m.id.to_string()));
+                    }
+                }
+            })
+            .response
+            .on_hover_text("Change the model, keeping the parameters both models declare");
+    });
     ui.label(RichText::new(info.summary).small());
     ui.label(RichText::new(info.citation).small().weak());
     if let Some(err) = runtime.get(e.id).and_then(|b| b.error.as_ref()) {

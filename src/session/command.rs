@@ -21,6 +21,13 @@ pub enum Command {
         /// Its model and parameters.
         spec: ModelSpec,
     },
+    /// Names a BRDF (legends and figures use the name), or gives it back its
+    /// model's name with `None` or an empty name.
+    Rename(u64, Option<String>),
+    /// Changes a BRDF's model, keeping the values of the parameters both
+    /// models declare (where the new declaration accepts them) and its
+    /// colour, visibility and name.
+    ChangeModel(u64, String),
     /// Removes a BRDF.
     RemoveBrdf(u64),
     /// Shows a BRDF's parameters in the panel.
@@ -128,6 +135,23 @@ impl Command {
             Command::AddNamed { name, spec } => {
                 state.add_named(spec, Some(name));
             }
+            Command::Rename(id, name) => {
+                if let Some(e) = state.entry_mut(id) {
+                    e.name = name
+                        .map(|n| n.trim().chars().take(MAX_NAME_CHARS).collect::<String>())
+                        .filter(|n| !n.is_empty());
+                }
+            }
+            Command::ChangeModel(id, model) => match bv_core::find(&model) {
+                Ok(info) => {
+                    if let Some(e) = state.entry_mut(id)
+                        && e.spec.id() != info.id
+                    {
+                        e.spec = carry_over(&e.spec, info);
+                    }
+                }
+                Err(e) => out.message = Some(e.to_string()),
+            },
             Command::RemoveBrdf(id) => {
                 let pos = state.brdfs.iter().position(|b| b.id == id);
                 if let Some(i) = pos {
@@ -273,6 +297,23 @@ impl Command {
     }
 }
 
+/// Longest BRDF name kept (a name is a legend entry, not a document).
+pub const MAX_NAME_CHARS: usize = 60;
+
+/// A spec of `info` with its defaults, then every value of `old` whose
+/// parameter `info` also declares and accepts (same id; e.g. `kd`, `ks`,
+/// `alpha_x` between Cook-Torrance and Ward). Values the new declaration
+/// refuses (another range, another kind) keep the new model's default.
+pub fn carry_over(old: &ModelSpec, info: &'static bv_core::ModelInfo) -> ModelSpec {
+    let mut spec = ModelSpec::defaults(info);
+    for (id, value) in old.params().iter() {
+        if info.param(id).is_ok() {
+            let _ = spec.set(id, value.clone());
+        }
+    }
+    spec
+}
+
 /// The id of model `model`'s file parameter, if it has one.
 pub fn path_param(model: &str) -> Option<&'static str> {
     bv_core::find(model).ok().and_then(|m| {
@@ -286,6 +327,43 @@ pub fn path_param(model: &str) -> Option<&'static str> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn changing_the_model_keeps_the_shared_parameters_and_renaming_trims() {
+        let mut s = AppState::default();
+        let ct = ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"kd": [0.1, 0.2, 0.3], "alpha_x": 0.07, "alpha_y": 0.3, "ks": 0.9}),
+        )
+        .unwrap();
+        let id = s.add(ct);
+        Command::ChangeModel(id, "ward".into()).apply(&mut s);
+        let e = s.entry(id).unwrap();
+        assert_eq!(e.spec.id(), "ward");
+        let p = e.spec.params();
+        assert_eq!(p.color("kd").unwrap(), glam::DVec3::new(0.1, 0.2, 0.3));
+        assert_eq!(p.float("alpha_x").unwrap(), 0.07);
+        assert_eq!(p.float("alpha_y").unwrap(), 0.3);
+        // Cook-Torrance's scalar ks becomes Ward's grey colour ks; a
+        // parameter Ward lacks (distribution) is dropped.
+        assert_eq!(p.color("ks").unwrap(), glam::DVec3::splat(0.9));
+        assert!(p.get("distribution").is_err());
+        // An unknown model changes nothing and says why.
+        let before = s.clone();
+        let r = Command::ChangeModel(id, "nope".into()).apply(&mut s);
+        assert_eq!(s, before);
+        assert!(r.message.unwrap().contains("nope"));
+        // Names: trimmed, bounded, and empty gives the model's name back.
+        Command::Rename(id, Some("  brushed steel  ".into())).apply(&mut s);
+        assert_eq!(s.entry(id).unwrap().name.as_deref(), Some("brushed steel"));
+        Command::Rename(id, Some("x".repeat(500))).apply(&mut s);
+        assert_eq!(
+            s.entry(id).unwrap().name.as_ref().unwrap().chars().count(),
+            MAX_NAME_CHARS
+        );
+        Command::Rename(id, Some("   ".into())).apply(&mut s);
+        assert_eq!(s.entry(id).unwrap().name, None);
+    }
 
     #[test]
     fn add_select_remove() {

@@ -300,6 +300,28 @@ pub fn slider_row(
 fn float_slider(ui: &mut Ui, id: Id, s: &FloatSpec, x: &mut f64, label: &str) -> SliderRow {
     let lo = s.slider_min.max(s.min);
     let hi = s.slider_max.min(s.max).max(lo);
+    if s.unit == "rad" {
+        // Angles are declared (and stored, and typed on the command line)
+        // in radians, as the formulas use them; people read degrees.
+        let shown = x.to_degrees();
+        let mut deg = shown;
+        let row = slider_row(
+            ui,
+            id,
+            &mut deg,
+            lo.to_degrees()..=hi.to_degrees(),
+            s.min.to_degrees()..=s.max.to_degrees(),
+            s.log,
+            "°",
+            label,
+        );
+        // Written back only when the user changed it: a round trip through
+        // degrees is not exact, and a value that drifts would be an edit.
+        if deg != shown {
+            *x = deg.to_radians().clamp(s.min, s.max);
+        }
+        return row;
+    }
     slider_row(ui, id, x, lo..=hi, s.min..=s.max, s.log, s.unit, label)
 }
 
