@@ -130,11 +130,7 @@ pub fn badges(report: &PropertyReport) -> [Badge; 4] {
     Property::ALL.map(|p| badge(report, p))
 }
 
-/// An angle with at most 3 decimals (89.999° must not read 90°).
-fn trim_deg(x: f64) -> String {
-    let s = format!("{x:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
+use bv_core::text::fmt_deg as trim_deg;
 
 fn pair(w: &PairSample) -> String {
     format!(

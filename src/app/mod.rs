@@ -325,7 +325,7 @@ impl Bench {
         let u = if phase <= 1.0 { phase } else { 2.0 - phase };
         let state = viewer.state();
         let target = state.selected_entry().and_then(|e| {
-            let info = bv_core::find(e.spec.id()).ok()?;
+            let info = e.spec.model();
             // A log-scaled float first (roughness, exponent: what a lecturer
             // drags), else the first float.
             let floats = || {

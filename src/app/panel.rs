@@ -261,13 +261,8 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
         ui.weak("Select a BRDF to edit its parameters.");
         return;
     };
-    let Ok(info) = bv_core::find(e.spec.id()) else {
-        ui.colored_label(
-            ui.visuals().error_fg_color,
-            format!("unknown model `{}`", e.spec.id()),
-        );
-        return;
-    };
+    // A spec holds its model: no lookup by id, which cannot fail.
+    let info = e.spec.model();
     let name = crate::session::naming::display_name(state, e);
     ui.horizontal(|ui| {
         let [r, g, b] = e.color;
@@ -340,7 +335,7 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
             // A file is read in the background first; a file the reader
             // refuses leaves the BRDF as it was (see `loader`).
             Edit::Set(param, bv_core::ParamValue::Text(path))
-                if crate::session::command::path_param(e.spec.id()) == Some(param.as_str())
+                if crate::session::command::path_param(&e.spec) == Some(param.as_str())
                     && !path.trim().is_empty() =>
             {
                 Command::OpenFile {

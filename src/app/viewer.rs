@@ -977,7 +977,7 @@ pub fn file_command(state: &AppState, runtime: &Runtime, path: &str, several: bo
     let into = state
         .selected_entry()
         .filter(|_| !several)
-        .filter(|e| crate::session::command::path_param(e.spec.id()).is_some())
+        .filter(|e| crate::session::command::path_param(&e.spec).is_some())
         .filter(|e| runtime.get(e.id).is_none_or(|b| b.brdf.is_none()))
         .map(|e| e.id);
     Command::OpenFile {

@@ -207,8 +207,7 @@ impl Command {
             }
             Command::ResetParam { brdf, param } => {
                 if let Some(e) = state.entry_mut(brdf)
-                    && let Ok(info) = bv_core::find(e.spec.id())
-                    && let Ok(decl) = info.param(&param)
+                    && let Ok(decl) = e.spec.model().param(&param)
                 {
                     // A declared default always validates.
                     let _ = e.spec.set(&param, decl.default_value());
@@ -274,7 +273,7 @@ impl Command {
             }
             Command::OpenFile { path, into } => {
                 let target = match into.and_then(|id| state.entry(id)) {
-                    Some(e) => match path_param(e.spec.id()) {
+                    Some(e) => match path_param(&e.spec) {
                         Some(param) => super::loader::LoadTarget::Into {
                             brdf: e.id,
                             param: param.to_string(),
@@ -314,14 +313,9 @@ pub fn carry_over(old: &ModelSpec, info: &'static bv_core::ModelInfo) -> ModelSp
     spec
 }
 
-/// The id of model `model`'s file parameter, if it has one.
-pub fn path_param(model: &str) -> Option<&'static str> {
-    bv_core::find(model).ok().and_then(|m| {
-        m.params
-            .iter()
-            .find(|d| matches!(d.kind, bv_core::ParamKind::Path { .. }))
-            .map(|d| d.id)
-    })
+/// The id of a spec's file parameter, if its model reads a file.
+pub fn path_param(spec: &ModelSpec) -> Option<&'static str> {
+    spec.model().file_param().map(|(d, _)| d.id)
 }
 
 #[cfg(test)]

@@ -180,12 +180,7 @@ pub struct Loaded {
 /// `file` entries are read relative to its folder.
 pub fn load(path: &Path, builds: Builds) -> Result<Loaded, DeckError> {
     let bytes = fsio::read_capped(path, MAX_DECK_BYTES, "a deck file")?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        DeckError::Syntax(format!(
-            "the file is not UTF-8 text (invalid byte at offset {})",
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    let text = super::scene_file::utf8_text(bytes).map_err(DeckError::Syntax)?;
     from_toml_in(&text, path.parent(), builds)
 }
 

@@ -40,7 +40,7 @@ pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
     }
     let name = info.name;
     let has_file = |b: &BrdfEntry| {
-        super::command::path_param(b.spec.id())
+        super::command::path_param(&b.spec)
             .and_then(|p| b.spec.params().text(p).ok())
             .is_some_and(|p| std::path::Path::new(p).file_stem().is_some())
     };

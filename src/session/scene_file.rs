@@ -501,13 +501,18 @@ pub fn load(path: &Path) -> Result<Loaded, SceneError> {
 /// window opens such a scene with a warning: [`Builds::Warn`]).
 pub fn load_with(path: &Path, builds: Builds) -> Result<Loaded, SceneError> {
     let bytes = fsio::read_capped(path, fsio::MAX_SCENE_BYTES, "a scene file")?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        SceneError::Syntax(format!(
+    let text = utf8_text(bytes).map_err(SceneError::Syntax)?;
+    from_toml_in(&text, path.parent(), builds)
+}
+
+/// The bytes of a text file (scene, deck) as a string, or why not.
+pub fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
             "the file is not UTF-8 text (invalid byte at offset {})",
             e.utf8_error().valid_up_to()
-        ))
-    })?;
-    from_toml_in(&text, path.parent(), builds)
+        )
+    })
 }
 
 /// Writes a scene file atomically (see [`write_atomic`]), with its file

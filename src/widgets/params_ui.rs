@@ -530,7 +530,7 @@ fn value_ui(
             let mut remove = None;
             let can_remove = comps.len() > 1;
             for (i, comp) in comps.iter_mut().enumerate() {
-                let name = bv_core::find(comp.spec.id()).map(|m| m.name).unwrap_or("?");
+                let name = comp.spec.model().name;
                 let header = format!("{} {}: {name}", singular(decl.label), i + 1);
                 egui::CollapsingHeader::new(&header)
                     .id_salt(id.with(i))

@@ -12,3 +12,10 @@ pub fn fmt_value(v: f64) -> String {
         format!("{v:.digits$}")
     }
 }
+
+/// An angle in degrees with at most three decimals and no trailing zeros
+/// (89.999° must not read 90°; 45° reads `45`).
+pub fn fmt_deg(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}

@@ -401,12 +401,8 @@ fn num(x: f64) -> String {
     }
 }
 
-/// An angle in degrees: up to 3 decimals, trailing zeros dropped (89.999°
-/// must not print as 90°).
-fn deg(x: f64) -> String {
-    let s = format!("{x:.3}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
+// Angles in reports: up to 3 decimals, trailing zeros dropped.
+use crate::text::fmt_deg as deg;
 
 /// An estimate of the largest channel with its error.
 fn est(e: &Estimate) -> String {
