@@ -284,7 +284,12 @@ fn every_model_gets_widgets_from_its_declaration() {
         let mut state = AppState::default();
         state.add(bv_core::ModelSpec::new(info.id).unwrap());
         let h = viewer(state);
-        for decl in info.params {
+        let defaults = bv_core::ModelSpec::new(info.id).unwrap();
+        for decl in info
+            .params
+            .iter()
+            .filter(|d| d.applies_to(defaults.params()))
+        {
             let found = h.query_all(by().label(decl.label).include_labels()).count();
             assert!(
                 found > 0,
@@ -294,6 +299,50 @@ fn every_model_gets_widgets_from_its_declaration() {
             );
         }
     }
+}
+
+/// A parameter declared to matter only under some choices (k of a
+/// conductor's Fresnel term) has a widget under those choices and none under
+/// the others: for every such declaration of every model, its label is found
+/// more often with a choice that makes it apply than with one that does not.
+#[test]
+fn parameters_that_do_not_apply_are_hidden() {
+    let mut checked = 0;
+    for info in bv_core::catalogue().iter() {
+        for decl in info.params {
+            let bv_core::Applies::When { param, any_of } = decl.applies else {
+                continue;
+            };
+            let bv_core::ParamKind::Choice { options, .. } = info.param(param).unwrap().kind else {
+                panic!(
+                    "{}: `{}` depends on `{param}`, which is not a choice",
+                    info.id, decl.id
+                );
+            };
+            let Some(off) = options.iter().find(|o| !any_of.contains(o)) else {
+                continue;
+            };
+            let count = |choice: &str| {
+                let mut spec = bv_core::ModelSpec::new(info.id).unwrap();
+                spec.set_str(param, choice).unwrap();
+                let mut state = AppState::default();
+                state.add(spec);
+                let h = viewer(state);
+                h.query_all(by().label(decl.label).include_labels()).count()
+            };
+            let shown = count(any_of[0]);
+            let hidden = count(off);
+            assert!(
+                shown > hidden,
+                "{}: `{}` has {shown} widgets with {param} = {} and {hidden} with {param} = {off}",
+                info.id,
+                decl.id,
+                any_of[0]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "only {checked} conditional parameters found");
 }
 
 #[test]

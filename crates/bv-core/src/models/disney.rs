@@ -6,7 +6,7 @@
 use crate::fresnel::schlick_weight;
 use crate::microfacet::{self, Distribution, Microfacet};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -19,6 +19,7 @@ const fn unit(id: &'static str, label: &'static str, doc: &'static str, default:
         label,
         doc,
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, default)),
+        applies: Applies::Always,
     }
 }
 
@@ -29,6 +30,7 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "base colour",
         doc: "Surface colour (linear RGB; the shader's gamma 2.2 conversion is not applied)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.82, 0.67, 0.16])),
+        applies: Applies::Always,
     },
     unit(
         "metallic",

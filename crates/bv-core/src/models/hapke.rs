@@ -6,7 +6,7 @@
 //! uses it for the Moon's flat, retro-reflective look.
 
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
@@ -19,6 +19,7 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "w",
         doc: "Single-scattering albedo of the particles",
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, 0.6)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "b0",
@@ -28,18 +29,21 @@ pub const PARAMS: &[ParamDecl] = &[
             slider_max: 4.0,
             ..FloatSpec::linear(0.0, 10.0, 1.0)
         }),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "h",
         label: "h",
         doc: "Angular width of the opposition surge (regolith compaction)",
         kind: ParamKind::Float(FloatSpec::log(0.001, 1.0, 0.06, 0.001, 1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "g",
         label: "g",
         doc: "Henyey-Greenstein asymmetry: g < 0 scatters back towards the light",
         kind: ParamKind::Float(FloatSpec::linear(-1.0, 1.0, -0.3)),
+        applies: Applies::Always,
     },
 ];
 
