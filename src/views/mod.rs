@@ -25,6 +25,7 @@ pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
 pub mod reciprocity;
+pub mod sampling;
 pub mod sh_overlay;
 pub mod snell;
 pub mod svg;
@@ -111,6 +112,7 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "reciprocity" => || Box::new(reciprocity::ReciprocityView::default()),
         "snell" => || Box::new(snell::SnellView::default()),
         "terms" => || Box::new(terms::TermsView::default()),
+        "sampling" => || Box::new(sampling::SamplingView::default()),
         _ => return None,
     };
     Some(make)
