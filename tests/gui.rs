@@ -204,6 +204,32 @@ fn the_light_follows_its_slider_and_the_hemisphere() {
     assert!(low.theta_deg > 30.0, "{low:?}");
 }
 
+/// The "turn surface" slider turns the surface about its normal: an
+/// anisotropic Ward's lobe is rebuilt and its values change.
+#[test]
+fn the_turn_slider_turns_an_anisotropic_lobe() {
+    let mut state = AppState::default();
+    state.add(
+        bv_core::ModelSpec::from_json(
+            "ward",
+            &serde_json::json!({"alpha_x": 0.08, "alpha_y": 0.4}),
+        )
+        .unwrap(),
+    );
+    let mut h = viewer(state);
+    let builds = lobe(&h).rebuild_count();
+    let slider = h.get_by_role_and_label(Role::Slider, "turn surface");
+    let r = slider.rect();
+    drag(
+        &mut h,
+        r.center(),
+        r.center() + egui::vec2(r.width() * 0.25, 0.0),
+    );
+    let turn = h.state().state().display.turn_deg;
+    assert!(turn > 20.0, "turn {turn}");
+    assert!(lobe(&h).rebuild_count() > builds, "the lobe is rebuilt");
+}
+
 #[test]
 fn views_maximise_and_restore() {
     let mut h = viewer(AppState::first_run());

@@ -126,6 +126,12 @@ pub struct Display {
     pub sh_overlay: bool,
     /// Its highest order L (0–16).
     pub sh_order: u8,
+    /// The surface turned about its normal by this angle, degrees
+    /// (counter-clockwise seen from above, from the tangent towards the
+    /// bitangent): "if you turn an object, does its shading change?" An
+    /// anisotropic highlight turns with the surface; an isotropic one does
+    /// not. Every view draws the turned surface.
+    pub turn_deg: f64,
 }
 
 impl Default for Display {
@@ -138,6 +144,7 @@ impl Default for Display {
             auto_scale: true,
             sh_overlay: false,
             sh_order: 4,
+            turn_deg: 0.0,
         }
     }
 }

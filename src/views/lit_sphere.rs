@@ -108,6 +108,7 @@ impl LitSphereView {
                 gpu_image::theme_background(dark),
                 pixels_per_point,
             ),
+            turn: scene.state.display.turn_deg.to_radians(),
         }
     }
 
