@@ -22,7 +22,7 @@ pub const PALETTE: [[u8; 3]; 10] = [
     [89, 185, 90],   // green
     [225, 87, 89],   // red
     [176, 122, 211], // purple
-    [237, 201, 72],  // yellow
+    [188, 189, 34],  // olive (not the light's sun yellow)
     [118, 183, 178], // teal
     [255, 157, 167], // pink
     [176, 135, 104], // brown
