@@ -191,7 +191,8 @@ impl<'a> Cx<'a> {
 
     fn too_large(&self, cells: u64) -> InterpError {
         InterpError::Memory {
-            bytes: usize::try_from(cells.max(self.estimate).saturating_mul(8)).unwrap_or(usize::MAX),
+            bytes: usize::try_from(cells.max(self.estimate).saturating_mul(8))
+                .unwrap_or(usize::MAX),
         }
     }
 
@@ -247,7 +248,7 @@ impl<'a> Cx<'a> {
 
     /// A constant expression's cells from the module pool, copied into a new
     /// slot of this frame.
-    fn from_pool(&mut self, ge: Handle<Expression>) -> Result<Loc, InterpError> {
+    fn pooled(&mut self, ge: Handle<Expression>) -> Result<Loc, InterpError> {
         let n = self.types_cells_global(ge);
         match self.globals {
             Some(g) => {
@@ -280,7 +281,9 @@ impl<'a> Cx<'a> {
                 ArraySize::Constant(n) => Ok((self.types.cells(base) as u32, n.get())),
                 _ => Err(unsup("runtime-sized arrays", &self.fname)),
             },
-            TypeInner::ValuePointer { size: Some(size), .. } => Ok((1, size as u32)),
+            TypeInner::ValuePointer {
+                size: Some(size), ..
+            } => Ok((1, size as u32)),
             TypeInner::BindingArray { .. } => Err(unsup("binding arrays", &self.fname)),
             _ => Err(InterpError::Internal("indexing a non-composite".into())),
         }
@@ -355,7 +358,7 @@ impl<'a> Cx<'a> {
             }
             Expression::Constant(c) => {
                 konst = true;
-                self.from_pool(self.m.constants[c].init)?
+                self.pooled(self.m.constants[c].init)?
             }
             Expression::Override(o) => {
                 let ov = &self.m.overrides[o];
@@ -369,7 +372,7 @@ impl<'a> Cx<'a> {
                     )
                 })?;
                 konst = true;
-                self.from_pool(init)?
+                self.pooled(init)?
             }
             Expression::ZeroValue(_) => {
                 konst = true;
@@ -513,9 +516,7 @@ impl<'a> Cx<'a> {
                     _ => return Err(unsup("ray-tracing or mesh-shader variables", &f)),
                 }
             }
-            Expression::LocalVariable(l) => {
-                Loc::Place(Place::Local(self.local_off[l.index()]))
-            }
+            Expression::LocalVariable(l) => Loc::Place(Place::Local(self.local_off[l.index()])),
             Expression::Load { pointer } => {
                 let src = self.place(pointer)?;
                 let dst = self.alloc(n)?;
@@ -591,7 +592,10 @@ impl<'a> Cx<'a> {
                 arg2,
                 arg3,
             } => {
-                let args: Vec<_> = [Some(arg), arg1, arg2, arg3].into_iter().flatten().collect();
+                let args: Vec<_> = [Some(arg), arg1, arg2, arg3]
+                    .into_iter()
+                    .flatten()
+                    .collect();
                 konst = is_const(self, &args);
                 self.math(fun, &args, n, konst)?
             }
@@ -687,26 +691,24 @@ impl<'a> Cx<'a> {
         let (li, ri) = (self.inner(left), self.inner(right));
         if op == B::Multiply {
             let special = match (li, ri) {
-                (
-                    &TypeInner::Matrix { columns, rows, .. },
-                    &TypeInner::Vector { .. },
-                ) => Some(Ins::MatVec {
-                    dst: 0,
-                    m: self.val(left)?,
-                    v: self.val(right)?,
-                    cols: columns as u8,
-                    rows: rows as u8,
-                }),
-                (
-                    &TypeInner::Vector { .. },
-                    &TypeInner::Matrix { columns, rows, .. },
-                ) => Some(Ins::VecMat {
-                    dst: 0,
-                    v: self.val(left)?,
-                    m: self.val(right)?,
-                    cols: columns as u8,
-                    rows: rows as u8,
-                }),
+                (&TypeInner::Matrix { columns, rows, .. }, &TypeInner::Vector { .. }) => {
+                    Some(Ins::MatVec {
+                        dst: 0,
+                        m: self.val(left)?,
+                        v: self.val(right)?,
+                        cols: columns as u8,
+                        rows: rows as u8,
+                    })
+                }
+                (&TypeInner::Vector { .. }, &TypeInner::Matrix { columns, rows, .. }) => {
+                    Some(Ins::VecMat {
+                        dst: 0,
+                        v: self.val(left)?,
+                        m: self.val(right)?,
+                        cols: columns as u8,
+                        rows: rows as u8,
+                    })
+                }
                 (
                     &TypeInner::Matrix {
                         columns: k, rows, ..
@@ -990,13 +992,13 @@ impl<'a> Cx<'a> {
             },
             M::QuantizeToF16 => return Err(unsup("quantizeToF16", &f)),
             M::Dot4I8Packed | M::Dot4U8Packed => {
-                return Err(unsup("packed dot products (dot4I8Packed, dot4U8Packed)", &f));
-            }
-            _ => {
                 return Err(unsup(
-                    &format!("the data packing function {fun:?}"),
+                    "packed dot products (dot4I8Packed, dot4U8Packed)",
                     &f,
                 ));
+            }
+            _ => {
+                return Err(unsup(&format!("the data packing function {fun:?}"), &f));
             }
         };
         self.emit(i, konst);
@@ -1209,7 +1211,11 @@ fn new_cx<'a>(
 }
 
 /// Evaluates the module's constant expressions and lays out its variables.
-pub(crate) fn globals(m: &Module, minfo: &ModuleInfo, types: &Types) -> Result<Globals, InterpError> {
+pub(crate) fn globals(
+    m: &Module,
+    minfo: &ModuleInfo,
+    types: &Types,
+) -> Result<Globals, InterpError> {
     let mut cx = new_cx(m, minfo, types, "module scope".into(), None, None);
     for (h, _) in m.global_expressions.iter() {
         cx.expr(h)?;
@@ -1266,7 +1272,14 @@ pub(crate) fn function(
     let fun = &m.functions[fh];
     let name = fun.name.clone().unwrap_or_default();
     let info = &minfo[fh];
-    let mut cx = new_cx(m, minfo, types, name.clone(), Some((fun, info)), Some(globals));
+    let mut cx = new_cx(
+        m,
+        minfo,
+        types,
+        name.clone(),
+        Some((fun, info)),
+        Some(globals),
+    );
     let ret = fun.result.as_ref().map(|r| r.ty);
     let estimate = fun
         .local_variables
@@ -1280,7 +1293,13 @@ pub(crate) fn function(
     match compile_body(&mut cx, fun, ret) {
         Ok((params, body)) => {
             let frame = cx.mem.len() as u32;
-            let keep = cx.mem.iter().rposition(|&x| x != 0.0).map_or(0, |i| i + 1);
+            // Trailing zero cells are left to the zero fill at entry (`-0.0`
+            // is kept: its sign is observable).
+            let keep = cx
+                .mem
+                .iter()
+                .rposition(|x| x.to_bits() != 0)
+                .map_or(0, |i| i + 1);
             cx.mem.truncate(keep);
             Ok(Func {
                 name,
@@ -1313,11 +1332,14 @@ pub(crate) fn function(
     }
 }
 
+/// A function's parameters and body.
+type Compiled = (Box<[Param]>, Box<[Stmt]>);
+
 fn compile_body(
     cx: &mut Cx<'_>,
     fun: &Function,
     ret: Option<Handle<Type>>,
-) -> Result<(Box<[Param]>, Box<[Stmt]>), InterpError> {
+) -> Result<Compiled, InterpError> {
     let types = cx.types;
     let m = cx.m;
     // The result first, at offset 0.

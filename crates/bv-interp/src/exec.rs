@@ -85,7 +85,12 @@ impl<'p> Machine<'p, '_> {
     }
 
     /// Runs the statements `body` of `f` in the frame at `fb`.
-    pub(crate) fn block(&mut self, f: &'p Func, body: &'p [Stmt], fb: usize) -> Result<Flow, InterpError> {
+    pub(crate) fn block(
+        &mut self,
+        f: &'p Func,
+        body: &'p [Stmt],
+        fb: usize,
+    ) -> Result<Flow, InterpError> {
         for s in body {
             self.tick(1)?;
             match *s {

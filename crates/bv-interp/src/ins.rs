@@ -144,12 +144,7 @@ pub(crate) enum Ins {
         per_component: bool,
     },
     /// `all` (`any` when `any`) of a boolean vector.
-    AllAny {
-        dst: u32,
-        a: u32,
-        n: u8,
-        any: bool,
-    },
+    AllAny { dst: u32, a: u32, n: u8, any: bool },
     /// Dot product; `int` wraps like `i32`/`u32` (`Some(signed)`).
     Dot {
         dst: u32,

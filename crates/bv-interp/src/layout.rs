@@ -86,10 +86,11 @@ impl Types {
             TypeInner::Vector { size, .. } => size as u64,
             TypeInner::Matrix { columns, rows, .. } => columns as u64 * rows as u64,
             TypeInner::Pointer { .. } | TypeInner::ValuePointer { .. } => 1,
-            TypeInner::Array { base, size, .. } => match size {
-                ArraySize::Constant(n) => u64::from(n.get()).saturating_mul(self.get(base)),
-                _ => 0,
-            },
+            TypeInner::Array {
+                base,
+                size: ArraySize::Constant(n),
+                ..
+            } => u64::from(n.get()).saturating_mul(self.get(base)),
             TypeInner::Struct { .. } => {
                 // Structures are always in the arena; this is only reached for
                 // a resolution by value, which naga never makes for them.
@@ -228,8 +229,12 @@ pub(crate) fn decode(
         }
         TypeInner::Matrix { columns, rows, .. } => {
             let n = columns as usize * rows as usize;
-            Matrix::new(columns as usize, rows as usize, &cells[..n.min(cells.len())])
-                .map_or(Value::Void, Value::Mat)
+            Matrix::new(
+                columns as usize,
+                rows as usize,
+                &cells[..n.min(cells.len())],
+            )
+            .map_or(Value::Void, Value::Mat)
         }
         TypeInner::Array {
             base,

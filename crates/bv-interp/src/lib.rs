@@ -78,12 +78,28 @@ impl Program {
         let info = Validator::new(ValidationFlags::all(), Capabilities::all())
             .validate(&module)
             .map_err(|e| InterpError::Invalid(e.emit_to_string("")))?;
+        // Validation makes every offset the compiler computes consistent;
+        // a panic would be an interpreter bug, reported rather than raised.
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            Program::compile(module, &info)
+        }))
+        .unwrap_or_else(|_| {
+            Err(InterpError::Internal(
+                "the interpreter failed while compiling the module".into(),
+            ))
+        })
+    }
+
+    fn compile(
+        module: naga::Module,
+        info: &naga::valid::ModuleInfo,
+    ) -> Result<Program, InterpError> {
         let types = Types::new(&module.types);
-        let globals = compile::globals(&module, &info, &types)?;
+        let globals = compile::globals(&module, info, &types)?;
         let mut funcs = Vec::with_capacity(module.functions.len());
         let mut by_name = HashMap::new();
         for (h, f) in module.functions.iter() {
-            let func = compile::function(&module, &info, &types, &globals, h)?;
+            let func = compile::function(&module, info, &types, &globals, h)?;
             if let Some(name) = &f.name {
                 by_name.entry(name.clone()).or_insert(funcs.len());
             }

@@ -227,6 +227,9 @@ pub(crate) fn un(op: Un, x: f64) -> f64 {
                 x
             }
         }
+        // min/max rather than `clamp`: a NaN becomes 0 (IEEE maxNum, as
+        // GPU min/max behave) instead of staying NaN.
+        #[allow(clippy::manual_clamp)]
         Un::Saturate => x.max(0.0).min(1.0),
         Un::IsNan => b(x.is_nan()),
         Un::IsInf => b(x.is_infinite()),
@@ -389,6 +392,7 @@ pub(crate) fn tern(op: Tern, x: f64, y: f64, z: f64) -> f64 {
         Tern::Mix => x * (1.0 - z) + y * z,
         Tern::Fma => x.mul_add(y, z),
         Tern::SmoothStep => {
+            #[allow(clippy::manual_clamp)]
             let t = ((z - x) / (y - x)).max(0.0).min(1.0);
             t * t * (3.0 - 2.0 * t)
         }

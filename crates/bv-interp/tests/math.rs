@@ -152,7 +152,10 @@ fn binary_and_ternary_functions() {
             assert_eq!(call_f(&p, "t_min", &a), if x < y { x } else { y });
             assert_eq!(call_f(&p, "t_max", &a), if x > y { x } else { y });
             let pw = call_f(&p, "t_pow", &a);
-            assert!(close(pw, (y * x.ln()).exp(), 1e-13) || (x <= 0.0), "pow({x},{y})={pw}");
+            assert!(
+                close(pw, (y * x.ln()).exp(), 1e-13) || (x <= 0.0),
+                "pow({x},{y})={pw}"
+            );
             let at = call_f(&p, "t_atan2", &a);
             if y != 0.0 || x != 0.0 {
                 // atan2(y = x-arg, x = y-arg): the angle of the point (y, x).
@@ -178,14 +181,14 @@ fn binary_and_ternary_functions() {
             }
             for &z in &pts {
                 let a3 = [Value::f(x), Value::f(y), Value::f(z)];
-                let want_clamp = if x < y {
-                    y
-                } else {
-                    x
-                };
+                let want_clamp = if x < y { y } else { x };
                 let want_clamp = if want_clamp > z { z } else { want_clamp };
                 assert_eq!(call_f(&p, "t_clamp", &a3), want_clamp);
-                assert!(close(call_f(&p, "t_mix", &a3), x * (1.0 - z) + y * z, 1e-15));
+                assert!(close(
+                    call_f(&p, "t_mix", &a3),
+                    x * (1.0 - z) + y * z,
+                    1e-15
+                ));
                 assert!(close(call_f(&p, "t_fma", &a3), x * y + z, 1e-15));
                 if x < y {
                     let t = ((z - x) / (y - x)).clamp(0.0, 1.0);
@@ -201,7 +204,10 @@ fn binary_and_ternary_functions() {
             for _ in 0..e.unsigned_abs() {
                 want *= if e > 0 { 2.0 } else { 0.5 };
             }
-            assert!(close(got, want, 1e-15) || (got == 0.0 && want.abs() < 1e-300), "ldexp({x},{e})={got} want {want}");
+            assert!(
+                close(got, want, 1e-15) || (got == 0.0 && want.abs() < 1e-300),
+                "ldexp({x},{e})={got} want {want}"
+            );
         }
     }
 }
@@ -245,8 +251,16 @@ fn geometric_functions() {
         }
         for b in vs {
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-            assert!(close(call_f(&p, "t_dist", &[v3(a), v3(b)]), dot(d, d).sqrt(), 1e-15));
-            assert!(close(call_f(&p, "t_dot", &[v3(a), v3(b)]), dot(a, b), 1e-15));
+            assert!(close(
+                call_f(&p, "t_dist", &[v3(a), v3(b)]),
+                dot(d, d).sqrt(),
+                1e-15
+            ));
+            assert!(close(
+                call_f(&p, "t_dot", &[v3(a), v3(b)]),
+                dot(a, b),
+                1e-15
+            ));
             let c = call(&p, "t_cross", &[v3(a), v3(b)]).as_vec3().unwrap();
             let want = [
                 a[1] * b[2] - a[2] * b[1],
@@ -275,7 +289,9 @@ fn geometric_functions() {
                     assert!(close(r[k], want, 1e-14), "refract");
                 }
             }
-            let f = call(&p, "t_ff", &[v3(a), v3(b), v3(vs[1])]).as_vec3().unwrap();
+            let f = call(&p, "t_ff", &[v3(a), v3(b), v3(vs[1])])
+                .as_vec3()
+                .unwrap();
             let s = if dot(vs[1], b) < 0.0 { 1.0 } else { -1.0 };
             for k in 0..3 {
                 assert_eq!(f[k], s * a[k]);
@@ -318,12 +334,18 @@ fn modf_frexp_and_vector_math() {
     let m = call(
         &p,
         "t_vmix",
-        &[Value::vec3(0.0, 1.0, 2.0), Value::vec3(4.0, 3.0, 2.0), Value::f(0.25)],
+        &[
+            Value::vec3(0.0, 1.0, 2.0),
+            Value::vec3(4.0, 3.0, 2.0),
+            Value::f(0.25),
+        ],
     );
     assert_eq!(m.as_vec3().unwrap(), [1.0, 1.5, 2.0]);
     let c = call(&p, "t_vclamp", &[Value::vec3(-1.0, 0.5, 3.0)]);
     assert_eq!(c.as_vec3().unwrap(), [0.0, 0.5, 1.0]);
-    let w = call(&p, "t_vpow", &[Value::vec3(-3.0, 4.0, 0.5)]).as_vec3().unwrap();
+    let w = call(&p, "t_vpow", &[Value::vec3(-3.0, 4.0, 0.5)])
+        .as_vec3()
+        .unwrap();
     assert!(close(w[0], 9.0, 1e-15) && close(w[1], 2.0, 1e-15) && close(w[2], 0.125, 1e-15));
 }
 
@@ -344,7 +366,10 @@ fn glsl_builtins_and_broadcasts() {
     for (x, y) in [(5.5, 2.0), (-5.5, 2.0), (5.5, -2.0), (0.25, 1.0)] {
         // GLSL mod is floored: x - y floor(x / y).
         let got = call_f(&p, "t_mod", &[Value::f(x), Value::f(y)]);
-        assert!(close(got, x - y * (x / y).floor(), 1e-15), "mod({x},{y})={got}");
+        assert!(
+            close(got, x - y * (x / y).floor(), 1e-15),
+            "mod({x},{y})={got}"
+        );
         let a = call_f(&p, "t_atan", &[Value::f(x), Value::f(y)]);
         assert!(close(a, x.atan2(y), 1e-15));
     }
@@ -353,10 +378,16 @@ fn glsl_builtins_and_broadcasts() {
     let m = call(
         &p,
         "t_mix",
-        &[Value::vec3(0.0, 2.0, 4.0), Value::vec3(1.0, 2.0, 0.0), Value::f(0.5)],
+        &[
+            Value::vec3(0.0, 2.0, 4.0),
+            Value::vec3(1.0, 2.0, 0.0),
+            Value::f(0.5),
+        ],
     );
     assert_eq!(m.as_vec3().unwrap(), [0.5, 2.0, 2.0]);
-    let s = call(&p, "t_smooth", &[Value::vec3(-1.0, 1.0, 0.5)]).as_vec3().unwrap();
+    let s = call(&p, "t_smooth", &[Value::vec3(-1.0, 1.0, 0.5)])
+        .as_vec3()
+        .unwrap();
     assert_eq!(s, [0.0, 0.5, 0.25 * 0.25 * (3.0 - 0.5)]);
     assert_eq!(call_f(&p, "t_isqrt", &[Value::f(4.0)]), 0.5);
     let st = call(&p, "t_step", &[Value::vec3(0.0, 0.5, 1.0)]);
@@ -417,7 +448,11 @@ fn matrices() {
     }
     let det = a[0] * (a[4] * a[8] - a[7] * a[5]) - a[3] * (a[1] * a[8] - a[7] * a[2])
         + a[6] * (a[1] * a[5] - a[4] * a[2]);
-    assert!(close(call_f(&p, "det", &[ma.clone()]), det, 1e-14));
+    assert!(close(
+        call_f(&p, "det", std::slice::from_ref(&ma)),
+        det,
+        1e-14
+    ));
     // A 4x4 with a known determinant: upper triangular, product of diagonal.
     let mut u = [0.0; 16];
     for c in 0..4 {
@@ -426,9 +461,15 @@ fn matrices() {
         }
     }
     let m4 = Value::Mat(bv_interp::Matrix::new(4, 4, &u).unwrap());
-    assert!(close(call_f(&p, "det4", &[m4]), 2.0 * 3.0 * 4.0 * 5.0, 1e-14));
+    assert!(close(
+        call_f(&p, "det4", &[m4]),
+        2.0 * 3.0 * 4.0 * 5.0,
+        1e-14
+    ));
     for i in 0..3 {
-        let c = call(&p, "col", &[ma.clone(), Value::I32(i)]).as_vec3().unwrap();
+        let c = call(&p, "col", &[ma.clone(), Value::I32(i)])
+            .as_vec3()
+            .unwrap();
         let i = i as usize;
         assert_eq!(c, [a[i * 3], a[i * 3 + 1], a[i * 3 + 2]]);
     }
@@ -452,8 +493,11 @@ fn glsl_inverse_and_outer_product() {
         ",
     );
     let a = [2.0, 1.0, 0.5, -1.0, 3.0, 0.25, 0.0, 1.0, 4.0];
-    let Value::Mat(inv) = call(&p, "inv", &[Value::Mat(bv_interp::Matrix::new(3, 3, &a).unwrap())])
-    else {
+    let Value::Mat(inv) = call(
+        &p,
+        "inv",
+        &[Value::Mat(bv_interp::Matrix::new(3, 3, &a).unwrap())],
+    ) else {
         panic!()
     };
     // a · inverse(a) is the identity.
@@ -466,7 +510,9 @@ fn glsl_inverse_and_outer_product() {
     let Value::Mat(i2) = call(
         &p,
         "inv2",
-        &[Value::Mat(bv_interp::Matrix::new(2, 2, &[4.0, 2.0, 7.0, 6.0]).unwrap())],
+        &[Value::Mat(
+            bv_interp::Matrix::new(2, 2, &[4.0, 2.0, 7.0, 6.0]).unwrap(),
+        )],
     ) else {
         panic!()
     };
@@ -481,7 +527,10 @@ fn glsl_inverse_and_outer_product() {
     };
     for c in 0..3 {
         for r in 0..3 {
-            assert_eq!(o.get(c, r).unwrap(), [1.0, 2.0, 3.0][r] * [4.0, 5.0, 6.0][c]);
+            assert_eq!(
+                o.get(c, r).unwrap(),
+                [1.0, 2.0, 3.0][r] * [4.0, 5.0, 6.0][c]
+            );
         }
     }
 }
@@ -489,7 +538,11 @@ fn glsl_inverse_and_outer_product() {
 #[test]
 fn vectors_of_other_kinds_come_back_typed() {
     let p = wgsl("fn cmp(a: vec3<f32>, b: vec3<f32>) -> vec3<bool> { return a < b; }");
-    let v = call(&p, "cmp", &[Value::vec3(1.0, 2.0, 3.0), Value::vec3(2.0, 2.0, 2.0)]);
+    let v = call(
+        &p,
+        "cmp",
+        &[Value::vec3(1.0, 2.0, 3.0), Value::vec3(2.0, 2.0, 2.0)],
+    );
     assert_eq!(
         v,
         Value::Vec(Vector::new(bv_interp::Kind::Bool, &[1.0, 0.0, 0.0]).unwrap())
