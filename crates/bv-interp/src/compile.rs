@@ -31,7 +31,8 @@ pub(crate) const MAX_CELLS: u64 = 2 * 1024 * 1024;
 /// A compiled statement.
 #[derive(Debug)]
 pub(crate) enum Stmt {
-    /// Runs the instructions `start..end` (the expressions of an `Emit`).
+    /// Runs the instructions `start..end` of the function's code (the
+    /// expressions of `Emit`s and `Store`s in a row).
     Run(u32, u32),
     If {
         cond: u32,
@@ -52,11 +53,6 @@ pub(crate) enum Stmt {
     /// Copies the value (offset, cells) to the frame's result, and returns.
     Return(Option<(u32, u32)>),
     Kill,
-    Store {
-        dst: Place,
-        src: u32,
-        n: u32,
-    },
     Call {
         func: u32,
         args: Box<[Arg]>,
@@ -93,8 +89,9 @@ pub(crate) struct Func {
     pub(crate) name: String,
     /// Frame cells, or the bytes a too-large frame would need.
     pub(crate) frame: Result<u32, usize>,
-    /// The frame's initial cells (constants folded, initialised locals);
-    /// the rest of the frame starts at zero.
+    /// The frame's initial cells: the result, arguments, local variables
+    /// (zero or their constant initial value) and every constant
+    /// expression. The cells after it need no initial value.
     pub(crate) template: Box<[f64]>,
     pub(crate) ins: Box<[Ins]>,
     pub(crate) body: Box<[Stmt]>,
@@ -143,12 +140,22 @@ struct Cx<'a> {
     mem: Vec<f64>,
     loc: Vec<Loc>,
     konst: Vec<bool>,
+    /// Instructions of the expressions, in arena order.
     ins: Vec<Ins>,
     ins_at: Vec<u32>,
+    /// The function's code: the instructions of each `Emit` and each
+    /// `Store` in statement order, so that straight-line statements run as
+    /// one [`Stmt::Run`].
+    code: Vec<Ins>,
     local_off: Vec<u32>,
     /// An upper bound of the cells the frame needs, for the message when it
     /// is too large.
     estimate: u64,
+    /// The end of the cells that must start each call with their compiled
+    /// value: local variables and constant expressions. Cells past it are
+    /// always written before they are read (naga's IR uses an expression
+    /// only after it was emitted), so they need no initialisation.
+    init_end: u64,
 }
 
 fn unsup(what: &str, f: &str) -> InterpError {
@@ -633,6 +640,9 @@ impl<'a> Cx<'a> {
                 return Err(unsup("cooperative matrices", &f));
             }
         };
+        if konst && let Loc::Val(o) = loc {
+            self.init_end = self.init_end.max(u64::from(o) + n);
+        }
         self.loc[h.index()] = loc;
         self.konst[h.index()] = konst;
         Ok(())
@@ -646,11 +656,16 @@ impl<'a> Cx<'a> {
         konst: bool,
     ) -> Result<Loc, InterpError> {
         let dst = self.alloc(n)?;
-        let i = Ins::Un {
-            op,
-            dst,
-            a: self.val(a)?,
-            n: n as u8,
+        let a = self.val(a)?;
+        let i = if n == 1 {
+            Ins::Un1 { op, dst, a }
+        } else {
+            Ins::Un {
+                op,
+                dst,
+                a,
+                n: n as u8,
+            }
         };
         self.emit(i, konst);
         Ok(Loc::Val(dst))
@@ -666,14 +681,24 @@ impl<'a> Cx<'a> {
         konst: bool,
     ) -> Result<Loc, InterpError> {
         let dst = self.alloc(n)?;
-        let i = Ins::Bin {
-            op,
-            dst,
-            a: self.val(a)?,
-            b: self.val(b)?,
-            n: n as u8,
-            sa: n > 1 && self.cells(a) == 1,
-            sb: n > 1 && self.cells(b) == 1,
+        let (va, vb) = (self.val(a)?, self.val(b)?);
+        let i = if n == 1 {
+            Ins::Bin1 {
+                op,
+                dst,
+                a: va,
+                b: vb,
+            }
+        } else {
+            Ins::Bin {
+                op,
+                dst,
+                a: va,
+                b: vb,
+                n: n as u8,
+                sa: self.cells(a) == 1,
+                sb: self.cells(b) == 1,
+            }
         };
         self.emit(i, konst);
         Ok(Loc::Val(dst))
@@ -1050,6 +1075,19 @@ impl<'a> Cx<'a> {
         }
     }
 
+    /// Ends a run of code that began at `start`: extends the previous
+    /// [`Stmt::Run`] when it ends there, else adds one.
+    fn run(&mut self, start: usize, out: &mut Vec<Stmt>) {
+        let end = self.code.len() as u32;
+        if end as usize == start {
+            return;
+        }
+        match out.last_mut() {
+            Some(Stmt::Run(_, e)) if *e as usize == start => *e = end,
+            _ => out.push(Stmt::Run(start as u32, end)),
+        }
+    }
+
     fn block(&mut self, b: &Block) -> Result<Box<[Stmt]>, InterpError> {
         let mut out = Vec::new();
         for s in b.iter() {
@@ -1064,9 +1102,10 @@ impl<'a> Cx<'a> {
             Statement::Emit(ref r) => {
                 let r = r.index_range();
                 let (a, b) = (self.ins_at[r.start as usize], self.ins_at[r.end as usize]);
-                if b > a {
-                    out.push(Stmt::Run(a, b));
-                }
+                let start = self.code.len();
+                self.code
+                    .extend_from_slice(&self.ins[a as usize..b as usize]);
+                self.run(start, out);
             }
             Statement::Block(ref b) => {
                 for s in b.iter() {
@@ -1119,11 +1158,15 @@ impl<'a> Cx<'a> {
                 None => None,
             })),
             Statement::Kill => out.push(Stmt::Kill),
-            Statement::Store { pointer, value } => out.push(Stmt::Store {
-                dst: self.place(pointer)?,
-                src: self.val(value)?,
-                n: self.cells(value) as u32,
-            }),
+            Statement::Store { pointer, value } => {
+                let start = self.code.len();
+                self.code.push(Ins::Store {
+                    dst: self.place(pointer)?,
+                    src: self.val(value)?,
+                    n: self.cells(value) as u32,
+                });
+                self.run(start, out);
+            }
             Statement::Call {
                 function,
                 ref arguments,
@@ -1205,8 +1248,10 @@ fn new_cx<'a>(
         konst: vec![false; n],
         ins: Vec::new(),
         ins_at: vec![0; n + 1],
+        code: Vec::new(),
         local_off: Vec::new(),
         estimate: 0,
+        init_end: 0,
     }
 }
 
@@ -1293,19 +1338,13 @@ pub(crate) fn function(
     match compile_body(&mut cx, fun, ret) {
         Ok((params, body)) => {
             let frame = cx.mem.len() as u32;
-            // Trailing zero cells are left to the zero fill at entry (`-0.0`
-            // is kept: its sign is observable).
-            let keep = cx
-                .mem
-                .iter()
-                .rposition(|x| x.to_bits() != 0)
-                .map_or(0, |i| i + 1);
+            let keep = (cx.init_end as usize).min(cx.mem.len());
             cx.mem.truncate(keep);
             Ok(Func {
                 name,
                 frame: Ok(frame),
                 template: cx.mem.into_boxed_slice(),
-                ins: cx.ins.into_boxed_slice(),
+                ins: cx.code.into_boxed_slice(),
                 body,
                 params,
                 ret,
@@ -1377,6 +1416,7 @@ fn compile_body(
         let o = cx.alloc(types.cells(l.ty))?;
         cx.local_off.push(o);
     }
+    cx.init_end = cx.mem.len() as u64;
     for (h, e) in fun.expressions.iter() {
         cx.ins_at[h.index()] = cx.ins.len() as u32;
         if let Expression::FunctionArgument(i) = *e {

@@ -49,7 +49,8 @@ pub(crate) struct Machine<'p, 'm> {
 
 impl<'p> Machine<'p, '_> {
     /// Pushes the frame of `f` at `fb`: checks the memory limit, then lays
-    /// down the template and zeroes the rest.
+    /// down the template (the cells after it are written before they are
+    /// read).
     pub(crate) fn enter(&mut self, f: &Func, fb: usize) -> Result<(), InterpError> {
         let cells = match f.frame {
             Ok(c) => c as usize,
@@ -68,7 +69,6 @@ impl<'p> Machine<'p, '_> {
         }
         let t = f.template.len();
         self.mem[fb..fb + t].copy_from_slice(&f.template);
-        self.mem[fb + t..top].fill(0.0);
         Ok(())
     }
 
@@ -161,17 +161,11 @@ impl<'p> Machine<'p, '_> {
                 Stmt::Continue => return Ok(Flow::Continue),
                 Stmt::Return(v) => {
                     if let Some((o, n)) = v {
-                        let s = fb + o as usize;
-                        self.mem.copy_within(s..s + n as usize, fb);
+                        ins::copy(self.mem, fb + o as usize, fb, n as usize);
                     }
                     return Ok(Flow::Return);
                 }
                 Stmt::Kill => return Err(InterpError::Kill),
-                Stmt::Store { dst, src, n } => {
-                    let d = dst.addr(self.mem, fb);
-                    let s = fb + src as usize;
-                    self.mem.copy_within(s..s + n as usize, d);
-                }
                 Stmt::Call {
                     func,
                     ref args,
@@ -204,10 +198,7 @@ impl<'p> Machine<'p, '_> {
         for (a, p) in args.iter().zip(callee.params.iter()) {
             let d = nfb + p.off as usize;
             match *a {
-                Arg::Val { off, n } => {
-                    let s = fb + off as usize;
-                    self.mem.copy_within(s..s + n as usize, d);
-                }
+                Arg::Val { off, n } => ins::copy(self.mem, fb + off as usize, d, n as usize),
                 Arg::Ptr(place) => self.mem[d] = place.addr(self.mem, fb) as f64,
             }
         }
@@ -216,8 +207,7 @@ impl<'p> Machine<'p, '_> {
         self.depth -= 1;
         r?;
         if let Some((o, n)) = result {
-            let d = fb + o as usize;
-            self.mem.copy_within(nfb..nfb + n as usize, d);
+            ins::copy(self.mem, nfb, fb + o as usize, n as usize);
         }
         Ok(())
     }

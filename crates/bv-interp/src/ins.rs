@@ -48,6 +48,9 @@ pub(crate) enum Ins {
     Copy { dst: u32, src: u32, n: u32 },
     /// Loads `n` cells from a place.
     Load { dst: u32, src: Place, n: u32 },
+    /// Stores `n` cells to a place (naga's `Store` statement, run as an
+    /// instruction so that straight-line code is one run).
+    Store { dst: Place, src: u32, n: u32 },
     /// A pointer `off` cells past `base`.
     PtrAdd { dst: u32, base: Place, off: u32 },
     /// A pointer to element `index` (clamped to `len`) of stride `stride`.
@@ -77,6 +80,10 @@ pub(crate) enum Ins {
     },
     /// A one-operand componentwise operation.
     Un { op: Un, dst: u32, a: u32, n: u8 },
+    /// [`Ins::Un`] on scalars (the common case, without the loop).
+    Un1 { op: Un, dst: u32, a: u32 },
+    /// [`Ins::Bin`] on scalars.
+    Bin1 { op: Bin, dst: u32, a: u32, b: u32 },
     /// A two-operand componentwise operation; `sa`/`sb` broadcast a scalar.
     Bin {
         op: Bin,
@@ -204,6 +211,19 @@ pub(crate) enum Ins {
     Frexp { dst: u32, a: u32, n: u8 },
 }
 
+/// Copies `n` cells from `s` to `d` (ranges may overlap only if equal):
+/// short runs, the common case, without a call to `memmove`.
+#[inline(always)]
+pub(crate) fn copy(mem: &mut [f64], s: usize, d: usize, n: usize) {
+    if n <= 4 {
+        for k in 0..n {
+            mem[d + k] = mem[s + k];
+        }
+    } else {
+        mem.copy_within(s..s + n, d);
+    }
+}
+
 /// Runs `ins` on the frame at `fb` of `mem`.
 pub(crate) fn run(ins: &[Ins], mem: &mut [f64], fb: usize) {
     for i in ins {
@@ -220,13 +240,18 @@ fn at(o: u32, fb: usize) -> usize {
 #[inline]
 pub(crate) fn step(i: Ins, mem: &mut [f64], fb: usize) {
     match i {
-        Ins::Copy { dst, src, n } => {
-            let s = at(src, fb);
-            mem.copy_within(s..s + n as usize, at(dst, fb));
-        }
+        Ins::Copy { dst, src, n } => copy(mem, at(src, fb), at(dst, fb), n as usize),
         Ins::Load { dst, src, n } => {
             let s = src.addr(mem, fb);
-            mem.copy_within(s..s + n as usize, at(dst, fb));
+            copy(mem, s, at(dst, fb), n as usize);
+        }
+        Ins::Store { dst, src, n } => {
+            let d = dst.addr(mem, fb);
+            copy(mem, at(src, fb), d, n as usize);
+        }
+        Ins::Un1 { op, dst, a } => mem[at(dst, fb)] = math::un(op, mem[at(a, fb)]),
+        Ins::Bin1 { op, dst, a, b } => {
+            mem[at(dst, fb)] = math::bin(op, mem[at(a, fb)], mem[at(b, fb)]);
         }
         Ins::PtrAdd { dst, base, off } => {
             mem[at(dst, fb)] = (base.addr(mem, fb) + off as usize) as f64;

@@ -195,9 +195,14 @@ impl Program {
             });
         }
         exec::with_memory(|mem| {
-            mem.clear();
-            mem.extend_from_slice(&self.globals.image);
-            let fb = mem.len();
+            // The vector keeps its length between calls (what a previous
+            // call left is overwritten before it is read), so only the
+            // module-scope image and the frame templates are copied.
+            let fb = self.globals.image.len();
+            if mem.len() < fb {
+                mem.resize(fb, 0.0);
+            }
+            mem[..fb].copy_from_slice(&self.globals.image);
             let mut machine = exec::Machine {
                 funcs: &self.funcs,
                 mem,

@@ -529,3 +529,37 @@ fn glsl_globals_uniform_blocks_and_consts() {
         Err(bv_interp::InterpError::Type { .. })
     ));
 }
+
+#[test]
+fn locals_start_at_zero_whatever_earlier_calls_left() {
+    // Two programs alternate on one thread, so they share its memory.
+    let a = wgsl(
+        "fn junk(x: f32) -> f32 {
+             var a: array<f32, 64>;
+             for (var i = 0; i < 64; i++) { a[i] = x; }
+             return a[63];
+         }",
+    );
+    let b = wgsl(
+        "fn z(k: i32) -> f32 {
+             var a: array<f32, 64>;
+             var s = 0.0;
+             for (var i = 0; i < 64; i++) { s += a[i]; }
+             var v: vec3<f32>;
+             return s + v.y + f32(k);
+         }",
+    );
+    for k in 0..5 {
+        assert_eq!(
+            call_f(&a, "junk", &[Value::f(123.0 + f64::from(k))]),
+            123.0 + f64::from(k)
+        );
+        assert_eq!(call_f(&b, "z", &[Value::I32(k)]), f64::from(k));
+    }
+}
+
+#[test]
+fn negative_zero_constants_keep_their_sign() {
+    let p = wgsl("fn nz(x: f32) -> f32 { return x / -0.0; }");
+    assert_eq!(call_f(&p, "nz", &[Value::f(1.0)]), f64::NEG_INFINITY);
+}
