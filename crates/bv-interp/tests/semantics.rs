@@ -563,3 +563,99 @@ fn negative_zero_constants_keep_their_sign() {
     let p = wgsl("fn nz(x: f32) -> f32 { return x / -0.0; }");
     assert_eq!(call_f(&p, "nz", &[Value::f(1.0)]), f64::NEG_INFINITY);
 }
+
+#[test]
+fn glsl_out_parameters_implicit_conversions_and_bool_globals() {
+    let mut p = glsl(
+        "
+        const float PI = 3.14159265358979323846;
+        bool useHalf;
+        vec3 baseColor;
+        void split(float x, out float whole, inout float acc) { whole = floor(x); acc += x - whole; }
+        float f(float x) {
+            float w; float acc = 1;
+            split(x, w, acc);
+            float g = min(1.0, 2*x / 3);
+            if (useHalf) g *= 0.5;
+            return w + acc + g + baseColor.g;
+        }
+        ",
+    );
+    p.set_global("baseColor", Value::vec3(0.0, 0.25, 0.0))
+        .unwrap();
+    let want = |x: f64, half: bool| {
+        let g = (2.0 * x / 3.0).min(1.0) * if half { 0.5 } else { 1.0 };
+        x.floor() + 1.0 + (x - x.floor()) + g + 0.25
+    };
+    for x in [0.25, 1.75, -2.5] {
+        p.set_global("useHalf", Value::Bool(false)).unwrap();
+        assert!(close(
+            call_f(&p, "f", &[Value::f(x)]),
+            want(x, false),
+            1e-15
+        ));
+        p.set_global("useHalf", Value::Bool(true)).unwrap();
+        assert!(close(call_f(&p, "f", &[Value::f(x)]), want(x, true), 1e-15));
+    }
+}
+
+#[test]
+fn relational_functions_and_vector_select() {
+    let p = glsl(
+        "
+        bool anynan(vec3 v) { return any(isnan(v)); }
+        bool allinf(vec3 v) { return all(isinf(v)); }
+        bool below(vec3 a, vec3 b) { return all(lessThan(a, b)); }
+        vec3 pick(vec3 a, vec3 b) { return mix(a, b, greaterThan(a, b)); }
+        ",
+    );
+    let inf = f64::INFINITY;
+    let b = |v: Value| match v {
+        Value::Bool(x) => x,
+        v => panic!("{v:?}"),
+    };
+    assert!(!b(call(&p, "anynan", &[Value::vec3(1.0, inf, 0.0)])));
+    assert!(b(call(&p, "anynan", &[Value::vec3(1.0, f64::NAN, 0.0)])));
+    assert!(b(call(&p, "allinf", &[Value::vec3(inf, -inf, inf)])));
+    assert!(!b(call(&p, "allinf", &[Value::vec3(inf, 1.0, inf)])));
+    assert!(b(call(
+        &p,
+        "below",
+        &[Value::vec3(0.0, 1.0, 2.0), Value::vec3(1.0, 2.0, 3.0)]
+    )));
+    assert!(!b(call(
+        &p,
+        "below",
+        &[Value::vec3(0.0, 2.0, 2.0), Value::vec3(1.0, 2.0, 3.0)]
+    )));
+    // mix with a boolean vector selects per component (the larger here).
+    let m = call(
+        &p,
+        "pick",
+        &[Value::vec3(5.0, 1.0, 3.0), Value::vec3(2.0, 4.0, 3.0)],
+    );
+    assert_eq!(m.as_vec3(), Some([2.0, 1.0, 3.0]));
+    let q = wgsl(
+        "fn sel(a: vec3<f32>, b: vec3<f32>, c: vec3<bool>) -> vec3<f32> { return select(a, b, c); }
+         struct S { w: f32, v: vec3<f32> }
+         fn arr_of_structs(i: i32, x: f32) -> f32 {
+             var ss: array<S, 3>;
+             ss[i].v.y = x;
+             ss[(i + 1) % 3].w = 2.0 * x;
+             return ss[i].v.y + ss[0].w + ss[1].w + ss[2].w;
+         }",
+    );
+    let c = Value::Vec(Vector::new(Kind::Bool, &[1.0, 0.0, 1.0]).unwrap());
+    let s = call(
+        &q,
+        "sel",
+        &[Value::vec3(1.0, 2.0, 3.0), Value::vec3(4.0, 5.0, 6.0), c],
+    );
+    assert_eq!(s.as_vec3(), Some([4.0, 2.0, 6.0]));
+    for i in 0..3 {
+        assert_eq!(
+            call_f(&q, "arr_of_structs", &[Value::I32(i), Value::f(1.5)]),
+            4.5
+        );
+    }
+}
