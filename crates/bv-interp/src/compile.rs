@@ -247,7 +247,7 @@ impl<'a> Cx<'a> {
     /// the expression is constant.
     fn emit(&mut self, i: Ins, konst: bool) {
         if konst || self.func.is_none() {
-            ins::step(i, &mut self.mem, 0);
+            ins::step(&i, &mut self.mem, 0);
         } else {
             self.ins.push(i);
         }

@@ -215,19 +215,25 @@ pub(crate) enum Ins {
 /// short runs, the common case, without a call to `memmove`.
 #[inline(always)]
 pub(crate) fn copy(mem: &mut [f64], s: usize, d: usize, n: usize) {
-    if n <= 4 {
-        for k in 0..n {
-            mem[d + k] = mem[s + k];
+    match n {
+        1 => mem[d] = mem[s],
+        3 => {
+            let v = [mem[s], mem[s + 1], mem[s + 2]];
+            mem[d..d + 3].copy_from_slice(&v);
         }
-    } else {
-        mem.copy_within(s..s + n, d);
+        0..=4 => {
+            for k in 0..n {
+                mem[d + k] = mem[s + k];
+            }
+        }
+        _ => mem.copy_within(s..s + n, d),
     }
 }
 
 /// Runs `ins` on the frame at `fb` of `mem`.
 pub(crate) fn run(ins: &[Ins], mem: &mut [f64], fb: usize) {
     for i in ins {
-        step(*i, mem, fb);
+        step(i, mem, fb);
     }
 }
 
@@ -237,9 +243,9 @@ fn at(o: u32, fb: usize) -> usize {
 }
 
 /// Runs one instruction.
-#[inline]
-pub(crate) fn step(i: Ins, mem: &mut [f64], fb: usize) {
-    match i {
+#[inline(always)]
+pub(crate) fn step(i: &Ins, mem: &mut [f64], fb: usize) {
+    match *i {
         Ins::Copy { dst, src, n } => copy(mem, at(src, fb), at(dst, fb), n as usize),
         Ins::Load { dst, src, n } => {
             let s = src.addr(mem, fb);

@@ -13,6 +13,43 @@
 //! Calls are independent: a call starts from the module-scope values set with
 //! [`Program::set_global`], and what it writes to them is dropped when it
 //! returns. [`Program`] is `Send + Sync`; many threads may call at once.
+//!
+//! ```
+//! use bv_interp::{Limits, Program, Value};
+//!
+//! let src = "var<private> k: f32 = 2.0;
+//!            fn f(v: vec3<f32>) -> f32 { return k * dot(v, v); }";
+//! let mut p = Program::new(naga::front::wgsl::parse_str(src).unwrap()).unwrap();
+//! p.set_global("k", Value::f(0.5)).unwrap();
+//! let r = p.call("f", &[Value::vec3(1.0, 2.0, 2.0)], &Limits::default());
+//! assert_eq!(r, Ok(Value::f(4.5)));
+//! ```
+//!
+//! # Semantics
+//!
+//! - Arithmetic follows WGSL where GLSL leaves things undefined: integer
+//!   `x / 0 == x`, `x % 0 == 0`, `i32::MIN / -1 == i32::MIN`; shifts use the
+//!   low five bits of the amount; float-to-integer conversions saturate (NaN
+//!   to 0); float `%` truncates (GLSL's floored `mod` arrives already
+//!   expanded by naga's front end); `round` is ties-to-even.
+//! - `min`, `max`, `clamp` and `saturate` are IEEE minNum/maxNum: a NaN
+//!   operand loses (`saturate(NaN) == 0`), as on GPUs.
+//! - A run-time index out of range is clamped to the last element (naga's
+//!   `Restrict` bounds-check policy).
+//! - Literals and constant sub-expressions are what naga's front ends made of
+//!   them: its constant evaluator folds constant expressions in the declared
+//!   type, so `2.0 * 3.14159` in an f32 shader is one f32 constant. Only the
+//!   run-time arithmetic is f64.
+//! - Not evaluated (reported by [`Program::new`] as
+//!   [`InterpError::Unsupported`]): textures and samplers, derivatives,
+//!   atomics, barriers, workgroup and storage variables, runtime-sized arrays
+//!   (`arrayLength`), ray queries, subgroup operations, cooperative matrices,
+//!   16- and 64-bit integers, `quantizeToF16`, the `pack*`/`unpack*` and
+//!   packed dot-product functions, overrides without a value. `discard`
+//!   fails the call with [`InterpError::Kill`].
+//! - One function's frame (locals plus intermediate values) is at most
+//!   16 MiB whatever the limits say; a larger one fails every call with
+//!   [`InterpError::Memory`] and is never allocated.
 
 mod compile;
 mod error;
