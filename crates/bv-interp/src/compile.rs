@@ -32,8 +32,9 @@ pub(crate) const MAX_CELLS: u64 = 2 * 1024 * 1024;
 #[derive(Debug)]
 pub(crate) enum Stmt {
     /// Runs the instructions `start..end` of the function's code (the
-    /// expressions of `Emit`s and `Store`s in a row).
-    Run(u32, u32),
+    /// expressions of `Emit`s and `Store`s in a row); the third field is
+    /// their cost in steps.
+    Run(u32, u32, u64),
     If {
         cond: u32,
         accept: Box<[Stmt]>,
@@ -1082,9 +1083,13 @@ impl<'a> Cx<'a> {
         if end as usize == start {
             return;
         }
+        let cost: u64 = self.code[start..].iter().map(ins::cost).sum();
         match out.last_mut() {
-            Some(Stmt::Run(_, e)) if *e as usize == start => *e = end,
-            _ => out.push(Stmt::Run(start as u32, end)),
+            Some(Stmt::Run(_, e, c)) if *e as usize == start => {
+                *e = end;
+                *c += cost;
+            }
+            _ => out.push(Stmt::Run(start as u32, end, cost)),
         }
     }
 

@@ -94,8 +94,8 @@ impl<'p> Machine<'p, '_> {
         for s in body {
             self.tick(1)?;
             match *s {
-                Stmt::Run(a, b) => {
-                    self.tick(u64::from(b - a))?;
+                Stmt::Run(a, b, cost) => {
+                    self.tick(cost)?;
                     ins::run(&f.ins[a as usize..b as usize], self.mem, fb);
                 }
                 Stmt::If {
@@ -161,6 +161,7 @@ impl<'p> Machine<'p, '_> {
                 Stmt::Continue => return Ok(Flow::Continue),
                 Stmt::Return(v) => {
                     if let Some((o, n)) = v {
+                        self.tick(u64::from(n / 8))?;
                         ins::copy(self.mem, fb + o as usize, fb, n as usize);
                     }
                     return Ok(Flow::Return);
@@ -194,6 +195,16 @@ impl<'p> Machine<'p, '_> {
             });
         }
         let nfb = fb + caller.frame.unwrap_or(0) as usize;
+        // Laying down the frame and copying arguments cost like copies.
+        let cells: u64 = args
+            .iter()
+            .map(|a| match *a {
+                Arg::Val { n, .. } => u64::from(n),
+                Arg::Ptr(_) => 1,
+            })
+            .sum::<u64>()
+            + callee.template.len() as u64;
+        self.tick(cells / 8)?;
         self.enter(callee, nfb)?;
         for (a, p) in args.iter().zip(callee.params.iter()) {
             let d = nfb + p.off as usize;

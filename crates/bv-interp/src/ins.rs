@@ -230,6 +230,19 @@ pub(crate) fn copy(mem: &mut [f64], s: usize, d: usize, n: usize) {
     }
 }
 
+/// The steps an instruction costs: one, plus one per 8 cells it copies, so
+/// that a loop copying a large array exhausts the step budget as promptly
+/// as any other loop.
+pub(crate) fn cost(i: &Ins) -> u64 {
+    let n = match *i {
+        Ins::Copy { n, .. } | Ins::Load { n, .. } | Ins::Store { n, .. } => n,
+        Ins::IndexVal { stride, .. } => stride,
+        Ins::Select { n, .. } => n,
+        _ => 0,
+    };
+    1 + u64::from(n / 8)
+}
+
 /// Runs `ins` on the frame at `fb` of `mem`.
 pub(crate) fn run(ins: &[Ins], mem: &mut [f64], fb: usize) {
     for i in ins {

@@ -38,6 +38,31 @@ fn endless_loops_exhaust_the_step_budget_quickly() {
         eprintln!("{name}: step budget of 1e6 exhausted in {dt:?}");
         assert!(dt < Duration::from_millis(500), "{name} took {dt:?}");
     }
+    // Copying a large array costs steps by its size, so a loop of copies
+    // ends as promptly.
+    let copies = wgsl(
+        "fn copies() -> f32 {
+             var a: array<f32, 200000>;
+             var s = 0.0;
+             loop { let b = a; s += b[7]; a[7] = s + 1.0; }
+             return s;
+         }
+         fn calls_big(x: f32) -> f32 { var a: array<f32, 200000>; a[3] = x; return take(a); }
+         fn take(a: array<f32, 200000>) -> f32 { return a[3]; }
+         fn many_calls() -> f32 { var s = 0.0; loop { s += calls_big(s); } return s; }",
+    );
+    for name in ["copies", "many_calls"] {
+        let t = Instant::now();
+        let r = copies.call(name, &[], &limits);
+        let dt = t.elapsed();
+        assert_eq!(
+            r,
+            Err(InterpError::StepBudget { steps: 1_000_000 }),
+            "{name}"
+        );
+        eprintln!("{name}: step budget exhausted in {dt:?}");
+        assert!(dt < Duration::from_millis(500), "{name} took {dt:?}");
+    }
     // A small budget stops a finite loop too; a large one lets it finish.
     let small = Limits {
         max_steps: 50,
