@@ -77,7 +77,8 @@ use layout::Types;
 pub struct Limits {
     /// Statements and expressions a call may run (loop iterations count too).
     pub max_steps: u64,
-    /// How deeply calls may nest.
+    /// How deeply calls may nest below the called function (0: it may call
+    /// no other function).
     pub max_call_depth: u32,
     /// Bytes of memory for module-scope variables, arguments, locals and
     /// intermediate values (8 bytes a component).

@@ -207,10 +207,8 @@ fn wrong_calls_are_errors() {
 
 #[test]
 fn invalid_modules_are_rejected() {
-    // A module naga's front end accepts but the validator does not: a
-    // function whose result is never returned is fine, but calling with an
-    // argument of the wrong type cannot be built by the front end, so build
-    // one by hand: a Load of a non-pointer.
+    // The front ends never produce invalid IR, so build some by hand: a
+    // `Load` whose operand is a float literal, not a pointer.
     let mut m = naga::Module::default();
     let f32_ty = m.types.insert(
         naga::Type {

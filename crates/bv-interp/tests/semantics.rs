@@ -659,3 +659,18 @@ fn relational_functions_and_vector_select() {
         );
     }
 }
+
+#[test]
+fn overrides_take_their_default_values() {
+    let p = wgsl(
+        "override k: f32 = 2.5;
+         override twice_k = k * 2.0;
+         fn f(x: f32) -> f32 { return x * k + twice_k; }",
+    );
+    assert_eq!(call_f(&p, "f", &[Value::f(2.0)]), 10.0);
+    let module =
+        naga::front::wgsl::parse_str("override k: f32; fn f(x: f32) -> f32 { return x * k; }")
+            .unwrap();
+    let e = bv_interp::Program::new(module).err().unwrap();
+    assert!(e.to_string().contains("override `k`"), "{e}");
+}
