@@ -674,3 +674,29 @@ fn overrides_take_their_default_values() {
     let e = bv_interp::Program::new(module).err().unwrap();
     assert!(e.to_string().contains("override `k`"), "{e}");
 }
+
+#[test]
+fn global_arrays_and_pointers_to_globals() {
+    let mut p = wgsl(
+        "var<private> table: array<f32, 4> = array<f32, 4>(1.0, 2.0, 3.0, 4.0);
+         var<private> acc: f32 = 0.0;
+         fn add_to(p: ptr<private, f32>, x: f32) { *p += x; }
+         fn f(i: i32) -> f32 { add_to(&acc, table[i]); add_to(&acc, table[i]); return acc; }",
+    );
+    for i in 0..4 {
+        assert_eq!(call_f(&p, "f", &[Value::I32(i)]), 2.0 * f64::from(i + 1));
+    }
+    let t = Value::Array(vec![
+        Value::f(0.5),
+        Value::f(-1.0),
+        Value::f(8.0),
+        Value::f(0.0),
+    ]);
+    p.set_global("table", t).unwrap();
+    assert_eq!(call_f(&p, "f", &[Value::I32(2)]), 16.0);
+    let short = Value::Array(vec![Value::f(0.5)]);
+    assert!(matches!(
+        p.set_global("table", short),
+        Err(bv_interp::InterpError::Type { .. })
+    ));
+}
