@@ -700,3 +700,32 @@ fn global_arrays_and_pointers_to_globals() {
         Err(bv_interp::InterpError::Type { .. })
     ));
 }
+
+/// Loads that may not read a variable in place: stored again, loaded before
+/// its store, stored in a loop, passed by pointer, stored in part.
+#[test]
+fn loads_see_the_value_at_the_time_of_the_load() {
+    let p = wgsl(
+        "fn inc(p: ptr<function, f32>) { *p += 1.0; }
+         fn twice(x: f32) -> f32 { var y = x; let a = y; y = 5.0; return a + y; }
+         fn before(x: f32) -> f32 { var y: f32; let a = y; y = x; return a + y; }
+         fn in_loop(n: i32) -> f32 {
+             var y: f32; var s = 0.0;
+             for (var i = 0; i < n; i++) { let b = y; y = f32(i); s += b; }
+             return s;
+         }
+         fn escaped(x: f32) -> f32 { var y: f32; y = x; let a = y; inc(&y); return a * 10.0 + y; }
+         fn partial(x: f32) -> f32 { var v: vec3<f32>; v = vec3(x); let a = v; v.y = 2.0; return a.y + v.y; }
+         fn once(x: f32) -> f32 { var y: f32; y = x * 2.0; let a = y; return a + y; }",
+    );
+    let x = 1.5;
+    assert_eq!(call_f(&p, "twice", &[Value::f(x)]), x + 5.0);
+    assert_eq!(call_f(&p, "before", &[Value::f(x)]), x);
+    // s = 0 + 0 + 1 + … + (n - 2).
+    assert_eq!(call_f(&p, "in_loop", &[Value::I32(5)]), 6.0);
+    assert_eq!(call_f(&p, "escaped", &[Value::f(x)]), x * 10.0 + x + 1.0);
+    assert_eq!(call_f(&p, "partial", &[Value::f(x)]), x + 2.0);
+    assert_eq!(call_f(&p, "once", &[Value::f(x)]), 4.0 * x);
+    let q = glsl("float f(float x) { float y = x; float a = y; y = 5.0; return a + y; }");
+    assert_eq!(call_f(&q, "f", &[Value::f(x)]), x + 5.0);
+}

@@ -193,6 +193,14 @@ impl Cx<'_> {
             Expression::LocalVariable(l) => Loc::Place(Place::Local(self.local_off[l.index()])),
             Expression::Load { pointer } => {
                 let src = self.place(pointer)?;
+                if let (Place::Local(o), Some(ss), Some((fun, _))) =
+                    (src, &self.single_store, self.func)
+                    && ss.in_place(fun, pointer, h)
+                {
+                    // The variable holds this value from here on.
+                    self.loc[h.index()] = Loc::Val(o);
+                    return Ok(());
+                }
                 let dst = self.alloc(n)?;
                 self.emit(
                     Ins::Load {

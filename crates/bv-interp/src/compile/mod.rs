@@ -12,6 +12,7 @@
 //! `expr` compiles expressions, `stmt` statements.
 
 mod expr;
+mod single_store;
 mod stmt;
 
 use naga::{
@@ -160,6 +161,8 @@ struct Cx<'a> {
     /// always written before they are read (naga's IR uses an expression
     /// only after it was emitted), so they need no initialisation.
     init_end: u64,
+    /// Which loads may read their local variable in place.
+    single_store: Option<single_store::SingleStore>,
 }
 
 fn unsup(what: &str, f: &str) -> InterpError {
@@ -389,6 +392,7 @@ fn new_cx<'a>(
         local_off: Vec::new(),
         estimate: 0,
         init_end: 0,
+        single_store: func.map(|(f, _)| single_store::SingleStore::new(f)),
     }
 }
 
