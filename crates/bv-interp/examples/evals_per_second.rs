@@ -2,7 +2,8 @@
 //! Times the interpreter on a Cook–Torrance (GGX) BRDF and a BRDF Explorer
 //! Blinn–Phong on one core and prints evaluations per second.
 //!
-//! `cargo run --release -p bv-interp --example evals_per_second`
+//! `cargo run --release -p bv-interp --example evals_per_second [EVALS]`
+//! (a million evaluations of each by default).
 
 use std::time::Instant;
 
@@ -51,7 +52,10 @@ void main() {}
         for _ in 0..extra {
             args.push(Value::vec3(1.0, 0.0, 0.0));
         }
-        let evals = 1_000_000;
+        let evals: usize = std::env::args()
+            .nth(1)
+            .and_then(|a| a.parse().ok())
+            .unwrap_or(1_000_000);
         let mut sink = 0.0;
         let t = Instant::now();
         for i in 0..evals {
