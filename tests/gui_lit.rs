@@ -198,9 +198,11 @@ fn lit_sphere_renders_and_follows_a_slider_and_the_light_drag() {
     h.drop_at(target);
     h.run();
     let inc = h.state().state().incident;
-    // n at (−0.5, 0.5) in view space (y up): θ = acos(√0.5) = 45°, φ = 135°.
+    // n at (−0.5, 0.5) in view space (y up): θ = acos(√0.5) = 45°; the
+    // sphere's frame has t to the left and b down at its centre, so the
+    // local direction is (0.5, −0.5): φ = −45°.
     assert!(
-        (inc.theta_deg - 45.0).abs() < 1.0 && (inc.phi_deg - 135.0).abs() < 1.0,
+        (inc.theta_deg - 45.0).abs() < 1.0 && (inc.phi_deg + 45.0).abs() < 1.0,
         "{inc:?}"
     );
     let img2 = crop(&h.render().unwrap(), rect);

@@ -83,8 +83,16 @@ impl Incident {
         } else {
             0.0
         };
+        // Wrapped into (−180°, 180°] in degrees: a value already there is
+        // kept exactly (a round trip through radians turns 30° into
+        // 29.999999999999993°, which a scene file then reports as changed).
         let phi = if self.phi_deg.is_finite() {
-            bv_core::frame::wrap_phi(self.phi_deg.to_radians()).to_degrees()
+            if self.phi_deg > -180.0 && self.phi_deg <= 180.0 {
+                self.phi_deg
+            } else {
+                let p = (self.phi_deg + 180.0).rem_euclid(360.0) - 180.0;
+                if p <= -180.0 { p + 360.0 } else { p }
+            }
         } else {
             0.0
         };
@@ -441,6 +449,34 @@ fn lenient_entries<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<BrdfEntry>, D:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Azimuths in (−180°, 180°] are kept exactly; others wrap by whole
+    /// turns into that range.
+    #[test]
+    fn azimuths_wrap_in_degrees_and_stay_exact() {
+        let phi = |p: f64| {
+            Incident {
+                theta_deg: 45.0,
+                phi_deg: p,
+            }
+            .clamped()
+            .phi_deg
+        };
+        for k in -1799..=1800 {
+            let p = k as f64 * 0.1;
+            assert_eq!(phi(p), p, "{p}");
+        }
+        for p in [30.0, -33.0, 0.1, 179.99, 1.0 / 3.0] {
+            assert_eq!(phi(p), p);
+        }
+        assert_eq!(phi(-180.0), 180.0);
+        assert_eq!(phi(540.0), 180.0);
+        assert_eq!(phi(190.0), -170.0);
+        assert_eq!(phi(-190.0), 170.0);
+        assert_eq!(phi(720.0 + 30.0), 30.0);
+        assert_eq!(phi(f64::NAN), 0.0);
+        assert!(phi(1e12).abs() <= 180.0);
+    }
 
     #[test]
     fn state_round_trips_through_json() {

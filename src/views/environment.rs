@@ -255,7 +255,8 @@ impl EnvironmentView {
 
     fn settings(env: &EnvView, turn_deg: f64) -> EnvSettings {
         EnvSettings {
-            turn: turn_deg.to_radians(),
+            // The lit sphere's frames: t to the left at a sphere's centre.
+            turn: turn_deg.to_radians() + super::lit_sphere::FRAME_TURN,
             rotation: env.rotation_deg.to_radians(),
             exposure_ev: env.exposure_ev,
             tone_map: gpu_image::tone_map(env.tone_map),

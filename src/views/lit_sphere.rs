@@ -5,10 +5,12 @@
 //! output, optional tone map and a choice of background. Drawing on a sphere
 //! moves the light there.
 //!
-//! The light is the scene's incident direction expressed in view space: at the
-//! centre of a sphere the shading frame is the view's (t right, b up, n
-//! towards the viewer), so the centre pixel shows exactly `f(ωi, n)·cos θi·E`
-//! for the (θi, φi) of the sliders, with irradiance E = 1.
+//! The light is the scene's incident direction expressed in view space. The
+//! spheres' tangent frames are turned by π about each normal ([`FRAME_TURN`])
+//! so that at the centre of a sphere t points left and b down, as the lobe
+//! view's default camera and the polar plot show them: light at φi = 0 comes
+//! from the left in every view. The centre pixel shows exactly
+//! `f(ωi, n)·cos θi·E` for the (θi, φi) of the sliders, with irradiance E = 1.
 //!
 //! The image is rendered by [`crate::gpu::LitSphereRenderer`] at the view's
 //! pixel size, and only when something it depends on changed (BRDF specs,
@@ -99,7 +101,7 @@ impl LitSphereView {
     pub fn settings(scene: &Scene<'_>, dark: bool, pixels_per_point: f32) -> LitSphereSettings {
         let lit = scene.state.lighting.lit;
         LitSphereSettings {
-            light: scene.wi(),
+            light: to_view(scene.wi()),
             irradiance: 1.0,
             exposure_ev: lit.exposure_ev,
             tone_map: gpu_image::tone_map(lit.tone_map),
@@ -108,7 +110,7 @@ impl LitSphereView {
                 gpu_image::theme_background(dark),
                 pixels_per_point,
             ),
-            turn: scene.state.display.turn_deg.to_radians(),
+            turn: scene.state.display.turn_deg.to_radians() + FRAME_TURN,
         }
     }
 
@@ -281,7 +283,7 @@ impl View for LitSphereView {
                 DVec2::new(rect.width().into(), rect.height().into()),
                 drawables.len(),
             );
-            out.push(Command::SetIncident(Incident::from_direction(dir)));
+            out.push(Command::SetIncident(Incident::from_direction(to_view(dir))));
         }
 
         if self.renderer.building() {
@@ -332,7 +334,7 @@ impl LitSphereView {
     ) {
         let painter = ui.painter_at(rect);
         let circle = gpu_image::sphere_circle(rect, drawables.len());
-        let wi = scene.wi();
+        let wi = to_view(scene.wi());
         let light = super::light_color(dark);
         for (k, d) in drawables.iter().enumerate() {
             let (c, r) = circle(k);
@@ -447,8 +449,10 @@ impl LitSphereView {
         let Some(d) = drawables.get(s.tile) else {
             return;
         };
-        let wi = s.to_local(scene.wi());
-        let wo = s.to_local(DVec3::Z);
+        // The shader's frame is turned by FRAME_TURN; the scene's BRDF
+        // already carries the user's turn.
+        let wi = to_view(s.to_local(to_view(scene.wi())));
+        let wo = to_view(s.to_local(DVec3::Z));
         let l = if wi.z > 0.0 {
             d.brdf.brdf.eval(wi, wo) * wi.z
         } else {
@@ -552,6 +556,18 @@ pub fn arrangement_control(
         .widget_info(|| {
             egui::WidgetInfo::labeled(egui::Role::ComboBox, true, format!("{salt} BRDFs shown"))
         });
+}
+
+/// The turn of the spheres' tangent frames about their normals (radians) on
+/// top of the user's: t points left at a sphere's centre (see the module
+/// doc).
+pub const FRAME_TURN: f64 = std::f64::consts::PI;
+
+/// A direction in the sphere centre's shading frame (turned by
+/// [`FRAME_TURN`]) in view space, and back: the turn by π negates x and y,
+/// and is its own inverse.
+pub fn to_view(w: DVec3) -> DVec3 {
+    DVec3::new(-w.x, -w.y, w.z)
 }
 
 /// Whether `b` scatters only through delta lobes (a smooth mirror or glass):
