@@ -395,7 +395,7 @@ impl View for AlbedoView {
         let size = ui.available_size();
         let light = super::light_color(dark);
         let plot = super::with_legend(
-            Plot::new(super::view_id("albedo")),
+            super::curves::with_linear_y(Plot::new(super::view_id("albedo"))),
             size,
             shown.len(),
             legend_corner(&shown, top, size),

@@ -156,7 +156,7 @@ impl View for CartesianView {
                 })
                 .y_grid_spacer(|input| curves::log_grid_marks(input.bounds, input.base_step_size));
         } else {
-            plot = plot.include_y(bottom).include_y(top);
+            plot = curves::with_linear_y(plot.include_y(bottom).include_y(top));
         }
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);

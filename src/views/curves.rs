@@ -237,6 +237,76 @@ pub fn log_ordinate(v: f64) -> f64 {
     }
 }
 
+/// Grid marks of a linear value axis over `bounds`: labelled lines at a
+/// 1-2-5 step giving about ten labels at most and at least five minimum steps
+/// apart (`min_step` is egui_plot's `GridInput::base_step_size`, about 6
+/// points), and thin unlabelled lines at a fifth of it where they are not
+/// crowded. egui_plot labels a mark when its `step_size` spans enough points,
+/// so the thin lines carry the minimum step as theirs: a maximised plot of a
+/// flat Lambert lobe reads 0, 0.05, 0.1, … rather than every 0.01.
+pub fn linear_grid_marks(bounds: (f64, f64), min_step: f64) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = bounds;
+    if !(lo.is_finite() && hi.is_finite() && min_step.is_finite()) || hi <= lo || min_step <= 0.0 {
+        return Vec::new();
+    }
+    let want = ((hi - lo) / 10.0).max(5.0 * min_step);
+    let decade = 10f64.powf(want.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * decade)
+        .find(|&s| s >= want * (1.0 - 1e-9))
+        .unwrap_or(10.0 * decade);
+    let minor = step / 5.0;
+    let fine = minor >= 1.5 * min_step;
+    // Values as integers of a tenth of the decade, divided once (15 / 100 is
+    // 0.15; 3 × 0.05 is 0.15000000000000002).
+    let tenth = decade / 10.0;
+    let value = |units: i64| {
+        if tenth < 1.0 {
+            units as f64 / (1.0 / tenth).round()
+        } else {
+            units as f64 * tenth
+        }
+    };
+    let step_units = (step / tenth).round() as i64;
+    let unit_units = if fine { step_units / 5 } else { step_units };
+    let first = (lo / (unit_units as f64 * tenth)).ceil() as i64;
+    let last = (hi / (unit_units as f64 * tenth)).floor() as i64;
+    if last - first > 10_000 || unit_units <= 0 {
+        return Vec::new();
+    }
+    (first..=last)
+        .map(|i| {
+            let units = i * unit_units;
+            let major = units.rem_euclid(step_units) == 0;
+            egui_plot::GridMark {
+                value: value(units),
+                step_size: if major { step } else { min_step },
+            }
+        })
+        .collect()
+}
+
+/// The label of a linear axis mark: as many decimals as its step needs
+/// (0.05 → "0.05"; egui_plot's default rounds the decimals of a 0.05 step
+/// to one and prints "0.1").
+pub fn linear_mark_label(value: f64, step: f64) -> String {
+    let decimals = if step > 0.0 && step.is_finite() {
+        (-step.log10() - 1e-9).ceil().clamp(0.0, 12.0) as usize
+    } else {
+        0
+    };
+    let v = if value == 0.0 { 0.0 } else { value };
+    format!("{v:.decimals$}")
+}
+
+/// `plot` with its y axis marked by [`linear_grid_marks`] and labelled by
+/// [`linear_mark_label`].
+pub fn with_linear_y(plot: egui_plot::Plot<'_>) -> egui_plot::Plot<'_> {
+    plot.y_grid_spacer(|input| linear_grid_marks(input.bounds, input.base_step_size))
+        .y_axis_formatter(|mark, _| linear_mark_label(mark.value, mark.step_size))
+}
+
 /// Grid marks of a log axis over `bounds` (in decades): a line at every
 /// decade, labelled every `k` decades (1, 2, 5, 10, … so that labels do not
 /// crowd: `min_step` is the plot's smallest readable step, egui_plot's
@@ -348,6 +418,43 @@ pub fn fmt_tick(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Labelled marks (those whose step spans the label spacing) of a linear
+    /// axis: a 1-2-5 step, exact multiples, about ten at most.
+    #[test]
+    fn linear_marks_label_a_readable_step() {
+        let labelled = |b: (f64, f64), min: f64| {
+            let marks = linear_grid_marks(b, min);
+            let step = marks.iter().map(|m| m.step_size).fold(0.0, f64::max);
+            let v: Vec<f64> = marks
+                .iter()
+                .filter(|m| m.step_size == step)
+                .map(|m| m.value)
+                .collect();
+            (step, v, marks.len())
+        };
+        // A maximised flat Lambert plot: 800 points over 0.23, 6-point base.
+        let (step, v, all) = labelled((-0.01, 0.22), 0.23 / 800.0 * 6.0);
+        assert_eq!(step, 0.05);
+        assert_eq!(v, vec![0.0, 0.05, 0.1, 0.15, 0.2]);
+        assert!(all > v.len(), "thin lines between the labels");
+        // A small cell: the minimum step wins, no thin lines.
+        let (step, v, all) = labelled((0.0, 1.1), 0.08);
+        assert_eq!(step, 0.5);
+        assert_eq!(v, vec![0.0, 0.5, 1.0]);
+        assert_eq!(all, 3);
+        // Negative ranges, exact multiples.
+        let (step, v, _) = labelled((-3.0, 3.0), 0.01);
+        assert_eq!(step, 1.0);
+        assert_eq!(v, vec![-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 3.0]);
+        let (_, v, _) = labelled((0.0, 0.7), 0.001);
+        assert!(v.contains(&0.3), "{v:?}");
+        assert!(v.len() <= 11);
+        // Degenerate input.
+        assert!(linear_grid_marks((1.0, 1.0), 0.1).is_empty());
+        assert!(linear_grid_marks((0.0, f64::NAN), 0.1).is_empty());
+        assert!(linear_grid_marks((0.0, 1.0), 0.0).is_empty());
+    }
 
     #[test]
     fn plane_directions_lie_in_the_plane_of_incidence() {

@@ -548,9 +548,11 @@ impl View for FresnelView {
             * (ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y);
         let plot_h = (size.y - strip_h - readout_h).max(50.0);
         let plot = super::with_legend(
-            Plot::new(super::view_id("fresnel"))
-                .width(size.x.max(50.0))
-                .height(plot_h),
+            super::curves::with_linear_y(
+                Plot::new(super::view_id("fresnel"))
+                    .width(size.x.max(50.0))
+                    .height(plot_h),
+            ),
             egui::vec2(size.x, plot_h),
             c.series.len(),
             Corner::LeftTop,

@@ -330,6 +330,8 @@ fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
                     .unwrap_or_default()
             })
             .y_grid_spacer(|input| curves::log_grid_marks(input.bounds, input.base_step_size));
+    } else {
+        plot = curves::with_linear_y(plot);
     }
     plot.show(ui, |pui| {
         for m in &c.vlines {
