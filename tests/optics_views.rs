@@ -119,14 +119,15 @@ fn snell_view_names_tir_from_the_dense_side_and_follows_drags() {
     let t = snell_texts(&h);
     assert!(has(&t, "Snell's window 2 × 48.6° = 97.2°"), "{t:?}");
     assert!(!has(&t, "no refracted ray"));
-    let v = &h.state().view;
+    // The settings are the scene's (saved with it), not the view's.
+    let v = h.state().state.plots.snell;
     assert!(
         v.use_own && v.from_below && (v.eta - 4.0 / 3.0).abs() < 1e-15,
-        "{} {} {}",
-        v.use_own,
-        v.from_below,
-        v.eta
+        "{v:?}"
     );
+    let text = bv::session::scene_file::to_toml(&h.state().state).unwrap();
+    let back = bv::session::scene_file::from_toml(&text).unwrap();
+    assert_eq!(back.state.plots.snell, v);
 
     // Dragging from the hit point to 60° below the interface (the light's
     // side) sets θi = 60°: past the window, totally reflected.

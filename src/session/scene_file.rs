@@ -44,7 +44,7 @@
 //! read-only files are refused, and a symlink is written through
 //! ([`fsio::write_atomic`]).
 
-use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION};
+use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION, SnellSettings};
 use bv_core::fsio;
 
 use serde::Deserialize;
@@ -464,6 +464,13 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         0.0,
         89.5,
         "°",
+    )?;
+    range(
+        "plots.snell.eta",
+        s.plots.snell.eta,
+        SnellSettings::ETA_RANGE.0,
+        SnellSettings::ETA_RANGE.1,
+        "",
     )?;
     range(
         "plots.fixed_theta_h_deg",

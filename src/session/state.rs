@@ -230,6 +230,8 @@ pub struct PlotSettings {
     pub fixed_theta_d_deg: f64,
     /// The fixed θh (for θd curves), degrees.
     pub fixed_theta_h_deg: f64,
+    /// The Snell view's interface.
+    pub snell: SnellSettings,
 }
 
 impl Default for PlotSettings {
@@ -238,6 +240,36 @@ impl Default for PlotSettings {
             axis: CartesianAxis::ThetaO,
             fixed_theta_d_deg: 30.0,
             fixed_theta_h_deg: 0.0,
+            snell: SnellSettings::default(),
+        }
+    }
+}
+
+/// The Snell view's interface: saved with the scene, so that a deck's slide
+/// can show the lecture's "optical manhole" (water seen from below).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SnellSettings {
+    /// The view's own relative index of the medium below (used when the
+    /// selected BRDF has no dielectric Fresnel term, or when `use_own` is set).
+    pub eta: f64,
+    /// Use `eta` even when the selected BRDF has a dielectric.
+    pub use_own: bool,
+    /// Light from below (from inside the medium η).
+    pub from_below: bool,
+}
+
+impl SnellSettings {
+    /// Accepted range of the view's own index.
+    pub const ETA_RANGE: (f64, f64) = (1.0, 3.0);
+}
+
+impl Default for SnellSettings {
+    fn default() -> Self {
+        Self {
+            eta: 1.5,
+            use_own: false,
+            from_below: false,
         }
     }
 }

@@ -18,7 +18,7 @@
 use super::svg::{Anchor, Baseline, Svg};
 use super::{Scene, View};
 use crate::session::command::Command;
-use crate::session::state::Incident;
+use crate::session::state::{Incident, PlotSettings, SnellSettings};
 use bv_core::fresnel::Fresnel;
 use bv_core::optics::{self, SnellDiagram};
 use eframe::egui::{self, Align2, Color32, Pos2, RichText, Sense, Stroke, Ui, Vec2};
@@ -667,13 +667,6 @@ fn to_svg(fig: &SnellFigure, size: [f32; 2], background: Option<Color32>) -> Str
 
 /// The Snell view.
 pub struct SnellView {
-    /// The view's own index of the medium below (used when the selected BRDF
-    /// has no dielectric Fresnel term, or when `use_own` is set).
-    pub eta: f64,
-    /// Use `eta` even when the selected BRDF has a dielectric.
-    pub use_own: bool,
-    /// Light from below (from inside the medium η).
-    pub from_below: bool,
     /// The figure of the last frame (for tests).
     pub last: Option<SnellFigure>,
     /// Where it was drawn, and the hit point's position and points per
@@ -684,9 +677,6 @@ pub struct SnellView {
 impl Default for SnellView {
     fn default() -> Self {
         Self {
-            eta: 1.5,
-            use_own: false,
-            from_below: false,
             last: None,
             last_rect: None,
         }
@@ -697,41 +687,46 @@ impl SnellView {
     /// The interface for `scene`: the selected BRDF's dielectric η unless the
     /// view's own is asked for.
     pub fn interface(&self, scene: &Scene<'_>) -> Interface {
+        let own = scene.state.plots.snell;
         let brdf = scene.primary().and_then(|b| {
             let f = b.brdf.fresnel_term()?;
             Some((b.label.clone(), dielectric_eta(&f.fresnel)?))
         });
         match brdf {
-            Some((label, eta)) if !self.use_own => Interface {
+            Some((label, eta)) if !own.use_own => Interface {
                 eta,
-                from_below: self.from_below,
+                from_below: own.from_below,
                 source: EtaSource::Brdf(label),
             },
             _ => Interface {
-                eta: self.eta,
-                from_below: self.from_below,
+                eta: own.eta,
+                from_below: own.from_below,
                 source: EtaSource::Own,
             },
         }
     }
 
     /// The lecture's "optical manhole": water (n = 4/3) seen from below.
-    pub fn optical_manhole(&mut self) {
-        self.eta = WATER;
-        self.use_own = true;
-        self.from_below = true;
+    pub fn optical_manhole() -> SnellSettings {
+        SnellSettings {
+            eta: WATER,
+            use_own: true,
+            from_below: true,
+        }
     }
 }
 
 impl View for SnellView {
-    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let before = scene.state.plots.snell;
+        let mut own = before;
         if super::toolbar_toggle(
             ui,
-            self.from_below,
+            own.from_below,
             "light from below",
             "Light arrives from inside the medium η (the dense side for η > 1)",
         ) {
-            self.from_below = !self.from_below;
+            own.from_below = !own.from_below;
         }
         let has_dielectric = scene
             .primary()
@@ -740,17 +735,18 @@ impl View for SnellView {
         if has_dielectric
             && super::toolbar_toggle(
                 ui,
-                !self.use_own,
+                !own.use_own,
                 "η of BRDF",
                 "Use the selected BRDF's dielectric index (off: the slider's)",
             )
         {
-            self.use_own = !self.use_own;
+            own.use_own = !own.use_own;
         }
-        if !has_dielectric || self.use_own {
+        if !has_dielectric || own.use_own {
+            let (lo, hi) = SnellSettings::ETA_RANGE;
             ui.add(
                 // No max_decimals: it would round the preset's 4/3 to 1.333.
-                egui::Slider::new(&mut self.eta, 1.0..=3.0).text("η"),
+                egui::Slider::new(&mut own.eta, lo..=hi).text("η"),
             );
         }
         if ui
@@ -758,7 +754,13 @@ impl View for SnellView {
             .on_hover_text("Water, n = 4/3, light from below: Snell's window of 2 × 48.6°")
             .clicked()
         {
-            self.optical_manhole();
+            own = Self::optical_manhole();
+        }
+        if own != before {
+            out.push(Command::SetPlots(PlotSettings {
+                snell: own,
+                ..scene.state.plots
+            }));
         }
     }
 
@@ -894,8 +896,7 @@ mod tests {
 
     #[test]
     fn the_manhole_preset_is_water_from_below() {
-        let mut v = SnellView::default();
-        v.optical_manhole();
+        let v = SnellView::optical_manhole();
         assert_eq!((v.eta, v.use_own, v.from_below), (WATER, true, true));
     }
 
