@@ -665,22 +665,14 @@ fn to_svg(fig: &SnellFigure, size: [f32; 2], background: Option<Color32>) -> Str
     svg.finish()
 }
 
-/// The Snell view.
+/// The Snell view (its settings are the scene's `plots.snell`).
+#[derive(Default)]
 pub struct SnellView {
     /// The figure of the last frame (for tests).
     pub last: Option<SnellFigure>,
     /// Where it was drawn, and the hit point's position and points per
     /// diagram unit there (for tests that drag the light).
     pub last_rect: Option<(egui::Rect, Pos2, f32)>,
-}
-
-impl Default for SnellView {
-    fn default() -> Self {
-        Self {
-            last: None,
-            last_rect: None,
-        }
-    }
 }
 
 impl SnellView {
