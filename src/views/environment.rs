@@ -835,12 +835,13 @@ impl View for EnvironmentView {
         for (k, d) in drawables.iter().enumerate() {
             let (c, r) = circle(k);
             let [cr, cg, cb] = d.brdf.rgb;
-            gpu_image::plate_text(
+            gpu_image::plate_text_within(
                 &painter,
                 egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
                 Align2::CENTER_TOP,
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),
+                Some(rect.width() / drawables.len().max(1) as f32),
             );
         }
         let mut y = rect.min.y + 30.0;

@@ -317,9 +317,35 @@ pub fn plate_text(
     text: &str,
     color: egui::Color32,
 ) -> egui::Rect {
+    plate_text_within(painter, pos, align, text, color, None)
+}
+
+/// [`plate_text`] on one line of at most `max_width` points (cut with "…"),
+/// when given; the plate is kept inside the painter's clip rectangle, so a
+/// label wider than its place is shortened rather than cut off at the edge.
+pub fn plate_text_within(
+    painter: &egui::Painter,
+    pos: egui::Pos2,
+    align: egui::Align2,
+    text: &str,
+    color: egui::Color32,
+    max_width: Option<f32>,
+) -> egui::Rect {
     let font = egui::FontId::proportional(12.5);
-    let galley = painter.layout(text.to_string(), font, color, 420.0);
-    let r = align.anchor_size(pos, galley.size());
+    let galley = match max_width {
+        Some(w) => {
+            let mut job = egui::text::LayoutJob::simple_singleline(text.to_string(), font, color);
+            job.wrap = egui::text::TextWrapping::truncate_at_width((w - 8.0).max(8.0));
+            painter.layout_job(job)
+        }
+        None => painter.layout(text.to_string(), font, color, 420.0),
+    };
+    let mut r = align.anchor_size(pos, galley.size());
+    let clip = painter.clip_rect().shrink(3.0);
+    if r.width() <= clip.width() {
+        let dx = (clip.min.x - r.min.x).max(0.0) + (clip.max.x - r.max.x).min(0.0);
+        r = r.translate(egui::vec2(dx, 0.0));
+    }
     let plate = r.expand(3.0);
     painter.rect_filled(
         plate,

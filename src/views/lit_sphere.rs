@@ -351,12 +351,13 @@ impl LitSphereView {
             painter.circle_stroke(at, 6.5, Stroke::new(1.5, outline));
             painter.circle_stroke(at, 3.5, Stroke::new(1.0, outline));
             let [cr, cg, cb] = d.brdf.rgb;
-            gpu_image::plate_text(
+            gpu_image::plate_text_within(
                 &painter,
                 egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
                 Align2::CENTER_TOP,
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),
+                Some(rect.width() / drawables.len().max(1) as f32),
             );
             // A mirror or smooth glass under a point light is black but for
             // one point: say why rather than show a black disc.
