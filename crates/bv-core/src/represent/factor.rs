@@ -39,7 +39,8 @@
 //! residual `M − Σ u_k u_kᵀ M`, not derived from the singular values.
 
 use crate::measured::Interpolation;
-use crate::measured::merl::{MerlDims, MerlTable};
+use crate::measured::merl::{MerlDims, MerlTable, tabulate};
+use crate::Brdf;
 use crate::models::merl::Merl;
 use crate::{BvError, Result};
 use std::sync::Arc;
@@ -362,12 +363,75 @@ pub fn factor(table: &MerlTable, terms: usize, space: FactorSpace) -> Result<Fac
     Ok(fac)
 }
 
+/// Table dimensions the views factor at: a quarter of the public MERL
+/// resolution along each angle (45 × 45 × 90 cells, 182 250 per channel).
+/// The θh axis keeps MERL's square-root spacing, which puts half its cells
+/// within 22.5° of the normal, so specular peaks stay resolved; the factoring
+/// takes a fraction of a second.
+pub const VIEW_DIMS: MerlDims = MerlDims {
+    theta_h: 45,
+    theta_d: 45,
+    phi_d: 90,
+};
+
+/// Reports the fraction done (0..=1) of a long computation and answers
+/// whether to go on: returning `false` cancels it (a background job whose
+/// result is no longer wanted).
+pub type Progress<'a> = &'a (dyn Fn(f64) -> bool + Sync);
+
+/// The error a cancelled computation returns.
+pub fn cancelled() -> BvError {
+    BvError::Invalid("cancelled".into())
+}
+
+/// Why a model cannot be factored through the half/difference table, if it
+/// cannot: the table has no φh axis, so it holds only isotropic BRDFs (an
+/// anisotropic model would be silently averaged to its φh = 0 slice).
+pub fn unsupported(brdf: &dyn Brdf) -> Option<String> {
+    if !brdf.claims().isotropic {
+        return Some(
+            "the half/difference table assumes an isotropic BRDF (no φh axis); \
+             this model is anisotropic"
+                .into(),
+        );
+    }
+    None
+}
+
+/// Tabulates an isotropic `brdf` at `dims` (see
+/// [`crate::measured::merl::tabulate`]) and factors the table into up to
+/// `terms` products per channel in `space`. `progress` is told the fraction
+/// done between stages and may cancel (then [`cancelled`] is returned).
+pub fn factor_model(
+    brdf: &dyn Brdf,
+    dims: MerlDims,
+    terms: usize,
+    space: FactorSpace,
+    progress: Progress<'_>,
+) -> Result<(MerlTable, Factorization)> {
+    if let Some(why) = unsupported(brdf) {
+        return Err(BvError::Invalid(why));
+    }
+    if !progress(0.0) {
+        return Err(cancelled());
+    }
+    let table = tabulate(brdf, dims)?;
+    if !progress(0.5) {
+        return Err(cancelled());
+    }
+    let f = factor(&table, terms, space)?;
+    if !progress(1.0) {
+        return Err(cancelled());
+    }
+    Ok((table, f))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::frame::{HalfDiff, from_half_diff};
-    use crate::measured::merl::{phi_d_centre, tabulate, theta_d_centre, theta_h_centre};
-    use crate::{Brdf, ModelSpec};
+    use crate::ModelSpec;
+    use crate::measured::merl::{phi_d_centre, theta_d_centre, theta_h_centre};
     use serde_json::json;
 
     const DIMS: MerlDims = MerlDims {
@@ -494,5 +558,101 @@ mod tests {
             factor(&z, 2, FactorSpace::Linear).unwrap().rel_l2_error,
             vec![0.0, 0.0]
         );
+    }
+
+    /// Lambert is constant over the cells above both horizons and 0 below:
+    /// per channel the table is `ρ/π · mask(θh, θd, φd)`, and the mask is not
+    /// a product of a θh row and a (θd, φd) column (the horizon θo = 90°
+    /// depends on all three), so it is *not* exactly rank 1. With the view's
+    /// own grid the rank-1 error is still small; the channels are exactly
+    /// proportional, so each channel's singular values are those of the mask
+    /// times ρ_c/π.
+    #[test]
+    fn lambert_factors_channel_by_channel_in_proportion() {
+        let b = ModelSpec::from_json("lambert", &json!({"albedo": [0.8, 0.4, 0.2]}))
+            .unwrap()
+            .build()
+            .unwrap();
+        let dims = MerlDims {
+            theta_h: 12,
+            theta_d: 10,
+            phi_d: 20,
+        };
+        let (t, f) = factor_model(b.as_ref(), dims, 6, FactorSpace::Linear, &|_| true).unwrap();
+        assert_eq!(t.dims(), dims);
+        let s = |c: usize| f.channels[c].sigma.clone();
+        for k in 0..6 {
+            assert!((s(1)[k] - 0.5 * s(0)[k]).abs() <= 1e-6 * s(0)[0], "{k}");
+            assert!((s(2)[k] - 0.25 * s(0)[k]).abs() <= 1e-6 * s(0)[0], "{k}");
+        }
+        // The per-channel errors agree (the same mask), and the combined one
+        // is non-increasing in K.
+        for k in 0..6 {
+            let e = &f.channels;
+            assert!((e[0].rel_l2_error[k] - e[2].rel_l2_error[k]).abs() < 1e-6);
+        }
+        for w in f.rel_l2_error.windows(2) {
+            assert!(w[1] <= w[0] + 1e-12, "{:?}", f.rel_l2_error);
+        }
+        // σ₁² + … ≤ ‖M‖² (Frobenius), with ‖M‖² = (ρ/π)² × cells above both
+        // horizons, counted here by hand.
+        let mut lit = 0usize;
+        for ih in 0..dims.theta_h {
+            for id in 0..dims.theta_d {
+                for ip in 0..dims.phi_d {
+                    let (wi, wo) = from_half_diff(HalfDiff {
+                        theta_h: theta_h_centre(ih, dims.theta_h),
+                        phi_h: 0.0,
+                        theta_d: theta_d_centre(id, dims.theta_d),
+                        phi_d: phi_d_centre(ip, dims.phi_d),
+                    });
+                    if wi.z > 0.0 && wo.z > 0.0 {
+                        lit += 1;
+                    }
+                }
+            }
+        }
+        let c = 0.8 / std::f64::consts::PI;
+        let norm2 = c * c * lit as f64;
+        let s2: f64 = s(0).iter().map(|x| x * x).sum();
+        assert!(s2 <= norm2 * (1.0 + 1e-6));
+        // The residual after 6 terms is what the singular values leave out.
+        let e6 = f.channels[0].rel_l2_error[5];
+        assert!(((1.0 - s2 / norm2).max(0.0).sqrt() - e6).abs() < 1e-4, "{e6}");
+    }
+
+    /// Lambert's table restricted to the cells above both horizons is the
+    /// constant ρ/π: exactly rank 1, with σ₁ by hand.
+    #[test]
+    fn constant_table_is_rank_one() {
+        let c = 0.3;
+        let dims = MerlDims {
+            theta_h: 6,
+            theta_d: 5,
+            phi_d: 8,
+        };
+        let cols = dims.theta_d * dims.phi_d;
+        let data: Vec<f32> = (0..3 * dims.cells()).map(|_| c as f32).collect();
+        let t = MerlTable::from_values(dims, data).unwrap();
+        let f = factor(&t, 3, FactorSpace::Linear).unwrap();
+        assert!(f.rel_l2_error[0] < 1e-12, "{:?}", f.rel_l2_error);
+        // σ₁ of a constant matrix: c √(rows · cols).
+        let want = f64::from(c as f32) * ((dims.theta_h * cols) as f64).sqrt();
+        assert!((f.channels[0].sigma[0] - want).abs() < 1e-9 * want);
+    }
+
+    #[test]
+    fn anisotropic_models_and_cancellation_are_refused() {
+        let ward = ModelSpec::from_json("ward", &json!({"alpha_x": 0.1, "alpha_y": 0.4}))
+            .unwrap()
+            .build()
+            .unwrap();
+        assert!(unsupported(ward.as_ref()).is_some());
+        assert!(factor_model(ward.as_ref(), DIMS, 2, FactorSpace::Linear, &|_| true).is_err());
+        let lambert = ModelSpec::new("lambert").unwrap().build().unwrap();
+        assert!(unsupported(lambert.as_ref()).is_none());
+        let stop = |x: f64| x < 0.25;
+        let e = factor_model(lambert.as_ref(), DIMS, 2, FactorSpace::Linear, &stop);
+        assert!(e.is_err());
     }
 }
