@@ -228,15 +228,18 @@ impl View for FactorView {
         self.chart.clear();
         let font = FontId::proportional(13.0);
         let small = FontId::proportional(12.0);
+        // A centred message, wrapped to the view's width.
         let message = |ui: &mut Ui, s: String, color: Color32| {
             let _ = ui.allocate_exact_size(area.size(), Sense::hover());
-            ui.painter_at(area).text(
-                area.center(),
-                Align2::CENTER_CENTER,
+            let painter = ui.painter_at(area);
+            let g = painter.layout(
                 s,
                 FontId::proportional(13.0),
                 color,
+                (area.width() - 12.0).max(40.0),
             );
+            let pos = area.center() - g.size() * 0.5;
+            painter.galley(pos, g, color);
         };
         let Some(b) = scene.primary().cloned() else {
             message(ui, "no BRDF drawn".into(), weak);
@@ -490,7 +493,11 @@ impl View for FactorView {
             painter.text(
                 Pos2::new(r.left(), r.top() - 3.0),
                 Align2::LEFT_BOTTOM,
-                format!("h_{}(θd, φd)", k + 1),
+                if w >= 110.0 {
+                    format!("h_{}(θd, φd)", k + 1)
+                } else {
+                    format!("h_{}", k + 1)
+                },
                 font.clone(),
                 color,
             );
