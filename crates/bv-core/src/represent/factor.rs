@@ -447,11 +447,10 @@ pub fn factor(table: &MerlTable, terms: usize, space: FactorSpace) -> Result<Fac
     Ok(fac)
 }
 
-/// Table dimensions the views factor at: a quarter of the public MERL
-/// resolution along each angle (45 × 45 × 90 cells, 182 250 per channel).
-/// The θh axis keeps MERL's square-root spacing, which puts half its cells
-/// within 22.5° of the normal, so specular peaks stay resolved; the factoring
-/// takes a fraction of a second.
+/// Table dimensions the views factor at: half the public MERL resolution
+/// along each angle (45 × 45 × 90 cells, 182 250 per channel, an eighth of
+/// MERL's). The θh axis keeps MERL's square-root spacing, which puts half
+/// its cells within 22.5° of the normal, so specular peaks stay resolved.
 pub const VIEW_DIMS: MerlDims = MerlDims {
     theta_h: 45,
     theta_d: 45,
