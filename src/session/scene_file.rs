@@ -44,7 +44,7 @@
 //! read-only files are refused, and a symlink is written through
 //! ([`fsio::write_atomic`]).
 
-use super::state::{AppState, BrdfEntry, Camera, Incident, STATE_VERSION, SnellSettings};
+use super::state::{AppState, BrdfEntry, Camera, Display, Incident, STATE_VERSION, SnellSettings};
 use bv_core::fsio;
 
 use serde::Deserialize;
@@ -425,6 +425,13 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
     )?;
     range("incident.phi_deg", s.incident.phi_deg, -360.0, 360.0, "°")?;
     range("display.turn_deg", s.display.turn_deg, -360.0, 360.0, "°")?;
+    range(
+        "display.factor_terms",
+        f64::from(s.display.factor_terms),
+        1.0,
+        f64::from(Display::MAX_FACTOR_TERMS),
+        " terms",
+    )?;
     let c = s.camera;
     if !c.yaw_deg.is_finite() {
         return bad(
@@ -639,6 +646,10 @@ mod tests {
         assert!(e.to_string().contains("incident.theta_deg"), "{e}");
         let e = from_toml(&text.replace("turn_deg = 37.5", "turn_deg = 1e9")).unwrap_err();
         assert!(e.to_string().contains("display.turn_deg"), "{e}");
+        let e = from_toml(&text.replace("factor_terms = 2", "factor_terms = 0")).unwrap_err();
+        assert!(e.to_string().contains("display.factor_terms"), "{e}");
+        let e = from_toml(&text.replace("factor_terms = 2", "factor_terms = 9")).unwrap_err();
+        assert!(e.to_string().contains("display.factor_terms"), "{e}");
         let e = from_toml(&text.replace("albedo = [", "albedo = [7.0, ")).unwrap_err();
         let m = e.to_string();
         assert!(m.contains("brdfs[0]") && m.contains("albedo"), "{m}");

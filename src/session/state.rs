@@ -134,6 +134,11 @@ pub struct Display {
     pub sh_overlay: bool,
     /// Its highest order L (0–16).
     pub sh_order: u8,
+    /// Lobe and polar views: overlay the selected BRDF rebuilt from the first
+    /// K terms of its half/difference-table factorisation.
+    pub factor_overlay: bool,
+    /// Its number of terms K (1..=[`Display::MAX_FACTOR_TERMS`]).
+    pub factor_terms: u8,
     /// The surface turned about its normal by this angle, degrees
     /// (counter-clockwise seen from above, from the tangent towards the
     /// bitangent): "if you turn an object, does its shading change?" An
@@ -152,9 +157,18 @@ impl Default for Display {
             auto_scale: true,
             sh_overlay: false,
             sh_order: 4,
+            factor_overlay: false,
+            factor_terms: 2,
             turn_deg: 0.0,
         }
     }
+}
+
+impl Display {
+    /// Most factorisation terms the overlay and the factorisation view use:
+    /// past 8 the rebuilt lobes of the catalogue's models no longer differ
+    /// visibly from the table.
+    pub const MAX_FACTOR_TERMS: u8 = 8;
 }
 
 /// The orbit camera of the lobe view.
@@ -421,6 +435,10 @@ impl AppState {
             .display
             .sh_order
             .min(bv_core::represent::sh::MAX_ORDER as u8);
+        self.display.factor_terms = self
+            .display
+            .factor_terms
+            .clamp(1, Display::MAX_FACTOR_TERMS);
         self.version = STATE_VERSION;
         self
     }

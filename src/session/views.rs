@@ -81,6 +81,11 @@ pub const VIEWS: &[ViewInfo] = &[
         title: "Importance sampling",
         in_grid: false,
     },
+    ViewInfo {
+        id: "factor",
+        title: "Factorisation (SVD vs SH)",
+        in_grid: false,
+    },
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

@@ -11,6 +11,7 @@
 
 use super::BrdfColor as _;
 use super::camera::{self, CameraMatrices};
+use super::factor_overlay::{self, FactorDone};
 use super::lobe_gpu::LobeCallback;
 use super::sh_overlay::{self, ShDone};
 use super::{Scene, View, colormap, curves};
@@ -40,6 +41,9 @@ const UNDER_SH_ALPHA: f32 = 0.6;
 /// Mesh key of the SH reconstruction (distinct from BRDF ids and the disc).
 const SH_MESH_KEY: u64 = u64::MAX - 2;
 
+/// Mesh key of the factorisation's reconstruction.
+const FACTOR_MESH_KEY: u64 = u64::MAX - 3;
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct MeshKey {
     brdf_revision: u64,
@@ -66,6 +70,8 @@ pub struct Lobe3dView {
     last_frame: Option<Arc<LobeFrame>>,
     /// The SH overlay's latest result and its mesh revision.
     sh: Option<(ShDone, u64)>,
+    /// The factorisation overlay's latest result and its mesh revision.
+    factor: Option<(FactorDone, u64)>,
     /// Where the view was drawn in the last frame.
     pub view_rect: Option<Rect>,
 }
@@ -90,6 +96,7 @@ impl Lobe3dView {
             rebuilds: 0,
             last_frame: None,
             sh: None,
+            factor: None,
             view_rect: None,
         }
     }
@@ -103,6 +110,24 @@ impl Lobe3dView {
     /// a new result gets a new mesh revision.
     pub fn set_sh(&mut self, done: Option<ShDone>) {
         self.sh = done.map(|d| match &self.sh {
+            Some((old, rev)) if Arc::ptr_eq(old, &d) => (d, *rev),
+            _ => {
+                let rev = self.next_revision;
+                self.next_revision += 1;
+                (d, rev)
+            }
+        });
+    }
+
+    /// The factorisation overlay result the view draws (with the overlay on).
+    pub fn factor_result(&self) -> Option<&FactorDone> {
+        self.factor.as_ref().map(|(d, _)| d)
+    }
+
+    /// Takes the factorisation overlay's latest result (`None` with the
+    /// overlay off); a new result gets a new mesh revision.
+    pub fn set_factor(&mut self, done: Option<FactorDone>) {
+        self.factor = done.map(|d| match &self.factor {
             Some((old, rev)) if Arc::ptr_eq(old, &d) => (d, *rev),
             _ => {
                 let rev = self.next_revision;
@@ -219,6 +244,13 @@ impl Lobe3dView {
             .filter(|_| d.sh_overlay)
             .and_then(|(done, rev)| Some((done.value.as_ref().ok()?, *rev)))
             .filter(|(r, _)| Some(r.brdf_id) == primary);
+        let factor = self
+            .factor
+            .as_ref()
+            .filter(|_| d.factor_overlay)
+            .and_then(|(done, rev)| Some((done.value.as_ref().ok()?, *rev)))
+            .filter(|(r, _)| Some(r.brdf_id) == primary);
+        let overlaid = sh.is_some() || factor.is_some();
         let mut meshes = Vec::new();
         for b in &scene.brdfs {
             let Some(c) = self.cache.get(&b.id) else {
@@ -235,7 +267,7 @@ impl Lobe3dView {
                     alpha: if d.wireframe {
                         1.0
                     } else if is_primary {
-                        if sh.is_some() { UNDER_SH_ALPHA } else { 1.0 }
+                        if overlaid { UNDER_SH_ALPHA } else { 1.0 }
                     } else {
                         OVERLAY_ALPHA
                     },
@@ -258,6 +290,28 @@ impl Lobe3dView {
                         [0.97, 0.97, 0.97]
                     } else {
                         [0.05, 0.05, 0.05]
+                    },
+                    alpha: 1.0,
+                    wireframe: true,
+                    value_max: 1.0,
+                    log: d.log,
+                    scale,
+                    unlit: true,
+                },
+            });
+        }
+        if let Some((r, rev)) = factor {
+            meshes.push(MeshDraw {
+                key: FACTOR_MESH_KEY,
+                revision: rev,
+                mesh: r.mesh.clone(),
+                style: MeshStyle {
+                    by_value: false,
+                    // Amber, apart from the SH wireframe's white / black.
+                    color: if dark {
+                        [1.0, 0.72, 0.2]
+                    } else {
+                        [0.75, 0.38, 0.0]
                     },
                     alpha: 1.0,
                     wireframe: true,
@@ -550,6 +604,8 @@ impl View for Lobe3dView {
         }
         sh_overlay::control(ui, scene, out);
         sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
+        factor_overlay::control(ui, scene, out);
+        factor_overlay::error_label(ui, scene, factor_overlay::request(ui.ctx(), scene).as_ref());
         if super::toolbar_toggle(
             ui,
             d.auto_scale,
@@ -586,6 +642,7 @@ impl View for Lobe3dView {
             bg = [0.0; 4];
         }
         self.set_sh(sh_overlay::request(ui.ctx(), scene));
+        self.set_factor(factor_overlay::request(ui.ctx(), scene));
         let frame = self.frame(scene, rect.size(), bg, dark);
         ui.painter().add(
             LobeCallback {

@@ -17,6 +17,8 @@ pub mod chart;
 pub mod colormap;
 pub mod curves;
 pub mod environment;
+pub mod factor;
+pub mod factor_overlay;
 pub mod fresnel;
 pub mod gpu_image;
 pub mod image_slice;
@@ -113,6 +115,7 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "snell" => || Box::new(snell::SnellView::default()),
         "terms" => || Box::new(terms::TermsView::default()),
         "sampling" => || Box::new(sampling::SamplingView::default()),
+        "factor" => || Box::new(factor::FactorView::default()),
         _ => return None,
     };
     Some(make)

@@ -6,7 +6,7 @@
 
 use super::BrdfColor as _;
 use super::curves::{self, Sample};
-use super::{Scene, View, sh_overlay};
+use super::{Scene, View, factor_overlay, sh_overlay};
 use crate::session::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
@@ -25,6 +25,8 @@ pub struct PolarView {
     pub plot_rect: Option<egui::Rect>,
     /// The SH overlay's curve drawn in the last frame (plot coordinates).
     pub sh_curve: Option<Vec<[f64; 2]>>,
+    /// The factorisation overlay's curve drawn in the last frame.
+    pub factor_curve: Option<Vec<[f64; 2]>>,
     /// The outgoing direction last hovered (signed in-plane angle, radians):
     /// it stays when the pointer leaves the plot, so that the swap button
     /// below can be reached.
@@ -173,6 +175,8 @@ impl View for PolarView {
         super::display_toggles(ui, scene, out);
         sh_overlay::control(ui, scene, out);
         sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
+        factor_overlay::control(ui, scene, out);
+        factor_overlay::error_label(ui, scene, factor_overlay::request(ui.ctx(), scene).as_ref());
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
@@ -203,6 +207,27 @@ impl View for PolarView {
             ))
         });
         self.sh_curve = sh.as_ref().map(|s| s.2.clone());
+        // The factorisation's reconstruction, dashed in amber (as its
+        // wireframe in the 3D lobe).
+        let factor = factor_overlay::request(ui.ctx(), scene).and_then(|done| {
+            let r = done.value.as_ref().ok()?;
+            let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;
+            let pts: Vec<[f64; 2]> = r
+                .plane
+                .iter()
+                .map(|s| {
+                    let rad = radius(s.value, d.log);
+                    [rad * s.x.sin(), rad * s.x.cos()]
+                })
+                .collect();
+            Some((format!("{} factor K = {}", b.label, r.terms), pts))
+        });
+        self.factor_curve = factor.as_ref().map(|f| f.1.clone());
+        let factor_color = if dark {
+            egui::Color32::from_rgb(255, 184, 51)
+        } else {
+            egui::Color32::from_rgb(191, 97, 0)
+        };
 
         let grid = super::grid_color(dark);
         let text_col = super::strong_text(ui);
@@ -363,6 +388,14 @@ impl View for PolarView {
                     Line::new(label.clone(), PlotPoints::from(pts.clone()))
                         .color(*color)
                         .style(LineStyle::Dashed { length: 8.0 })
+                        .width(scene.stroke(2.0)),
+                );
+            }
+            if let Some((label, pts)) = &factor {
+                pui.line(
+                    Line::new(label.clone(), PlotPoints::from(pts.clone()))
+                        .color(factor_color)
+                        .style(LineStyle::Dashed { length: 12.0 })
                         .width(scene.stroke(2.0)),
                 );
             }

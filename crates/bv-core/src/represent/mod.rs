@@ -4,5 +4,6 @@
 
 pub mod factor;
 pub mod sh;
+pub mod sh_table;
 
 pub use sh::{Domain, ShLobe};
