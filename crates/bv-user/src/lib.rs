@@ -19,6 +19,7 @@ pub mod front;
 pub mod port;
 pub mod safety;
 pub mod source_map;
+pub mod watch;
 
 pub use catalogue::{install, is_file_name, load, model_id, open, path_of};
 pub use compile::{Compiled, compile};
