@@ -194,3 +194,168 @@ fn the_gpu_evaluates_every_test_file_as_its_closed_form() {
         assert!(g.iter().all(|x| x.is_finite()), "{g:?}");
     }
 }
+
+/// The parity directions of `tests/gpu_parity.rs` in spirit: uniform pairs
+/// over the upper hemisphere, grazing ones, near the mirror and retro
+/// directions and on the normal.
+fn parity_pairs() -> Vec<(DVec3, DVec3)> {
+    let mut out = pairs();
+    let d = |t: f64, p: f64| DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
+    for k in 0..24 {
+        let t = 0.05 + 1.5 * f64::from(k) / 24.0;
+        let p = 0.37 * f64::from(k);
+        let wi = d(t, p);
+        out.push((wi, d(t * 0.999, p + PI + 0.01))); // near the mirror
+        out.push((wi, d(t * 0.98, p + 0.02))); // near the retro direction
+        out.push((wi, DVec3::Z));
+        out.push((DVec3::Z, wi));
+        out.push((d(1.55, p), d(1.5, p + 2.0))); // grazing
+    }
+    out
+}
+
+#[test]
+fn cpu_and_gpu_agree_on_file_models() {
+    let names = [
+        ("lambert.brdf", serde_json::json!({})),
+        ("phong.brdf", serde_json::json!({"e": 50.0})),
+        ("cooktorrance.brdf", serde_json::json!({"m": 0.2})),
+        (
+            "ward.brdf",
+            serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.3}),
+        ),
+        ("ggx.brdf", serde_json::json!({"alpha": 0.4})),
+        ("lenient_int_literals.brdf", serde_json::json!({})),
+        ("lenient_reflect.brdf", serde_json::json!({})),
+        ("lenient_globals.brdf", serde_json::json!({})),
+        ("lenient_shadowing.brdf", serde_json::json!({})),
+        ("lenient_bools.brdf", serde_json::json!({"doubled": true})),
+        ("features.brdf", serde_json::json!({})),
+        ("native.brdf", serde_json::json!({})),
+        ("retro.brdf", serde_json::json!({"shine": 30.0})),
+    ];
+    let specs: Vec<(&str, ModelSpec)> = names
+        .iter()
+        .map(|(n, p)| (*n, spec(n, p.clone())))
+        .collect();
+    let Some((eval, ())) = gpu() else {
+        return;
+    };
+    let p = parity_pairs();
+    let fp = f32_pairs(&p);
+    let mut worst = 0.0f64;
+    for (name, s) in &specs {
+        let cpu = s.build().unwrap();
+        let got = eval.eval(s, &fp).unwrap();
+        for ((wi, wo), g) in fp.iter().zip(&got) {
+            // The CPU gets exactly the f32 directions the GPU got.
+            let wi = glam::Vec3::from_array(*wi).as_dvec3();
+            let wo = glam::Vec3::from_array(*wo).as_dvec3();
+            let w = cpu.eval(wi, wo);
+            for c in 0..3 {
+                let err = (f64::from(g[c]) - w[c]).abs();
+                let rel = err / w[c].abs().max(1e-3);
+                worst = worst.max(rel);
+                assert!(
+                    err <= 1e-4 * w[c].abs() + 1e-6,
+                    "{name}: GPU {g:?} against CPU {w} at wi {wi} wo {wo}"
+                );
+            }
+        }
+    }
+    println!("worst CPU/GPU relative difference: {worst:.2e}");
+}
+
+/// Runs `bv eval` on JSON lines and returns the `f` of each answer.
+fn bv_eval(queries: &[serde_json::Value]) -> Vec<[f64; 3]> {
+    use std::io::Write as _;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_bv"))
+        .arg("eval")
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    {
+        let mut stdin = child.stdin.take().unwrap();
+        for q in queries {
+            writeln!(stdin, "{q}").unwrap();
+        }
+    }
+    let out = child.wait_with_output().unwrap();
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let v: serde_json::Value = serde_json::from_str(l).unwrap();
+            let f = v.get("f").unwrap_or_else(|| panic!("{l}"));
+            let f: Vec<f64> = serde_json::from_value(f.clone()).unwrap();
+            [f[0], f[1], f[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn bv_eval_of_a_file_agrees_with_the_built_in_model() {
+    // (file, its parameters, built-in model, the built-in's parameters).
+    let cases = [
+        (
+            "lambert.brdf",
+            serde_json::json!({"albedo": [0.2, 0.5, 0.8]}),
+            "lambert",
+            serde_json::json!({"albedo": [0.2, 0.5, 0.8]}),
+        ),
+        (
+            "phong.brdf",
+            serde_json::json!({"kd": 0.1, "ks": [0.3, 0.2, 0.1], "e": 40}),
+            "phong",
+            serde_json::json!({"kd": 0.1, "ks": [0.3, 0.2, 0.1], "e": 40}),
+        ),
+        (
+            "cooktorrance.brdf",
+            serde_json::json!({"kd": 0.2, "ks": 0.6, "m": 0.25, "f0": 0.1}),
+            "cook-torrance",
+            serde_json::json!({"kd": 0.2, "ks": 0.6, "distribution": "beckmann",
+                "alpha_x": 0.25, "alpha_y": 0.25, "geometry": "v-groove",
+                "fresnel": "schlick", "f0": 0.1}),
+        ),
+        (
+            "ward.brdf",
+            serde_json::json!({"kd": 0.3, "ks": 0.15, "alpha_x": 0.1, "alpha_y": 0.35}),
+            "ward",
+            serde_json::json!({"kd": 0.3, "ks": 0.15, "alpha_x": 0.1, "alpha_y": 0.35}),
+        ),
+        (
+            "ggx.brdf",
+            serde_json::json!({"alpha": 0.3}),
+            "cook-torrance",
+            serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx",
+                "alpha_x": 0.3, "alpha_y": 0.3, "geometry": "v-groove", "fresnel": "none"}),
+        ),
+    ];
+    let dirs = pairs();
+    for (file, fp, model, mp) in cases {
+        let path = data(file).display().to_string();
+        let mut queries = Vec::new();
+        for (wi, wo) in &dirs {
+            let (wi, wo) = (wi.to_array(), wo.to_array());
+            queries.push(serde_json::json!({"model": path, "params": fp, "wi": wi, "wo": wo}));
+            queries.push(serde_json::json!({"model": model, "params": mp, "wi": wi, "wo": wo}));
+        }
+        let f = bv_eval(&queries);
+        assert_eq!(f.len(), queries.len(), "{file}: one answer per query");
+        let mut worst = 0.0f64;
+        for (k, pair) in f.chunks(2).enumerate() {
+            for c in 0..3 {
+                let (a, b) = (pair[0][c], pair[1][c]);
+                let rel = (a - b).abs() / b.abs().max(1e-300);
+                worst = worst.max(if b == 0.0 { a.abs() } else { rel });
+                assert!(
+                    (a - b).abs() <= 1e-5 * b.abs() + 1e-12,
+                    "{file} against {model} at {:?}: {a} vs {b}",
+                    dirs[k]
+                );
+            }
+        }
+        println!("{file} vs {model}: worst relative difference {worst:.2e}");
+    }
+}

@@ -66,7 +66,7 @@ pub fn model_info(c: &Compiled, path: &Path) -> Result<ModelInfo> {
         .unwrap_or_else(|| id.clone());
     let module_path = format!("bv::user::m{}", id.replace('-', "_"));
     let source = port::bv_module(&module_path, &c.wgsl, c.decls)?;
-    let program = cpu::FileProgram::new(c)?;
+    let program = cpu::FileProgram::new(c, &path.display().to_string())?;
     let id: &'static str = leak(id);
     let build = Build::Shared(Arc::new(move |p: &bv_core::Params| {
         program
@@ -121,7 +121,11 @@ pub fn read(path: &Path) -> Result<String> {
     let bytes =
         bv_core::fsio::read_capped(path, cap, "BRDF file").map_err(|e| UserError::Read {
             file: path.display().to_string(),
-            reason: e.to_string(),
+            // The file's name is said once.
+            reason: match e {
+                bv_core::BvError::File { reason, .. } => reason,
+                other => other.to_string(),
+            },
         })?;
     String::from_utf8(bytes).map_err(|_| UserError::Read {
         file: path.display().to_string(),

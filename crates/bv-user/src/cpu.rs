@@ -1,49 +1,141 @@
-//! The CPU evaluator of a file model (placeholder until the interpreter).
+//! The CPU evaluator of a file model: bv-interp, an f64 interpreter over the
+//! same naga module the GPU port is written from, so that both evaluate one
+//! translation of the user's code. Parameters are set as the module-scope
+//! globals the wrapper of the GPU port sets ([`crate::port::param_global`]);
+//! the model function is called in bv's frame (N = +z, X = +x, Y = +y,
+//! L = ωi, V = ωo).
+//!
+//! Every call is bounded by the interpreter's [`Limits`] (steps, call depth,
+//! memory): an endless loop ends with an error, never a hang. An evaluator is
+//! probed once when it is built (at normal incidence), so that a shader that
+//! never finishes, or one the interpreter cannot run, is a clear build error;
+//! a later evaluation that fails reads as 0.
+//!
+//! Values are handled as the built-in models and the GPU port handle them:
+//! 0 below the horizon (the Explorer draws only the upper hemisphere), and
+//! a NaN or infinite channel (a division by a vanishing cosine) reads as 0.
+//! Negative values are kept, so that `bv check` reports them.
 
 use crate::compile::Compiled;
 use crate::error::{Result, UserError};
-use bv_core::{Brdf, Claims, Rgb};
+use crate::port;
+use bv_core::params::ParamKind;
+use bv_core::{Brdf, Claims, ParamDecl, Params, Rgb};
+use bv_interp::{InterpError, Limits, Program, Value};
 use glam::DVec3;
+use std::sync::Arc;
 
-/// A file's program, ready to be given parameter values.
+/// A file's module and declaration, ready to be given parameter values.
 #[derive(Debug, Clone)]
 pub struct FileProgram {
+    module: naga::Module,
+    decls: &'static [ParamDecl],
     file: String,
 }
 
-impl FileProgram {
-    /// The program of a compiled file.
-    pub fn new(c: &Compiled) -> Result<Self> {
-        let _ = c;
-        Ok(Self {
-            file: String::new(),
-        })
-    }
-
-    /// An evaluator for parameter values `p`.
-    pub fn build(&self, id: &'static str, p: &bv_core::Params) -> Result<FileBrdf> {
-        let _ = p;
-        let _ = id;
-        Err(UserError::Model {
-            file: self.file.clone(),
-            reason: "no CPU evaluator yet".into(),
-        })
+fn interp_error(file: &str, e: &InterpError) -> UserError {
+    UserError::Model {
+        file: file.to_string(),
+        reason: format!("on the CPU: {e}"),
     }
 }
 
-/// A file model with its parameter values.
-#[derive(Debug)]
+impl FileProgram {
+    /// The program of a compiled file; fails if the interpreter cannot run
+    /// the module (a feature it lacks).
+    pub fn new(c: &Compiled, file: &str) -> Result<Self> {
+        Program::new(c.module.clone()).map_err(|e| interp_error(file, &e))?;
+        Ok(Self {
+            module: c.module.clone(),
+            decls: c.decls,
+            file: file.to_string(),
+        })
+    }
+
+    /// An evaluator for parameter values `p` (validated by the spec against
+    /// the file's declaration).
+    pub fn build(&self, id: &'static str, p: &Params) -> Result<FileBrdf> {
+        let mut program =
+            Program::new(self.module.clone()).map_err(|e| interp_error(&self.file, &e))?;
+        let bad = |e: bv_core::BvError| UserError::Model {
+            file: self.file.clone(),
+            reason: e.to_string(),
+        };
+        for (k, d) in self.decls.iter().enumerate() {
+            let v = match d.kind {
+                ParamKind::Float(_) => Value::f(p.float(d.id).map_err(bad)?),
+                ParamKind::Bool { .. } => Value::Bool(p.bool(d.id).map_err(bad)?),
+                ParamKind::Color(_) => {
+                    let c = p.color(d.id).map_err(bad)?;
+                    Value::vec3(c.x, c.y, c.z)
+                }
+                _ => {
+                    return Err(UserError::Model {
+                        file: self.file.clone(),
+                        reason: format!("internal: parameter `{}` has no file kind", d.id),
+                    });
+                }
+            };
+            program
+                .set_global(&port::param_global(k), v)
+                .map_err(|e| interp_error(&self.file, &e))?;
+        }
+        let b = FileBrdf {
+            id,
+            program: Arc::new(program),
+            limits: Limits::default(),
+        };
+        b.try_eval(DVec3::Z, DVec3::Z)
+            .map_err(|e| interp_error(&self.file, &e))?;
+        Ok(b)
+    }
+}
+
+/// A file model with its parameter values, evaluated by the interpreter.
 pub struct FileBrdf {
     id: &'static str,
+    program: Arc<Program>,
+    limits: Limits,
+}
+
+impl std::fmt::Debug for FileBrdf {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FileBrdf").field("id", &self.id).finish()
+    }
+}
+
+fn v3(w: DVec3) -> Value {
+    Value::vec3(w.x, w.y, w.z)
+}
+
+impl FileBrdf {
+    /// f(wi, wo) as the shader returns it (no horizon test, no clamping).
+    pub fn try_eval(&self, wi: DVec3, wo: DVec3) -> Result<Rgb, InterpError> {
+        let args = [v3(wi), v3(wo), v3(DVec3::Z), v3(DVec3::X), v3(DVec3::Y)];
+        let out = self.program.call(port::BRDF_FN, &args, &self.limits)?;
+        let [r, g, b] = out
+            .as_vec3()
+            .ok_or_else(|| InterpError::Invalid("the BRDF function returned no vec3".into()))?;
+        Ok(Rgb::new(r, g, b))
+    }
 }
 
 impl Brdf for FileBrdf {
     fn id(&self) -> &'static str {
         self.id
     }
-    fn eval(&self, _wi: DVec3, _wo: DVec3) -> Rgb {
-        Rgb::ZERO
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        match self.try_eval(wi, wo) {
+            Ok(f) => Rgb::from_array(f.to_array().map(|x| if x.is_finite() { x } else { 0.0 })),
+            Err(_) => Rgb::ZERO,
+        }
     }
+
+    /// A user file claims nothing: `bv check` measures what it does.
     fn claims(&self) -> Claims {
         Claims {
             reciprocal: false,
