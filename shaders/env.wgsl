@@ -12,7 +12,7 @@
 #import bv::dispatch
 #import bv::frame::PI
 #import bv::sampling::pcg
-#import bv::sphere::{sphere_at, to_local, to_view, SpherePoint}
+#import bv::sphere::{sphere_at, to_local, to_view, turned, SpherePoint}
 #import bv::torus
 
 struct Frame {
@@ -38,6 +38,11 @@ struct Frame {
     // device's storage binding limit; the dispatch starts at y0).
     y0: u32,
     y1: u32,
+    // The surface turned about its normal (radians).
+    turn: f32,
+    pad0: f32,
+    pad1: f32,
+    pad2: f32,
 }
 
 // Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
@@ -234,6 +239,7 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     } else {
         s = sphere_at(p, view.size, view.tiles);
     }
+    s = turned(s, view.turn);
     var sum = vec3<f32>(0.0);
     if (s.tile < 0) {
         // Background: the environment through a pinhole of the given field of view.

@@ -3,7 +3,7 @@
 // and sRGB encoding.
 #import bv::brdf
 #import bv::display::display
-#import bv::sphere::{sphere_at, to_local}
+#import bv::sphere::{sphere_at, to_local, turned}
 
 struct View {
     size: vec2<f32>,
@@ -17,7 +17,8 @@ struct View {
     // Background: 0 flat colour, 1 checkerboard of colour and colour2.
     background: u32,
     checker: f32,
-    pad: f32,
+    // The surface turned about its normal (radians).
+    turn: f32,
     color: vec4<f32>,
     color2: vec4<f32>,
 }
@@ -51,7 +52,7 @@ fn background(p: vec2<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = sphere_at(pos.xy, view.size, view.tiles);
+    let s = turned(sphere_at(pos.xy, view.size, view.tiles), view.turn);
     if (s.tile < 0) {
         return vec4<f32>(background(pos.xy), 1.0);
     }

@@ -204,6 +204,32 @@ fn the_light_follows_its_slider_and_the_hemisphere() {
     assert!(low.theta_deg > 30.0, "{low:?}");
 }
 
+/// The "turn surface" slider turns the surface about its normal: an
+/// anisotropic Ward's lobe is rebuilt and its values change.
+#[test]
+fn the_turn_slider_turns_an_anisotropic_lobe() {
+    let mut state = AppState::default();
+    state.add(
+        bv_core::ModelSpec::from_json(
+            "ward",
+            &serde_json::json!({"alpha_x": 0.08, "alpha_y": 0.4}),
+        )
+        .unwrap(),
+    );
+    let mut h = viewer(state);
+    let builds = lobe(&h).rebuild_count();
+    let slider = h.get_by_role_and_label(Role::Slider, "turn surface");
+    let r = slider.rect();
+    drag(
+        &mut h,
+        r.center(),
+        r.center() + egui::vec2(r.width() * 0.25, 0.0),
+    );
+    let turn = h.state().state().display.turn_deg;
+    assert!(turn > 20.0, "turn {turn}");
+    assert!(lobe(&h).rebuild_count() > builds, "the lobe is rebuilt");
+}
+
 #[test]
 fn views_maximise_and_restore() {
     let mut h = viewer(AppState::first_run());
@@ -284,7 +310,12 @@ fn every_model_gets_widgets_from_its_declaration() {
         let mut state = AppState::default();
         state.add(bv_core::ModelSpec::new(info.id).unwrap());
         let h = viewer(state);
-        for decl in info.params {
+        let defaults = bv_core::ModelSpec::new(info.id).unwrap();
+        for decl in info
+            .params
+            .iter()
+            .filter(|d| d.applies_to(defaults.params()))
+        {
             let found = h.query_all(by().label(decl.label).include_labels()).count();
             assert!(
                 found > 0,
@@ -294,6 +325,50 @@ fn every_model_gets_widgets_from_its_declaration() {
             );
         }
     }
+}
+
+/// A parameter declared to matter only under some choices (k of a
+/// conductor's Fresnel term) has a widget under those choices and none under
+/// the others: for every such declaration of every model, its label is found
+/// more often with a choice that makes it apply than with one that does not.
+#[test]
+fn parameters_that_do_not_apply_are_hidden() {
+    let mut checked = 0;
+    for info in bv_core::catalogue().iter() {
+        for decl in info.params {
+            let bv_core::Applies::When { param, any_of } = decl.applies else {
+                continue;
+            };
+            let bv_core::ParamKind::Choice { options, .. } = info.param(param).unwrap().kind else {
+                panic!(
+                    "{}: `{}` depends on `{param}`, which is not a choice",
+                    info.id, decl.id
+                );
+            };
+            let Some(off) = options.iter().find(|o| !any_of.contains(o)) else {
+                continue;
+            };
+            let count = |choice: &str| {
+                let mut spec = bv_core::ModelSpec::new(info.id).unwrap();
+                spec.set_str(param, choice).unwrap();
+                let mut state = AppState::default();
+                state.add(spec);
+                let h = viewer(state);
+                h.query_all(by().label(decl.label).include_labels()).count()
+            };
+            let shown = count(any_of[0]);
+            let hidden = count(off);
+            assert!(
+                shown > hidden,
+                "{}: `{}` has {shown} widgets with {param} = {} and {hidden} with {param} = {off}",
+                info.id,
+                decl.id,
+                any_of[0]
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "only {checked} conditional parameters found");
 }
 
 #[test]

@@ -14,7 +14,7 @@ use bv::session::scene_file;
 use bv::session::state::AppState;
 use bv::views::REGISTRY;
 use bv_core::model::{Build, GpuPort, ModelInfo};
-use bv_core::params::{ColorSpec, ParamDecl, ParamKind, Params};
+use bv_core::params::{Applies, ColorSpec, ParamDecl, ParamKind, Params};
 use bv_core::{Brdf, Claims, ModelSpec, Rgb};
 use eframe::egui::Vec2;
 use glam::DVec3;
@@ -57,6 +57,7 @@ static PARAMS: &[ParamDecl] = &[ParamDecl {
     label: "albedo",
     doc: "Reflectance scale",
     kind: ParamKind::Color(ColorSpec::unit_range([0.6, 0.5, 0.4])),
+    applies: Applies::Always,
 }];
 
 const WGSL: &str = "\

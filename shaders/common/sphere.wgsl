@@ -47,6 +47,17 @@ fn sphere_at(p: vec2<f32>, size: vec2<f32>, tiles: u32) -> SpherePoint {
     return out;
 }
 
+// The point with its tangent frame turned about the normal by `angle`
+// (radians, from t towards b): the surface turned about its normal.
+fn turned(s: SpherePoint, angle: f32) -> SpherePoint {
+    var out = s;
+    let c = cos(angle);
+    let sn = sin(angle);
+    out.t = c * s.t + sn * s.b;
+    out.b = c * s.b - sn * s.t;
+    return out;
+}
+
 // A view-space direction in the point's local shading frame .
 fn to_local(s: SpherePoint, w: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(w, s.t), dot(w, s.b), dot(w, s.n));

@@ -4,7 +4,7 @@
 
 use crate::session::command::Command;
 use crate::session::runtime::Runtime;
-use crate::session::state::{AppState, Incident};
+use crate::session::state::{AppState, Display, Incident};
 use crate::views;
 use crate::widgets::params_ui::{self, Edit};
 use eframe::egui::{
@@ -154,6 +154,39 @@ pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
         out.push(Command::SetIncident(Incident {
             theta_deg: t,
             phi_deg: p,
+        }));
+    }
+    turn_ui(ui, state, out);
+}
+
+/// The surface turned about its normal: the lecture's test of isotropy
+/// ("turn the object: does the shading change?").
+fn turn_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
+    let mut turn = state.display.turn_deg;
+    ui.horizontal(|ui| {
+        ui.spacing_mut().slider_width = 110.0;
+        let row = params_ui::slider_row(
+            ui,
+            egui::Id::unique("bv surface turn"),
+            &mut turn,
+            -180.0..=180.0,
+            -180.0..=180.0,
+            false,
+            "°",
+            "turn surface",
+        );
+        if row.reset {
+            turn = 0.0;
+        }
+        row.track.on_hover_text(
+            "Turn the surface about its normal (its tangent frame): an anisotropic \
+             highlight turns with it, an isotropic one stays",
+        );
+    });
+    if turn != state.display.turn_deg {
+        out.push(Command::SetDisplay(Display {
+            turn_deg: turn,
+            ..state.display
         }));
     }
 }

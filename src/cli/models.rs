@@ -2,7 +2,7 @@
 //! unit, slider scale and description, as a readable listing or as JSON.
 
 use super::output::{json_f64, print};
-use bv_core::params::{ParamDecl, ParamKind};
+use bv_core::params::{Applies, ParamDecl, ParamKind};
 use bv_core::{ModelInfo, catalogue};
 use serde_json::{Value, json};
 use std::fmt::Write as _;
@@ -58,7 +58,8 @@ fn model_json(m: &ModelInfo) -> Value {
 }
 
 /// One parameter declaration as JSON. Always present: `id`, `label`, `kind`,
-/// `range` (human text), `default`, `unit`, `log`, `doc`; numeric kinds add
+/// `range` (human text), `default`, `unit`, `log`, `doc`, `applies_when`
+/// (`null`, or the choice parameter and values under which it matters); numeric kinds add
 /// `min`/`max` (and the slider span), choices their `options`, lists their
 /// item `fields`.
 pub fn param_json(d: &ParamDecl) -> Value {
@@ -71,6 +72,10 @@ pub fn param_json(d: &ParamDecl) -> Value {
         "unit": d.unit(),
         "log": matches!(d.kind, ParamKind::Float(s) if s.log),
         "doc": d.doc,
+        "applies_when": match d.applies {
+            Applies::Always => Value::Null,
+            Applies::When { param, any_of } => json!({ "param": param, "any_of": any_of }),
+        },
     });
     let extra = match d.kind {
         ParamKind::Float(s) => json!({
@@ -162,7 +167,10 @@ fn param_table(s: &mut String, decls: &[ParamDecl], indent: &str) {
             [
                 d.id.to_string(),
                 kind_name(&d.kind).to_string(),
-                d.range_text(),
+                match d.applies_text() {
+                    Some(when) => format!("{} (if {when})", d.range_text()),
+                    None => d.range_text(),
+                },
                 default_text(d),
                 d.unit().to_string(),
                 match d.kind {

@@ -50,6 +50,9 @@ pub struct EnvSettings {
     pub tone_map: ToneMap,
     /// Field of view of the background (degrees, vertical).
     pub background_fov_deg: f64,
+    /// The surface turned about its normal (radians, from the tangent
+    /// towards the bitangent).
+    pub turn: f64,
 }
 
 impl Default for EnvSettings {
@@ -59,6 +62,7 @@ impl Default for EnvSettings {
             exposure_ev: 0.0,
             tone_map: ToneMap::Aces,
             background_fov_deg: 60.0,
+            turn: 0.0,
         }
     }
 }
@@ -77,6 +81,8 @@ struct FrameUniform {
     x1: u32,
     y0: u32,
     y1: u32,
+    turn: f32,
+    pad: [f32; 3],
 }
 
 #[repr(C)]
@@ -130,6 +136,7 @@ struct EnvBuffers {
 struct Key {
     models: Vec<ModelSpec>,
     rotation: f64,
+    turn: f64,
     fov: f64,
     size: (u32, u32),
     env: u64,
@@ -478,6 +485,7 @@ impl EnvRenderer {
         Key {
             models: models.to_vec(),
             rotation: settings.rotation,
+            turn: settings.turn,
             fov: settings.background_fov_deg,
             size: (width, height),
             env: self.env.generation,
@@ -585,6 +593,8 @@ impl EnvRenderer {
             x1: width,
             y0: 0,
             y1: height,
+            turn: settings.turn as f32,
+            pad: [0.0; 3],
         };
         let env = EnvUniform {
             width: self.env.size.0,

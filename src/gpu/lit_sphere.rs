@@ -49,6 +49,9 @@ pub struct LitSphereSettings {
     pub tone_map: ToneMap,
     /// Background.
     pub background: Background,
+    /// The surface turned about its normal (radians, from the tangent
+    /// towards the bitangent).
+    pub turn: f64,
 }
 
 impl Default for LitSphereSettings {
@@ -59,6 +62,7 @@ impl Default for LitSphereSettings {
             exposure_ev: 0.0,
             tone_map: ToneMap::None,
             background: Background::default(),
+            turn: 0.0,
         }
     }
 }
@@ -74,7 +78,7 @@ struct ViewUniform {
     exposure: f32,
     background: u32,
     checker: f32,
-    pad: f32,
+    turn: f32,
     color: [f32; 4],
     color2: [f32; 4],
 }
@@ -266,7 +270,7 @@ impl LitSphereRenderer {
             exposure: settings.exposure_ev.exp2() as f32,
             background,
             checker,
-            pad: 0.0,
+            turn: settings.turn as f32,
             color: [color[0], color[1], color[2], 1.0],
             color2: [color2[0], color2[1], color2[2], 1.0],
         };
@@ -363,9 +367,19 @@ pub fn reference_image(
     use super::display::{display, to_u8};
     use super::sphere::sphere_at;
     use glam::DVec2;
+    // The turned surface through bv-core's change of frame (directions
+    // rotated into the model's frame), not the shader's turned tangents, so
+    // that the comparison checks one against the other.
     let brdfs = models
         .iter()
-        .map(|m| m.build())
+        .map(|m| {
+            let b: std::sync::Arc<dyn bv_core::Brdf> = m.build()?.into();
+            Ok(if settings.turn == 0.0 {
+                b
+            } else {
+                std::sync::Arc::new(bv_core::rotated::Rotated::new(b, settings.turn))
+            })
+        })
         .collect::<bv_core::Result<Vec<_>>>()?;
     let light = settings.light.try_normalize().unwrap_or(DVec3::Z);
     let exposure = settings.exposure_ev.exp2();

@@ -424,6 +424,7 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         "°",
     )?;
     range("incident.phi_deg", s.incident.phi_deg, -360.0, 360.0, "°")?;
+    range("display.turn_deg", s.display.turn_deg, -360.0, 360.0, "°")?;
     let c = s.camera;
     if !c.yaw_deg.is_finite() {
         return bad(
@@ -555,6 +556,7 @@ mod tests {
         };
         s.camera.yaw_deg = 12.5;
         s.display.log = true;
+        s.display.turn_deg = 37.5;
         s.maximised = Some("polar".into());
         s.sanitised()
     }
@@ -628,6 +630,8 @@ mod tests {
         let text = to_toml(&sample()).unwrap();
         let e = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 120.0")).unwrap_err();
         assert!(e.to_string().contains("incident.theta_deg"), "{e}");
+        let e = from_toml(&text.replace("turn_deg = 37.5", "turn_deg = 1e9")).unwrap_err();
+        assert!(e.to_string().contains("display.turn_deg"), "{e}");
         let e = from_toml(&text.replace("albedo = [", "albedo = [7.0, ")).unwrap_err();
         let m = e.to_string();
         assert!(m.contains("brdfs[0]") && m.contains("albedo"), "{m}");

@@ -22,7 +22,7 @@ pub const PALETTE: [[u8; 3]; 10] = [
     [89, 185, 90],   // green
     [225, 87, 89],   // red
     [176, 122, 211], // purple
-    [237, 201, 72],  // yellow
+    [188, 189, 34],  // olive (not the light's sun yellow)
     [118, 183, 178], // teal
     [255, 157, 167], // pink
     [176, 135, 104], // brown
@@ -126,6 +126,12 @@ pub struct Display {
     pub sh_overlay: bool,
     /// Its highest order L (0–16).
     pub sh_order: u8,
+    /// The surface turned about its normal by this angle, degrees
+    /// (counter-clockwise seen from above, from the tangent towards the
+    /// bitangent): "if you turn an object, does its shading change?" An
+    /// anisotropic highlight turns with the surface; an isotropic one does
+    /// not. Every view draws the turned surface.
+    pub turn_deg: f64,
 }
 
 impl Default for Display {
@@ -138,6 +144,7 @@ impl Default for Display {
             auto_scale: true,
             sh_overlay: false,
             sh_order: 4,
+            turn_deg: 0.0,
         }
     }
 }

@@ -76,6 +76,11 @@ pub const VIEWS: &[ViewInfo] = &[
         title: "Microfacet terms D, G, F",
         in_grid: false,
     },
+    ViewInfo {
+        id: "sampling",
+        title: "Importance sampling",
+        in_grid: false,
+    },
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

@@ -342,6 +342,39 @@ fn y_top(shown: &[Shown]) -> f64 {
     (m * 1.08).max(1.1)
 }
 
+/// The plot corner whose legend box covers the fewest curve points, given
+/// the plot's size in points (the box's extent is estimated from the labels:
+/// about 6.5 points per character plus the swatch, 18 points per line), in
+/// the order of preference bottom right, top right, bottom left, top left.
+fn legend_corner(shown: &[Shown], top: f64, size: egui::Vec2) -> Corner {
+    let chars = shown
+        .iter()
+        .map(|s| legend_label(s).chars().count())
+        .max()
+        .unwrap_or(0);
+    let w = ((chars as f32 * 6.5 + 30.0) / size.x.max(1.0)).min(1.0) as f64 * 90.0;
+    let h = ((shown.len() as f32 * 18.0 + 12.0) / size.y.max(1.0)).min(1.0) as f64 * top;
+    let boxes = [
+        (Corner::RightBottom, 90.0 - w, 90.0, 0.0, h),
+        (Corner::RightTop, 90.0 - w, 90.0, top - h, top),
+        (Corner::LeftBottom, 0.0, w, 0.0, h),
+        (Corner::LeftTop, 0.0, w, top - h, top),
+    ];
+    let covered = |(x0, x1, y0, y1): (f64, f64, f64, f64)| {
+        shown
+            .iter()
+            .flat_map(|s| {
+                (0..s.data.rho.len()).map(move |k| (s.data.theta_deg[k], s.data.mean_and_band(k).0))
+            })
+            .filter(|&(x, y)| (x0..=x1).contains(&x) && (y0..=y1).contains(&y))
+            .count()
+    };
+    boxes
+        .iter()
+        .min_by_key(|b| covered((b.1, b.2, b.3, b.4)))
+        .map_or(Corner::RightBottom, |b| b.0)
+}
+
 const Y_LABEL: &str = "ρhd (mean of r, g, b)";
 const X_LABEL: &str = "θi (°)";
 
@@ -364,7 +397,7 @@ impl View for AlbedoView {
         let plot = Plot::new(super::view_id("albedo"))
             .width(size.x.max(50.0))
             .height(size.y.max(50.0))
-            .legend(Legend::default().position(Corner::RightBottom))
+            .legend(Legend::default().position(legend_corner(&shown, top, size)))
             .x_axis_label(X_LABEL)
             .y_axis_label(Y_LABEL)
             .y_axis_min_width(36.0)

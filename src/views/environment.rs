@@ -99,6 +99,8 @@ struct Mode {
     figure: bool,
     /// On a software renderer.
     software: bool,
+    /// The surface turned about its normal, degrees.
+    turn_deg: f64,
 }
 
 /// A map being loaded on a worker thread.
@@ -251,8 +253,9 @@ impl EnvironmentView {
         self.map_in_use.as_deref()
     }
 
-    fn settings(env: &EnvView) -> EnvSettings {
+    fn settings(env: &EnvView, turn_deg: f64) -> EnvSettings {
         EnvSettings {
+            turn: turn_deg.to_radians(),
             rotation: env.rotation_deg.to_radians(),
             exposure_ev: env.exposure_ev,
             tone_map: gpu_image::tone_map(env.tone_map),
@@ -345,7 +348,12 @@ impl EnvironmentView {
                 let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
                 let (w, h) = gpu_image::pixel_size(rect, pixels_per_point * current);
                 r.object() != gpu_image::env_object(env.object)
-                    || r.would_restart(&specs, &Self::settings(env), w, h)
+                    || r.would_restart(
+                        &specs,
+                        &Self::settings(env, scene.state.display.turn_deg),
+                        w,
+                        h,
+                    )
             }
             None => false,
         };
@@ -402,6 +410,7 @@ impl EnvironmentView {
             interacting,
             figure,
             software,
+            turn_deg,
         } = mode;
         let Some(rs) = gpu_image::render_state(ui.ctx()) else {
             return (None, false);
@@ -442,7 +451,7 @@ impl EnvironmentView {
             // A figure is drawn in one go: accumulate to the target now.
             let target = figure_spp(env.target_spp, software);
             let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
-            let settings = Self::settings(env);
+            let settings = Self::settings(env, turn_deg);
             let mut texture = None;
             loop {
                 let done = if renderer.would_restart(&specs, &settings, size.0, size.1) {
@@ -480,7 +489,7 @@ impl EnvironmentView {
             return (Some(self.image.id(&rs, &texture)), false);
         }
         let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
-        let settings = Self::settings(env);
+        let settings = Self::settings(env, turn_deg);
         let restart = renderer.would_restart(&specs, &settings, size.0, size.1);
         let target = u64::from(env.target_spp.clamp(1, MAX_TARGET_SPP));
         let done = renderer.samples_per_pixel();
@@ -721,6 +730,7 @@ impl View for EnvironmentView {
                 interacting: scene.interacting,
                 figure: scene.figure,
                 software,
+                turn_deg: scene.state.display.turn_deg,
             };
             let (id, m) = self.step(ui, &drawables, env, size, mode);
             more = m;

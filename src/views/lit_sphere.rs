@@ -108,6 +108,7 @@ impl LitSphereView {
                 gpu_image::theme_background(dark),
                 pixels_per_point,
             ),
+            turn: scene.state.display.turn_deg.to_radians(),
         }
     }
 
@@ -338,7 +339,15 @@ impl LitSphereView {
             // The point the light shines straight onto (its normal is ωi).
             let at = c + Vec2::new(wi.x as f32, -wi.y as f32) * r;
             painter.circle_stroke(at, 5.0, Stroke::new(2.0, light));
-            painter.circle_stroke(at, 6.5, Stroke::new(1.0, Color32::from_black_alpha(160)));
+            // An outline of the opposite shade, so that the ring reads on a
+            // lit and on a black sphere alike.
+            let outline = if dark {
+                Color32::from_black_alpha(160)
+            } else {
+                Color32::from_white_alpha(200)
+            };
+            painter.circle_stroke(at, 6.5, Stroke::new(1.5, outline));
+            painter.circle_stroke(at, 3.5, Stroke::new(1.0, outline));
             let [cr, cg, cb] = d.brdf.rgb;
             gpu_image::plate_text(
                 &painter,
@@ -347,6 +356,18 @@ impl LitSphereView {
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),
             );
+            // A mirror or smooth glass under a point light is black but for
+            // one point: say why rather than show a black disc.
+            if delta_only(d.brdf.brdf.as_ref()) {
+                gpu_image::plate_text(
+                    &painter,
+                    c + Vec2::new(0.0, 0.45 * r),
+                    Align2::CENTER_CENTER,
+                    "only δ lobes: a point light\nlights one direction, no pixel;\nsee the environment view",
+                    // On the plate's dark backing in either theme.
+                    Color32::from_gray(235),
+                );
+            }
         }
         let lit = scene.state.lighting.lit;
         let status = format!(
@@ -525,4 +546,46 @@ pub fn arrangement_control(
         .widget_info(|| {
             egui::WidgetInfo::labeled(egui::Role::ComboBox, true, format!("{salt} BRDFs shown"))
         });
+}
+
+/// Whether `b` scatters only through delta lobes (a smooth mirror or glass):
+/// it has delta lobes and its finite part is 0 at a spread of direction
+/// pairs, so that a point light lights none of the sphere's pixels.
+pub fn delta_only(b: &dyn bv_core::Brdf) -> bool {
+    let n = glam::DVec3::Z;
+    if b.deltas(n).is_empty() {
+        return false;
+    }
+    let dirs = [
+        n,
+        glam::DVec3::new(0.6, 0.0, 0.8),
+        glam::DVec3::new(-0.3, 0.5, 0.81),
+        glam::DVec3::new(0.0, -0.95, 0.312),
+    ];
+    dirs.iter().all(|&wi| {
+        dirs.iter()
+            .all(|&wo| b.eval(wi.normalize(), wo.normalize()).max_element() == 0.0)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_pure_delta_models_are_delta_only() {
+        let b = |id: &str, p: serde_json::Value| {
+            bv_core::ModelSpec::from_json(id, &p)
+                .unwrap()
+                .build()
+                .unwrap()
+        };
+        assert!(delta_only(b("mirror", serde_json::json!({})).as_ref()));
+        assert!(delta_only(b("glass", serde_json::json!({})).as_ref()));
+        assert!(!delta_only(b("lambert", serde_json::json!({})).as_ref()));
+        let half = serde_json::json!({"components": [
+            {"weight": 0.5, "model": "mirror"},
+            {"weight": 0.5, "model": "lambert"}]});
+        assert!(!delta_only(b("mix", half).as_ref()));
+    }
 }

@@ -25,6 +25,7 @@ pub mod lobe3d;
 pub mod lobe_gpu;
 pub mod polar;
 pub mod reciprocity;
+pub mod sampling;
 pub mod sh_overlay;
 pub mod snell;
 pub mod svg;
@@ -111,6 +112,7 @@ fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
         "reciprocity" => || Box::new(reciprocity::ReciprocityView::default()),
         "snell" => || Box::new(snell::SnellView::default()),
         "terms" => || Box::new(terms::TermsView::default()),
+        "sampling" => || Box::new(sampling::SamplingView::default()),
         _ => return None,
     };
     Some(make)
@@ -187,12 +189,16 @@ pub fn strong_text_color(dark: bool) -> Color32 {
     }
 }
 
-/// Marker colour of the light (ωi) in every view.
+/// Marker colour of the light (ωi) in every view: a colour no BRDF of the
+/// palette ([`crate::session::state::PALETTE`]) is drawn in, so that the
+/// light is never mistaken for a curve (a test holds it apart from each).
+/// Sun yellow on dark backgrounds; near-black on light ones, where yellow
+/// does not read and orange is the second BRDF's colour.
 pub fn light_color(dark: bool) -> Color32 {
     if dark {
-        Color32::from_rgb(255, 200, 60)
+        Color32::from_rgb(255, 235, 110)
     } else {
-        Color32::from_rgb(210, 130, 0)
+        Color32::from_rgb(35, 35, 35)
     }
 }
 
@@ -268,6 +274,22 @@ pub fn view_id(id: &str) -> egui::Id {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The light's marker differs clearly from every BRDF colour, in both
+    /// themes (largest channel difference at least 60 of 255).
+    #[test]
+    fn the_light_is_not_drawn_in_a_brdf_colour() {
+        for dark in [true, false] {
+            let l = light_color(dark);
+            for c in crate::session::state::PALETTE {
+                let d = (0..3)
+                    .map(|k| (i32::from(l[k]) - i32::from(c[k])).abs())
+                    .max()
+                    .unwrap();
+                assert!(d >= 60, "dark {dark}: light {l:?} vs palette {c:?}");
+            }
+        }
+    }
 
     #[test]
     fn every_session_view_has_a_constructor() {

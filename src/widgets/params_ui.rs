@@ -2,7 +2,9 @@
 //! ([`bv_core::ParamDecl`]): no model has UI code of its own. Floats become
 //! sliders (logarithmic where declared, with units), colours a level slider, a
 //! picker and per-channel fields, choices combo boxes, flags check boxes, lists
-//! (Lafortune lobes) and mix components nested groups. Double-clicking a slider
+//! (Lafortune lobes) and mix components nested groups. A parameter whose
+//! declaration says it does not apply to the current choices is not shown.
+//! Double-clicking a slider
 //! or pressing its "reset" button resets the value to its declared default.
 //!
 //! Numbers are typed into [`number_field`]s: the text is the user's while the
@@ -40,6 +42,11 @@ pub fn params_ui(ui: &mut Ui, salt: Id, decls: &[ParamDecl], params: &Params) ->
         let Ok(current) = params.get(decl.id) else {
             continue;
         };
+        // A parameter that does not matter under the current choices (k of
+        // a dielectric) is hidden; its value is kept for when it matters.
+        if !decl.applies_to(params) {
+            continue;
+        }
         let mut value = current.clone();
         let r = value_ui(ui, salt.with(decl.id), decl, &mut value, 0);
         if r.reset {
@@ -486,6 +493,9 @@ fn value_ui(
                     .default_open(i == 0)
                     .show(ui, |ui| {
                         for f in fields {
+                            if !f.applies_to(item) {
+                                continue;
+                            }
                             if let Some(v) = item.get_mut(f.id) {
                                 let r = value_ui(ui, id.with(i).with(f.id), f, v, depth + 1);
                                 if r.reset {
@@ -556,6 +566,9 @@ fn value_ui(
                                 let Ok(current) = comp.spec.params().get(f.id) else {
                                     continue;
                                 };
+                                if !f.applies_to(comp.spec.params()) {
+                                    continue;
+                                }
                                 let mut v = current.clone();
                                 let r = value_ui(ui, id.with(i).with(f.id), f, &mut v, depth + 1);
                                 if r.reset {

@@ -7,7 +7,7 @@
 //! −z side with respect to the +z side (air above glass: `eta = 1.5`). Light
 //! arriving from the −z side has `cos_i < 0` and sees the reciprocal index.
 
-use crate::params::decl::{ColorSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{BvError, Result, Rgb};
 
@@ -155,36 +155,52 @@ pub const fn fresnel_param(default: &'static str) -> ParamDecl {
             options: FRESNEL_OPTIONS,
             default,
         },
+        applies: Applies::Always,
     }
 }
 
-/// The `eta` parameter (relative index, per channel; a scalar means grey).
+/// The `eta` parameter (relative index, per channel; a scalar means grey),
+/// which matters for the exact Fresnel terms.
 pub const fn eta_param(default: [f64; 3]) -> ParamDecl {
     ParamDecl {
         id: "eta",
         label: "η",
         doc: "Relative refractive index ηt/ηi (real part for conductors), per channel",
         kind: ParamKind::Color(ColorSpec::range(0.01, 10.0, default)),
+        applies: Applies::When {
+            param: "fresnel",
+            any_of: ETA_APPLIES,
+        },
     }
 }
 
-/// The `k` parameter (extinction coefficient of a conductor, per channel).
+/// The `k` parameter (extinction coefficient of a conductor, per channel),
+/// which matters for the conductor term only.
 pub const fn k_param(default: [f64; 3]) -> ParamDecl {
     ParamDecl {
         id: "k",
         label: "k",
         doc: "Extinction coefficient (imaginary part of the index) of a conductor, per channel",
         kind: ParamKind::Color(ColorSpec::range(0.0, 20.0, default)),
+        applies: Applies::When {
+            param: "fresnel",
+            any_of: K_APPLIES,
+        },
     }
 }
 
-/// The `f0` parameter (normal-incidence reflectance for Schlick).
+/// The `f0` parameter (normal-incidence reflectance for Schlick), which
+/// matters for Schlick's approximation only.
 pub const fn f0_param(default: [f64; 3]) -> ParamDecl {
     ParamDecl {
         id: "f0",
         label: "F0",
         doc: "Reflectance at normal incidence, for Schlick's approximation",
         kind: ParamKind::Color(ColorSpec::unit_range(default)),
+        applies: Applies::When {
+            param: "fresnel",
+            any_of: F0_APPLIES,
+        },
     }
 }
 
@@ -196,6 +212,13 @@ pub const ETA: ParamDecl = eta_param([1.5, 1.5, 1.5]);
 pub const K: ParamDecl = k_param([0.0, 0.0, 0.0]);
 /// `f0` with the default of glass-like dielectrics (0.04).
 pub const F0: ParamDecl = f0_param([0.04, 0.04, 0.04]);
+
+/// The Fresnel choices under which `eta` matters.
+pub const ETA_APPLIES: &[&str] = &["dielectric", "conductor"];
+/// The Fresnel choices under which `k` matters.
+pub const K_APPLIES: &[&str] = &["conductor"];
+/// The Fresnel choices under which `f0` matters.
+pub const F0_APPLIES: &[&str] = &["schlick"];
 
 /// A Fresnel term, per linear-RGB channel.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -36,7 +36,7 @@ pub mod user;
 pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, MicrofacetTerms, Ndf};
 pub use error::{BvError, Result};
 pub use model::ModelInfo;
-pub use params::{ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
+pub use params::{Applies, ModelSpec, ParamDecl, ParamKind, ParamValue, Params};
 pub use registry::{catalogue, find, register};
 
 /// A linear-RGB triple (one value per channel).

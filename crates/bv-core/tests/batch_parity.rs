@@ -153,6 +153,8 @@ const WITH_KERNEL: &[&str] = &[
     "modified-phong",
     "ward",
     "oren-nayar",
+    "hapke",
+    "disney",
     "ashikhmin-shirley",
     "banks",
     "lafortune",
@@ -203,7 +205,7 @@ fn mixes_sum_their_parts_batches() {
         serde_json::Value::Null,
         // With a part that has no kernel (its scalar fallback runs inside).
         serde_json::json!({"components": [
-            {"weight": 0.3, "model": "hapke"},
+            {"weight": 0.3, "model": "cook-torrance", "params": {"distribution": "blinn"}},
             {"weight": 0.5, "model": "ward", "params": {"alpha_x": 0.05, "alpha_y": 0.4}},
             {"weight": 0.2, "model": "mix", "params": {"components": [
                 {"weight": 1.0, "model": "blinn-phong", "params": {"e": 5000.0}}]}}

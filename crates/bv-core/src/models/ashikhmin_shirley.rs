@@ -6,7 +6,7 @@
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::frame::half_vector;
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, FresnelTerm, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -19,24 +19,28 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "Rd",
         doc: "Diffuse reflectance (scaled by 1 − Rs so that the sum stays plausible)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "rs",
         label: "Rs",
         doc: "Specular reflectance at normal incidence (Schlick's F0)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.05, 0.05, 0.05])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "nu",
         label: "nu",
         doc: "Phong exponent along the tangent u = +x (sharper lobe when larger)",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 100.0, 1.0, 10000.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "nv",
         label: "nv",
         doc: "Phong exponent along the bitangent v = +y",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 100.0, 1.0, 10000.0)),
+        applies: Applies::Always,
     },
 ];
 

@@ -16,7 +16,7 @@
 use super::lobes::clamped_pow;
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -29,18 +29,21 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse coefficient (not divided by π, as in Banks' shading rule)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.15, 0.15, 0.15])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Specular coefficient",
         kind: ParamKind::Color(ColorSpec::unit_range([0.3, 0.3, 0.3])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "e",
         label: "e",
         doc: "Exponent of the specular cone around the fibre (tangent x)",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 20.0, 1.0, 1000.0)),
+        applies: Applies::Always,
     },
 ];
 

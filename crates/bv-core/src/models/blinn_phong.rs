@@ -11,7 +11,7 @@
 use super::lobes::{COS_FLOOR, clamped_pow, half_vector};
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -24,18 +24,21 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse coefficient (not divided by π, as in the lecture: diffuse albedo is π·kd)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.15, 0.15, 0.15])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Specular coefficient",
         kind: ParamKind::Color(ColorSpec::unit_range([0.3, 0.3, 0.3])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "e",
         label: "e",
         doc: "Blinn exponent on h·n (about 4× a Phong exponent for the same highlight)",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 20.0, 1.0, 1000.0)),
+        applies: Applies::Always,
     },
 ];
 

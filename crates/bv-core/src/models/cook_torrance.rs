@@ -9,7 +9,7 @@ use crate::microfacet::{
     self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
 };
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -26,12 +26,14 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse reflectance (Lambertian base kd/π)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.3, 0.3, 0.3])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Weight of the specular microfacet lobe",
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, 0.7)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "distribution",
@@ -41,18 +43,21 @@ pub const PARAMS: &[ParamDecl] = &[
             options: DISTRIBUTION_OPTIONS,
             default: "beckmann",
         },
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "alpha_x",
         label: "α x",
         doc: "Roughness along the tangent (RMS slope for Beckmann; Blinn's only width)",
         kind: ParamKind::Float(ALPHA),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "alpha_y",
         label: "α y",
         doc: "Roughness along the bitangent (ignored by Blinn)",
         kind: ParamKind::Float(ALPHA),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "geometry",
@@ -62,6 +67,7 @@ pub const PARAMS: &[ParamDecl] = &[
             options: GEOMETRY_OPTIONS,
             default: "v-groove",
         },
+        applies: Applies::Always,
     },
     fresnel::fresnel_param("dielectric"),
     fresnel::ETA,
@@ -72,12 +78,14 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "α2",
         doc: "Roughness of the second (isotropic) scale of the multiscale mixture",
         kind: ParamKind::Float(FloatSpec::log(0.001, 2.0, 0.05, 0.005, 1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "weight2",
         label: "w2",
         doc: "Weight of the second scale: D = (1 − w2) D(α) + w2 D(α2); 0 = off",
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, 0.0)),
+        applies: Applies::Always,
     },
 ];
 

@@ -3,10 +3,11 @@
 //! BRDF Explorer), with these fixed choices: linear `base_color`,
 //! `Cdlum = 0.3R + 0.6G + 0.1B`, specular G = separable Smith GGX with (αx, αy).
 
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::fresnel::schlick_weight;
-use crate::microfacet::{self, Distribution, Microfacet};
+use crate::microfacet::{self, Distribution, Microfacet, Scale, ScaleLanes};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -19,6 +20,7 @@ const fn unit(id: &'static str, label: &'static str, doc: &'static str, default:
         label,
         doc,
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, default)),
+        applies: Applies::Always,
     }
 }
 
@@ -29,6 +31,7 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "base colour",
         doc: "Surface colour (linear RGB; the shader's gamma 2.2 conversion is not applied)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.82, 0.67, 0.16])),
+        applies: Applies::Always,
     },
     unit(
         "metallic",
@@ -172,6 +175,72 @@ pub struct Disney {
     /// takes the rest).
     p_diffuse: f64,
     p_spec: f64,
+    kernel: DisneyLanes,
+}
+
+/// [`Disney`]'s f32 batch kernel: the f64 `eval` term by term, with the
+/// specular `D G / (4 cosθi cosθo)` from the GGX lanes of
+/// [`ScaleLanes::ggx_dg`] (separable Smith, as `eval`) and the clearcoat's
+/// Smith G from [`ScaleLanes::one_plus_lambda`].
+#[derive(Debug, Clone, Copy)]
+struct DisneyLanes {
+    /// `(1 − metallic) base / π`.
+    diffuse: [f32; 3],
+    /// `(1 − metallic) sheen · Csheen`.
+    sheen: [f32; 3],
+    roughness: f32,
+    subsurface: f32,
+    cspec0: [f32; 3],
+    spec: ScaleLanes,
+    /// `0.25 · clearcoat`.
+    coat: f32,
+    /// GTR1 as `coat_num / (α² cos²θh + sin²θh)`: the same as
+    /// `1 + (α² − 1) cos²θh` for a unit h, without its cancellation near the
+    /// peak of a glossy coat (α down to 0.001).
+    coat_num: f32,
+    coat_a2: f32,
+    coat_g: ScaleLanes,
+}
+
+impl LaneKernel for DisneyLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let (nl, nv) = (wi[2], wo[2]);
+        let hu = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let l2 = math::dot(hu, hu);
+        let inv = 1.0 / l2.sqrt();
+        let h = [hu[0] * inv, hu[1] * inv, hu[2] * inv];
+        let lh = math::dot(wi, h).clamp(0.0, 1.0);
+        let weight = |c: f32| {
+            let m = (1.0 - c).clamp(0.0, 1.0);
+            let m2 = m * m;
+            m2 * m2 * m
+        };
+        let (fl, fv, fh) = (weight(nl), weight(nv), weight(lh));
+        let mix = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let fd90 = 0.5 + 2.0 * lh * lh * self.roughness;
+        let fd = mix(1.0, fd90, fl) * mix(1.0, fd90, fv);
+        let fss90 = lh * lh * self.roughness;
+        let fss = mix(1.0, fss90, fl) * mix(1.0, fss90, fv);
+        let ss = 1.25 * (fss * (1.0 / (nl + nv) - 0.5) + 0.5);
+        let diffuse = mix(fd, ss, self.subsurface);
+        let dg = self.spec.ggx_dg::<false>(wi, wo, hu, l2);
+        let coat = if self.coat > 0.0 {
+            let dr = self.coat_num / (self.coat_a2 * h[2] * h[2] + h[0] * h[0] + h[1] * h[1]);
+            let fr = 0.04 + 0.96 * fh;
+            let g = self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }>(wi)
+                * self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }>(wo);
+            self.coat * dr * fr / (g * 4.0 * nl * nv)
+        } else {
+            0.0
+        };
+        let valid = nl > 0.0 && nv > 0.0 && l2 > 1e-24;
+        std::array::from_fn(|c| {
+            let fs = self.cspec0[c] + (1.0 - self.cspec0[c]) * fh;
+            let f = self.diffuse[c] * diffuse + self.sheen[c] * fh + fs * dg + coat;
+            if valid && f.is_finite() { f } else { 0.0 }
+        })
+    }
 }
 
 /// Smith GGX Λ for the clearcoat, fixed α = 0.25 (the reference shader's
@@ -209,6 +278,32 @@ impl Disney {
         let ws = 1.0;
         let wc = 0.25 * clearcoat;
         let sum = wd + ws + wc;
+        let clearcoat_alpha = mix(0.1, 0.001, clearcoat_gloss);
+        let (coat_num, coat_a2) = if clearcoat_alpha >= 1.0 {
+            (FRAC_1_PI, 1.0)
+        } else {
+            let a2 = clearcoat_alpha * clearcoat_alpha;
+            ((a2 - 1.0) / (PI * a2.ln()), a2)
+        };
+        let lanes = |dist, ax, ay| ScaleLanes::new(&Scale::new(dist, ax, ay)).map(|(_, l)| l);
+        let (Some(spec_lanes), Some(coat_g)) = (
+            lanes(Distribution::Ggx, ax, ay),
+            lanes(Distribution::Ggx, CLEARCOAT_G_ALPHA, CLEARCOAT_G_ALPHA),
+        ) else {
+            unreachable!("GGX always has a lane form")
+        };
+        let kernel = DisneyLanes {
+            diffuse: math::rgb(base * ((1.0 - metallic) * FRAC_1_PI)),
+            sheen: math::rgb(csheen * (sheen * (1.0 - metallic))),
+            roughness: roughness as f32,
+            subsurface: subsurface as f32,
+            cspec0: math::rgb(cspec0),
+            spec: spec_lanes,
+            coat: (0.25 * clearcoat) as f32,
+            coat_num: coat_num as f32,
+            coat_a2: coat_a2 as f32,
+            coat_g,
+        };
         Self {
             base,
             metallic,
@@ -218,10 +313,11 @@ impl Disney {
             clearcoat,
             cspec0,
             csheen,
-            clearcoat_alpha: mix(0.1, 0.001, clearcoat_gloss),
+            clearcoat_alpha,
             spec: Gtr2(Microfacet::new(Distribution::Ggx, ax, ay)),
             p_diffuse: wd / sum,
             p_spec: ws / sum,
+            kernel,
         }
     }
 
@@ -271,6 +367,10 @@ impl Brdf for Disney {
             g1: Arc::new(g1),
             g2: Arc::new(move |wi, wo, _h| g1(wi) * g1(wo)),
         })
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn fresnel_term(&self) -> Option<FresnelTerm> {

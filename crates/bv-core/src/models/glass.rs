@@ -4,7 +4,7 @@
 
 use crate::fresnel;
 use crate::model::{Build, DeltaPort, GpuPort, ModelInfo};
-use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, DeltaKind, DeltaLobe, FresnelTerm, Result, Rgb, frame};
 use glam::DVec3;
@@ -15,6 +15,7 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
     label: "η",
     doc: "Relative index ηt/ηi of the medium below the surface (−z) to the one above",
     kind: ParamKind::Float(FloatSpec::log(0.01, 10.0, 1.5, 0.25, 4.0)),
+    applies: Applies::Always,
 }];
 
 /// Catalogue entry.

@@ -5,8 +5,9 @@
 //! Hapke's closed-form approximation of Chandrasekhar's H function. The lecture
 //! uses it for the Moon's flat, retro-reflective look.
 
+use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
@@ -19,6 +20,7 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "w",
         doc: "Single-scattering albedo of the particles",
         kind: ParamKind::Float(FloatSpec::linear(0.0, 1.0, 0.6)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "b0",
@@ -28,18 +30,21 @@ pub const PARAMS: &[ParamDecl] = &[
             slider_max: 4.0,
             ..FloatSpec::linear(0.0, 10.0, 1.0)
         }),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "h",
         label: "h",
         doc: "Angular width of the opposition surge (regolith compaction)",
         kind: ParamKind::Float(FloatSpec::log(0.001, 1.0, 0.06, 0.001, 1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "g",
         label: "g",
         doc: "Henyey-Greenstein asymmetry: g < 0 scatters back towards the light",
         kind: ParamKind::Float(FloatSpec::linear(-1.0, 1.0, -0.3)),
+        applies: Applies::Always,
     },
 ];
 
@@ -70,18 +75,83 @@ pub struct Hapke {
     asym: f64,
     /// `γ = √(1 − w)`, used by H.
     gamma: f64,
+    kernel: HapkeLanes,
+}
+
+/// [`Hapke`]'s f32 batch kernel: the same expressions as the f64 `eval`
+/// (the surge from `|wi ± wo|`, Henyey–Greenstein with its cancellation-free
+/// denominator, Hapke's H), written branch-free.
+#[derive(Debug, Clone, Copy)]
+struct HapkeLanes {
+    /// `w / (4π)`.
+    w4pi: f32,
+    b0: f32,
+    width: f32,
+    asym: f32,
+    gamma: f32,
+    one_minus_gamma: f32,
+}
+
+impl LaneKernel for HapkeLanes {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        let s = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let d = [wi[0] - wo[0], wi[1] - wo[1], wi[2] - wo[2]];
+        let (s2, d2) = (math::dot(s, s), math::dot(d, d));
+        let hs = self.width * s2.sqrt();
+        let bd = hs + d2.sqrt();
+        let surge = if bd > 0.0 { self.b0 * hs / bd } else { 0.0 };
+        let g = self.asym;
+        let num = (1.0 - g) * (1.0 + g);
+        let a = if g <= 0.0 {
+            (1.0 + g) - g * 0.5 * d2
+        } else {
+            (1.0 - g) + g * 0.5 * s2
+        };
+        let c = [
+            wi[1] * wo[2] - wi[2] * wo[1],
+            wi[2] * wo[0] - wi[0] * wo[2],
+            wi[0] * wo[1] - wi[1] * wo[0],
+        ];
+        let dd = a * a + g * g * math::dot(c, c);
+        let phase = if num > 0.0 && dd > 0.0 {
+            num / (dd * dd.sqrt())
+        } else {
+            0.0
+        };
+        // H(μi) H(μo) − 1 as (Hi − 1)(Ho − 1) + (Hi − 1) + (Ho − 1) with
+        // H(x) − 1 = 2x (1 − γ)/(1 + 2xγ): near the horizon both H are close
+        // to 1 and the direct product minus 1 loses f32's digits, while f
+        // divides it by the small cos θi + cos θo.
+        let hm1 = |x: f32| 2.0 * x * self.one_minus_gamma / (1.0 + 2.0 * x * self.gamma);
+        let (hi, ho) = (hm1(wi[2]), hm1(wo[2]));
+        let multiple = hi * ho + hi + ho;
+        let multiple = if multiple > 0.0 { multiple } else { 0.0 };
+        let f = self.w4pi / (wi[2] + wo[2]) * ((1.0 + surge) * phase + multiple);
+        let v = if wi[2] > 0.0 && wo[2] > 0.0 { f } else { 0.0 };
+        [v; 3]
+    }
 }
 
 impl Hapke {
     /// The model with single-scattering albedo `w`, surge amplitude `b0` and
     /// width `h`, and phase asymmetry `g`.
     pub fn new(w: f64, b0: f64, h: f64, g: f64) -> Self {
+        let gamma = (1.0 - w).max(0.0).sqrt();
         Self {
             w,
             b0,
             width: h,
             asym: g,
-            gamma: (1.0 - w).max(0.0).sqrt(),
+            gamma,
+            kernel: HapkeLanes {
+                w4pi: (w / (4.0 * PI)) as f32,
+                b0: b0 as f32,
+                width: h as f32,
+                asym: g as f32,
+                gamma: gamma as f32,
+                one_minus_gamma: (1.0 - gamma) as f32,
+            },
         }
     }
 
@@ -172,6 +242,10 @@ impl Brdf for Hapke {
     /// zero phase angle, `wo = wi` (the surge has a cusp there).
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         vec![wi]
+    }
+
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        Some(&self.kernel)
     }
 
     fn claims(&self) -> Claims {

@@ -18,7 +18,7 @@
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, mean_rgb};
 use glam::{DVec2, DVec3};
@@ -34,30 +34,35 @@ pub const LOBE_FIELDS: &[ParamDecl] = &[
         label: "Cx",
         doc: "Weight of wi.x·wo.x (−1: mirror-like, +1: retro-reflective)",
         kind: ParamKind::Float(FloatSpec::linear(-1.0, 1.0, -1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "cy",
         label: "Cy",
         doc: "Weight of wi.y·wo.y (Cx ≠ Cy: anisotropic)",
         kind: ParamKind::Float(FloatSpec::linear(-1.0, 1.0, -1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "cz",
         label: "Cz",
         doc: "Weight of wi.z·wo.z (|Cz| < |Cx|: off-specular peak)",
         kind: ParamKind::Float(FloatSpec::linear(-1.0, 1.0, 1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "n",
         label: "n",
         doc: "Lobe exponent",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 20.0, 1.0, 1000.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Lobe weight (its albedo at normal incidence for the (−1, −1, 1) lobe)",
         kind: ParamKind::Color(ColorSpec::range(0.0, 10.0, [0.3, 0.3, 0.3])),
+        applies: Applies::Always,
     },
 ];
 
@@ -68,6 +73,7 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse albedo (the diffuse term is kd/π)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "lobes",
@@ -79,6 +85,7 @@ pub const PARAMS: &[ParamDecl] = &[
             max_items: MAX_LOBES,
             default_items: 1,
         },
+        applies: Applies::Always,
     },
 ];
 

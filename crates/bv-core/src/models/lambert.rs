@@ -2,7 +2,7 @@
 
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
@@ -14,6 +14,7 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
     label: "albedo",
     doc: "Directional-hemispherical reflectance ρ (the BRDF is ρ/π)",
     kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+    applies: Applies::Always,
 }];
 
 /// Catalogue entry.

@@ -5,7 +5,7 @@ use crate::measured::merl::{self as table, Interpolation, MerlTable};
 use crate::model::{
     Build, FileData, FileFormat, GpuPort, GpuTables, ModelInfo, Progress, TABLE_ALIGN,
 };
-use crate::params::decl::{ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, BvError, Claims, Result, Rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -23,6 +23,7 @@ pub const PARAMS: &[ParamDecl] = &[
             default: "",
             format: &MERL_FILES,
         },
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "interpolation",
@@ -32,6 +33,7 @@ pub const PARAMS: &[ParamDecl] = &[
             options: Interpolation::NAMES,
             default: "trilinear",
         },
+        applies: Applies::Always,
     },
 ];
 

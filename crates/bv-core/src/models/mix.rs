@@ -5,7 +5,7 @@
 
 use crate::model::{Build, ModelInfo};
 use crate::params::MAX_NESTING;
-use crate::params::decl::{FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{Component, ModelSpec, ParamValue, Params};
 use crate::{Brdf, BvError, Claims, DeltaLobe, Result, Rgb};
 use glam::{DVec2, DVec3};
@@ -26,6 +26,7 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
         weight: WEIGHT,
         default: default_components,
     },
+    applies: Applies::Always,
 }];
 
 /// Catalogue entry.

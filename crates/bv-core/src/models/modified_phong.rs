@@ -9,7 +9,7 @@
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb};
 use glam::{DVec2, DVec3};
@@ -22,18 +22,21 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse albedo (the diffuse term is kd/π)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Specular albedo at normal incidence",
         kind: ParamKind::Color(ColorSpec::unit_range([0.3, 0.3, 0.3])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "e",
         label: "e",
         doc: "Phong exponent (sharpness of the highlight)",
         kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 20.0, 1.0, 1000.0)),
+        applies: Applies::Always,
     },
 ];
 

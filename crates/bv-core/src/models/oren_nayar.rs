@@ -4,7 +4,7 @@
 
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb};
 use glam::DVec3;
@@ -17,12 +17,14 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "albedo",
         doc: "Albedo ρ of the facets (the model is ρ/π when σ = 0)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "sigma",
         label: "σ",
         doc: "Roughness: standard deviation of the facet slope angle",
         kind: ParamKind::Float(FloatSpec::linear(0.0, FRAC_PI_2, 0.3).with_unit("rad")),
+        applies: Applies::Always,
     },
 ];
 

@@ -9,7 +9,7 @@
 use super::lobes::{COS_FLOOR, half_unnormalised};
 use crate::batch::{Kernel, LaneKernel, math};
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, ModelInfo};
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{Brdf, Claims, Result, Rgb, frame, mean_rgb, sampling};
 use glam::{DVec2, DVec3};
@@ -23,24 +23,28 @@ pub const PARAMS: &[ParamDecl] = &[
         label: "kd",
         doc: "Diffuse albedo (the diffuse term is kd/π)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.5, 0.5, 0.5])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "ks",
         label: "ks",
         doc: "Specular reflectance (ρs in Ward 1992)",
         kind: ParamKind::Color(ColorSpec::unit_range([0.2, 0.2, 0.2])),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "alpha_x",
         label: "α x",
         doc: "RMS surface slope along the tangent x (`alpha` sets both)",
         kind: ParamKind::Float(FloatSpec::log(0.001, 1.0, 0.2, 0.001, 1.0)),
+        applies: Applies::Always,
     },
     ParamDecl {
         id: "alpha_y",
         label: "α y",
         doc: "RMS surface slope along the bitangent y (`alpha` sets both)",
         kind: ParamKind::Float(FloatSpec::log(0.001, 1.0, 0.2, 0.001, 1.0)),
+        applies: Applies::Always,
     },
 ];
 

@@ -159,9 +159,62 @@ pub struct ParamDecl {
     pub doc: &'static str,
     /// The value's kind, range and default.
     pub kind: ParamKind,
+    /// When the value matters (the GUI hides a parameter that does not apply
+    /// to the current choices, e.g. `k` while the Fresnel term is a
+    /// dielectric's); values are accepted and kept either way.
+    pub applies: Applies,
+}
+
+/// When a parameter's value affects the model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Applies {
+    /// Always.
+    Always,
+    /// Only while the choice parameter `param` of the same record has one of
+    /// the values `any_of`.
+    When {
+        /// Id of a [`ParamKind::Choice`] parameter declared beside this one.
+        param: &'static str,
+        /// The choices under which this parameter matters.
+        any_of: &'static [&'static str],
+    },
 }
 
 impl ParamDecl {
+    /// The same declaration, mattering only while choice `param` is one of
+    /// `any_of`.
+    pub const fn applies_when(
+        mut self,
+        param: &'static str,
+        any_of: &'static [&'static str],
+    ) -> Self {
+        self.applies = Applies::When { param, any_of };
+        self
+    }
+
+    /// The condition in words (`fresnel is dielectric or conductor`), `None`
+    /// for a parameter that always matters.
+    pub fn applies_text(&self) -> Option<String> {
+        match self.applies {
+            Applies::Always => None,
+            Applies::When { param, any_of } => Some(format!("{param} is {}", any_of.join(" or "))),
+        }
+    }
+
+    /// Whether the value matters for the record `values` (the parameters of
+    /// one model, or of one list item). A condition naming a parameter the
+    /// record does not hold as text counts as met, so that a declaration
+    /// error never hides a control.
+    pub fn applies_to(&self, values: &Params) -> bool {
+        match self.applies {
+            Applies::Always => true,
+            Applies::When { param, any_of } => match values.get(param) {
+                Ok(ParamValue::Text(v)) => any_of.contains(&v.as_str()),
+                _ => true,
+            },
+        }
+    }
+
     /// The declared default value.
     pub fn default_value(&self) -> ParamValue {
         match self.kind {
@@ -209,5 +262,73 @@ impl ParamDecl {
             ParamKind::Color(s) => s.unit,
             _ => "",
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ModelSpec;
+
+    /// Every condition of every built-in declaration (and of list items)
+    /// names a choice parameter of the same record, and only values it offers.
+    #[test]
+    fn conditions_name_choices_of_their_record() {
+        fn check(model: &str, decls: &[ParamDecl]) -> usize {
+            let mut n = 0;
+            for d in decls {
+                if let ParamKind::List { fields, .. } = d.kind {
+                    n += check(model, fields);
+                }
+                let Applies::When { param, any_of } = d.applies else {
+                    continue;
+                };
+                let owner = decls.iter().find(|o| o.id == param);
+                let Some(ParamKind::Choice { options, .. }) = owner.map(|o| o.kind) else {
+                    panic!(
+                        "{model}: `{}` depends on `{param}`, not a choice beside it",
+                        d.id
+                    );
+                };
+                assert!(!any_of.is_empty(), "{model}: `{}` never applies", d.id);
+                for v in any_of {
+                    assert!(
+                        options.contains(v),
+                        "{model}: `{}`: `{param}` has no `{v}`",
+                        d.id
+                    );
+                }
+                n += 1;
+            }
+            n
+        }
+        let n: usize = crate::catalogue()
+            .iter()
+            .map(|m| check(m.id, m.params))
+            .sum();
+        // eta, k and f0 of Cook-Torrance and of the mirror.
+        assert!(n >= 6, "{n} conditions");
+    }
+
+    /// The Fresnel parameters follow the choice: eta for the exact terms, k
+    /// for conductors only, f0 for Schlick only.
+    #[test]
+    fn fresnel_parameters_follow_the_choice() {
+        let mut spec = ModelSpec::new("cook-torrance").unwrap();
+        let shown = |spec: &ModelSpec| {
+            ["eta", "k", "f0"].map(|id| spec.model().param(id).unwrap().applies_to(spec.params()))
+        };
+        for (choice, want) in [
+            ("none", [false, false, false]),
+            ("dielectric", [true, false, false]),
+            ("conductor", [true, true, false]),
+            ("schlick", [false, false, true]),
+        ] {
+            spec.set_str("fresnel", choice).unwrap();
+            assert_eq!(shown(&spec), want, "fresnel = {choice}");
+        }
+        let k = spec.model().param("k").unwrap();
+        assert_eq!(k.applies_text().as_deref(), Some("fresnel is conductor"));
+        assert_eq!(spec.model().param("kd").unwrap().applies_text(), None);
     }
 }

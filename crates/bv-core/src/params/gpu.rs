@@ -348,12 +348,14 @@ mod tests {
             label: "n",
             doc: "exponent",
             kind: ParamKind::Float(FloatSpec::linear(0.0, 100.0, 2.0)),
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "c",
             label: "c",
             doc: "colour",
             kind: ParamKind::Color(ColorSpec::unit_range([0.25, 0.5, 0.75])),
+            applies: crate::Applies::Always,
         },
     ];
 
@@ -363,6 +365,7 @@ mod tests {
             label: "kd",
             doc: "colour",
             kind: ParamKind::Color(ColorSpec::unit_range([0.1, 0.2, 0.3])),
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "mode",
@@ -372,12 +375,14 @@ mod tests {
                 options: &["a", "b", "c"],
                 default: "c",
             },
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "flag",
             label: "flag",
             doc: "bool",
             kind: ParamKind::Bool { default: true },
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "lobes",
@@ -389,6 +394,7 @@ mod tests {
                 max_items: 3,
                 default_items: 2,
             },
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "file",
@@ -398,12 +404,14 @@ mod tests {
                 default: "",
                 format: &crate::models::merl::MERL_FILES,
             },
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "e",
             label: "e",
             doc: "float",
             kind: ParamKind::Float(FloatSpec::linear(0.0, 10.0, 7.5)),
+            applies: crate::Applies::Always,
         },
     ];
 

@@ -11,7 +11,7 @@ mod gpu;
 pub mod spec;
 pub mod value;
 
-pub use decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+pub use decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 pub use gpu::{
     COMPONENT_ENTRY_SLOTS, DerivedSlots, GpuLayout, GpuModelRef, GpuParam, GpuSlot, MAX_SLOTS,
     gpu_layout, gpu_model_index, pack_model, pack_model_with,

@@ -475,12 +475,14 @@ mod tests {
             label: "e",
             doc: "exponent",
             kind: ParamKind::Float(FloatSpec::log(0.0, 10000.0, 20.0, 1.0, 1000.0)),
+            applies: crate::Applies::Always,
         },
         ParamDecl {
             id: "kd",
             label: "kd",
             doc: "diffuse",
             kind: ParamKind::Color(ColorSpec::unit_range([0.5; 3])),
+            applies: crate::Applies::Always,
         },
     ];
 

@@ -28,7 +28,7 @@
 //! ([`MAX_FILE_BYTES`]), the number of parameters ([`MAX_PARAMS`]) and the
 //! length of a parameter name.
 
-use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
+use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::{BvError, Result};
 
 /// Largest `.brdf` file read (the shipped files are a few kB).
@@ -421,6 +421,7 @@ impl FileParam {
             label: id,
             doc,
             kind,
+            applies: Applies::Always,
         }
     }
 }
