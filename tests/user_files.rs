@@ -345,8 +345,7 @@ fn bv_eval_of_a_file_agrees_with_the_built_in_model() {
         assert_eq!(f.len(), queries.len(), "{file}: one answer per query");
         let mut worst = 0.0f64;
         for (k, pair) in f.chunks(2).enumerate() {
-            for c in 0..3 {
-                let (a, b) = (pair[0][c], pair[1][c]);
+            for (&a, &b) in pair[0].iter().zip(&pair[1]) {
                 let rel = (a - b).abs() / b.abs().max(1e-300);
                 worst = worst.max(if b == 0.0 { a.abs() } else { rel });
                 assert!(
@@ -357,5 +356,39 @@ fn bv_eval_of_a_file_agrees_with_the_built_in_model() {
             }
         }
         println!("{file} vs {model}: worst relative difference {worst:.2e}");
+    }
+}
+
+#[test]
+fn scene_files_name_a_file_model_by_its_path_and_every_view_draws_it() {
+    use bv::session::scene_file;
+    use bv::session::state::AppState;
+    let s = spec("cooktorrance.brdf", serde_json::json!({"m": 0.2}));
+    let mut state = AppState::default();
+    let id = state.add(s.clone());
+    state.selected = Some(id);
+    let text = scene_file::to_toml(&state).unwrap();
+    let canon = std::fs::canonicalize(data("cooktorrance.brdf")).unwrap();
+    assert!(
+        text.contains(&format!("model = \"{}\"", canon.display())),
+        "the scene names the file: {text}"
+    );
+    let back = scene_file::from_toml(&text).unwrap();
+    assert_eq!(back.state.brdfs[0].spec, s);
+
+    let Some(_) = bv::gpu::context::gpu_for_test() else {
+        return;
+    };
+    let mut off = bv::export::Offscreen::headless().unwrap();
+    let frame = bv::export::Frame {
+        size: eframe::egui::Vec2::new(320.0, 240.0),
+        pixels_per_point: 1.0,
+        dark: true,
+        transparent: false,
+    };
+    for e in bv::views::REGISTRY.iter() {
+        let img = bv::export::render_view(&mut off, &state, e, frame)
+            .unwrap_or_else(|err| panic!("view {}: {err:#}", e.id));
+        assert!(!bv::export::is_blank(&img), "view {} is blank", e.id);
     }
 }

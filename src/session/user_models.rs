@@ -19,6 +19,12 @@ pub fn is_file(name: &str) -> bool {
     bv_user::is_file_name(name)
 }
 
+/// The path of the file a model id was loaded from, if it is a file model:
+/// what scene files and the saved session name it by.
+pub fn path_of(id: &str) -> Option<String> {
+    bv_user::path_of(id).map(|p| p.display().to_string())
+}
+
 /// The catalogue entry a model name stands for: a catalogue id, or the path
 /// of a `.brdf` file (compiled and registered, or the entry of an unchanged
 /// earlier load).

@@ -71,9 +71,12 @@ fn the_good_files_compile_with_their_declarations() {
     assert!(f.file.is_func.is_some(), "the isFunc section is kept");
 }
 
+/// A broken file, a part of its message, and its line and column if placed.
+type Case = (&'static str, &'static str, Option<(usize, usize)>);
+
 #[test]
 fn broken_files_are_refused_at_their_place() {
-    let cases: &[(&str, &str, Option<(usize, usize)>)] = &[
+    let cases: &[Case] = &[
         // `    float x = a * ;`: the `;` of file line 8.
         ("broken_syntax.brdf", "Semicolon", Some((8, 19))),
         ("broken_type.brdf", "undefined_thing", Some((6, 17))),
