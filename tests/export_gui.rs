@@ -6,7 +6,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bv::app::Viewer;
-use bv::app::screenshot::{FigureSettings, Format, ScreenGeometry, Target};
+use bv::app::screenshot::{FigureLayout, FigureSettings, Format, ScreenGeometry, Target};
 use bv::session::Command;
 use bv::session::state::AppState;
 use bv::views::albedo::AlbedoView;
@@ -92,6 +92,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
             format: Format::Png,
             scale,
             transparent: false,
+            layout: FigureLayout::Screen,
         };
         let msg = v
             .export
@@ -110,6 +111,29 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
     }
     assert_eq!(sizes, vec![(300, 200), (600, 400), (1200, 800)]);
 
+    // Laid out as a figure, whatever the view's size on screen: at 2× on a
+    // 1× screen, 1600 × 1200 pixels, with the x axis's numbers.
+    let path = tmp("polar-figure.png");
+    let s = FigureSettings {
+        target: Target::View("cartesian".into()),
+        format: Format::Png,
+        scale: 2,
+        transparent: false,
+        layout: FigureLayout::Figure,
+    };
+    v.export
+        .export_figure(
+            &state,
+            &s,
+            &path,
+            geometry(1.0),
+            Some(egui::vec2(300.0, 200.0)),
+            bv::app::viewer::figure_window,
+        )
+        .unwrap();
+    let img = image::open(&path).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (1600, 1200));
+
     // The whole window, transparent: panels are unfilled.
     let path = tmp("window.png");
     let s = FigureSettings {
@@ -117,6 +141,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
         format: Format::Png,
         scale: 1,
         transparent: true,
+        layout: FigureLayout::Figure,
     };
     v.export
         .export_figure(
@@ -144,6 +169,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
             format,
             scale: 1,
             transparent: false,
+            layout: FigureLayout::Screen,
         };
         v.export
             .export_figure(

@@ -61,6 +61,8 @@ pub struct FigureSettings {
     pub scale: u32,
     /// Transparent background (PNG and SVG).
     pub transparent: bool,
+    /// How a view's figure is laid out.
+    pub layout: FigureLayout,
 }
 
 impl Default for FigureSettings {
@@ -70,9 +72,26 @@ impl Default for FigureSettings {
             format: Format::Png,
             scale: 2,
             transparent: false,
+            layout: FigureLayout::Figure,
         }
     }
 }
+
+/// How a view's figure is laid out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FigureLayout {
+    /// At [`FIGURE_SIZE`] points whatever the view's size on screen: a view
+    /// in a small grid cell still gets axis numbers and a legend, laid out
+    /// as `bv render` lays out its figures.
+    Figure,
+    /// At the view's size on screen (its grid cell, or the window when
+    /// maximised).
+    Screen,
+}
+
+/// The layout size of a figure of one view, points (×2 at the default 2×
+/// resolution: 1600 × 1200 pixels, `bv render`'s default).
+pub const FIGURE_SIZE: egui::Vec2 = egui::vec2(800.0, 600.0);
 
 /// What a file dialog was opened for.
 #[derive(Debug, Clone)]
@@ -255,6 +274,24 @@ impl ExportUi {
                             });
                             ui.end_row();
                         }
+                        if matches!(s.target, Target::View(_)) && s.format != Format::Mesh {
+                            ui.label("Layout");
+                            ui.horizontal(|ui| {
+                                ui.selectable_value(
+                                    &mut s.layout,
+                                    FigureLayout::Figure,
+                                    format!("figure {}×{}", FIGURE_SIZE.x, FIGURE_SIZE.y),
+                                )
+                                .on_hover_text("Laid out for the figure's own size (points)");
+                                ui.selectable_value(
+                                    &mut s.layout,
+                                    FigureLayout::Screen,
+                                    "as on screen",
+                                )
+                                .on_hover_text("The view's size in the window");
+                            });
+                            ui.end_row();
+                        }
                         if s.format != Format::Mesh {
                             ui.label("Background");
                             ui.checkbox(&mut s.transparent, "transparent");
@@ -348,9 +385,10 @@ impl ExportUi {
                     .ok_or_else(|| anyhow::anyhow!("no view `{id}` in this build"))?,
             ),
         };
-        let size = match entry {
-            Some(_) => view_size.unwrap_or(geometry.window * 0.5),
-            None => geometry.window,
+        let size = match (entry, settings.layout) {
+            (Some(_), FigureLayout::Figure) => FIGURE_SIZE,
+            (Some(_), FigureLayout::Screen) => view_size.unwrap_or(geometry.window * 0.5),
+            (None, _) => geometry.window,
         };
         match settings.format {
             Format::Png => {

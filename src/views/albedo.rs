@@ -20,7 +20,7 @@ use bv_core::analysis::albedo::{AlbedoOptions, Estimate, rho_hd_auto, rho_hh_aut
 use bv_core::analysis::directions::stream_seed;
 use bv_core::{Brdf, mean_rgb};
 use eframe::egui::{self, Ui};
-use egui_plot::{Corner, FilledArea, HLine, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+use egui_plot::{Corner, FilledArea, HLine, Line, LineStyle, Plot, PlotPoints, VLine};
 use rayon::prelude::*;
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -394,19 +394,23 @@ impl View for AlbedoView {
         let top = y_top(&shown);
         let size = ui.available_size();
         let light = super::light_color(dark);
-        let plot = Plot::new(super::view_id("albedo"))
-            .width(size.x.max(50.0))
-            .height(size.y.max(50.0))
-            .legend(Legend::default().position(legend_corner(&shown, top, size)))
-            .x_axis_label(X_LABEL)
-            .y_axis_label(Y_LABEL)
-            .y_axis_min_width(36.0)
-            .include_x(0.0)
-            .include_x(90.0)
-            .include_y(0.0)
-            .include_y(top)
-            .allow_scroll(false)
-            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        let plot = super::with_legend(
+            Plot::new(super::view_id("albedo")),
+            size,
+            shown.len(),
+            legend_corner(&shown, top, size),
+        )
+        .width(size.x.max(50.0))
+        .height(size.y.max(50.0))
+        .x_axis_label(X_LABEL)
+        .y_axis_label(Y_LABEL)
+        .y_axis_min_width(36.0)
+        .include_x(0.0)
+        .include_x(90.0)
+        .include_y(0.0)
+        .include_y(top)
+        .allow_scroll(false)
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
         let theta_i = scene.incident.theta_deg;
         plot.show(ui, |pui| {
             pui.hline(

@@ -11,7 +11,7 @@ use super::{Scene, View};
 use crate::session::command::Command;
 use crate::session::state::CartesianAxis;
 use eframe::egui::{self, Color32, RichText, Ui};
-use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text, VLine};
+use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text, VLine};
 
 /// Samples per curve over 180° (0.25° steps).
 const SAMPLES: usize = 720;
@@ -101,44 +101,48 @@ impl View for CartesianView {
 
         let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
-        let mut plot = Plot::new(super::view_id("cartesian"))
-            .width(size.x.max(50.0))
-            .height(size.y.max(50.0))
-            .legend(Legend::default().position(Corner::RightTop))
-            .x_axis_label(x_label)
-            .y_axis_label(y_label)
-            .y_axis_min_width(44.0)
-            // Angles read in steps a lecturer uses: 15°, 45°, 90°.
-            .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
-                let span = input.bounds.1 - input.bounds.0;
-                if span > 200.0 {
-                    [10.0, 30.0, 90.0]
-                } else if span > 50.0 {
-                    [5.0, 15.0, 45.0]
+        let mut plot = super::with_legend(
+            Plot::new(super::view_id("cartesian"))
+                .width(size.x.max(50.0))
+                .height(size.y.max(50.0)),
+            size,
+            scene.brdfs.len(),
+            Corner::RightTop,
+        )
+        .x_axis_label(x_label)
+        .y_axis_label(y_label)
+        .y_axis_min_width(44.0)
+        // Angles read in steps a lecturer uses: 15°, 45°, 90°.
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+            let span = input.bounds.1 - input.bounds.0;
+            if span > 200.0 {
+                [10.0, 30.0, 90.0]
+            } else if span > 50.0 {
+                [5.0, 15.0, 45.0]
+            } else {
+                [1.0, 5.0, 15.0]
+            }
+        }))
+        .allow_scroll(false)
+        .label_formatter(move |hover| match hover {
+            egui_plot::HoverPosition::NearDataPoint {
+                plot_name,
+                position,
+                ..
+            } if !plot_name.is_empty() => {
+                let v = if log {
+                    10f64.powf(position.y)
                 } else {
-                    [1.0, 5.0, 15.0]
-                }
-            }))
-            .allow_scroll(false)
-            .label_formatter(move |hover| match hover {
-                egui_plot::HoverPosition::NearDataPoint {
-                    plot_name,
-                    position,
-                    ..
-                } if !plot_name.is_empty() => {
-                    let v = if log {
-                        10f64.powf(position.y)
-                    } else {
-                        position.y
-                    };
-                    Some(format!(
-                        "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
-                        position.x,
-                        curves::fmt_value(v)
-                    ))
-                }
-                _ => None,
-            });
+                    position.y
+                };
+                Some(format!(
+                    "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
+                    position.x,
+                    curves::fmt_value(v)
+                ))
+            }
+            _ => None,
+        });
         if log {
             // The axis spans the decades the data reach (see
             // `curves::LogRange`): curves below it leave through the bottom

@@ -34,7 +34,7 @@ use bv_core::fresnel::{self, Fresnel};
 use bv_core::optics;
 use bv_core::{Brdf, Rgb};
 use eframe::egui::{self, Color32, RichText, Ui};
-use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoints, VLine};
 
 /// Samples over 0..90°.
 const SAMPLES: usize = 360;
@@ -547,19 +547,23 @@ impl View for FresnelView {
         let readout_h = readouts.len() as f32
             * (ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y);
         let plot_h = (size.y - strip_h - readout_h).max(50.0);
-        let plot = Plot::new(super::view_id("fresnel"))
-            .width(size.x.max(50.0))
-            .height(plot_h)
-            .legend(Legend::default().position(Corner::LeftTop))
-            .x_axis_label(c.x_label.clone())
-            .y_axis_label(c.y_label.clone())
-            .y_axis_min_width(36.0)
-            .include_x(0.0)
-            .include_x(90.0)
-            .include_y(0.0)
-            .include_y(1.05)
-            .allow_scroll(false)
-            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        let plot = super::with_legend(
+            Plot::new(super::view_id("fresnel"))
+                .width(size.x.max(50.0))
+                .height(plot_h),
+            egui::vec2(size.x, plot_h),
+            c.series.len(),
+            Corner::LeftTop,
+        )
+        .x_axis_label(c.x_label.clone())
+        .y_axis_label(c.y_label.clone())
+        .y_axis_min_width(36.0)
+        .include_x(0.0)
+        .include_x(90.0)
+        .include_y(0.0)
+        .include_y(1.05)
+        .allow_scroll(false)
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
         let response = plot.show(ui, |pui| {
             for (k, m) in c.vlines.iter().enumerate() {
                 let mut v = VLine::new("", m.at)

@@ -359,11 +359,17 @@ impl LitSphereView {
             // A mirror or smooth glass under a point light is black but for
             // one point: say why rather than show a black disc.
             if delta_only(d.brdf.brdf.as_ref()) {
+                // The whole sentence where the sphere has room for it.
+                let note = if r >= 110.0 {
+                    "only δ lobes: a point light\nlights one direction, no pixel;\nsee the environment view"
+                } else {
+                    "only δ lobes"
+                };
                 gpu_image::plate_text(
                     &painter,
                     c + Vec2::new(0.0, 0.45 * r),
                     Align2::CENTER_CENTER,
-                    "only δ lobes: a point light\nlights one direction, no pixel;\nsee the environment view",
+                    note,
                     // On the plate's dark backing in either theme.
                     Color32::from_gray(235),
                 );

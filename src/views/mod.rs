@@ -211,6 +211,28 @@ pub fn mirror_color(dark: bool) -> Color32 {
     }
 }
 
+/// Whether a plot of `size` points has room for a legend of `entries` lines
+/// (at most 40 % of its height, and a width a label fits in): in a small
+/// grid cell a legend would cover the curves, and the panel's colour
+/// swatches name them anyway. Maximised views and figures have room.
+pub fn legend_fits(size: egui::Vec2, entries: usize) -> bool {
+    entries as f32 * 18.0 + 12.0 <= 0.4 * size.y && size.x >= 280.0
+}
+
+/// `plot` with a legend in `corner` where [`legend_fits`].
+pub fn with_legend(
+    plot: egui_plot::Plot<'_>,
+    size: egui::Vec2,
+    entries: usize,
+    corner: egui_plot::Corner,
+) -> egui_plot::Plot<'_> {
+    if legend_fits(size, entries) {
+        plot.legend(egui_plot::Legend::default().position(corner))
+    } else {
+        plot
+    }
+}
+
 /// A faint colour for grids.
 pub fn grid_color(dark: bool) -> Color32 {
     if dark {

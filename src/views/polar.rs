@@ -9,7 +9,7 @@ use super::curves::{self, Sample};
 use super::{Scene, View, sh_overlay};
 use crate::session::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
-use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
+use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
 use std::f64::consts::FRAC_PI_2;
 
 /// Samples per curve (half circle); 0.25° steps keep a Phong lobe of exponent
@@ -221,30 +221,34 @@ impl View for PolarView {
         let value_name = super::value_label(d.cosine);
         let log = d.log;
 
-        let plot = Plot::new(super::view_id("polar"))
-            .width(size.x.max(50.0))
-            .height(size.y.max(50.0))
-            .data_aspect(1.0)
-            .show_axes(false)
-            .show_grid(false)
-            .allow_scroll(false)
-            .legend(Legend::default().position(Corner::RightTop))
-            .label_formatter(move |hover| match hover {
-                egui_plot::HoverPosition::NearDataPoint {
-                    plot_name,
-                    position,
-                    ..
-                } if !plot_name.is_empty() => {
-                    let angle = position.x.atan2(position.y).to_degrees();
-                    let v = value_at(position.x.hypot(position.y), log);
-                    Some(format!(
-                        "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
-                        angle,
-                        curves::fmt_value(v)
-                    ))
-                }
-                _ => None,
-            });
+        let plot = super::with_legend(
+            Plot::new(super::view_id("polar")),
+            size,
+            scene.brdfs.len(),
+            Corner::RightTop,
+        )
+        .width(size.x.max(50.0))
+        .height(size.y.max(50.0))
+        .data_aspect(1.0)
+        .show_axes(false)
+        .show_grid(false)
+        .allow_scroll(false)
+        .label_formatter(move |hover| match hover {
+            egui_plot::HoverPosition::NearDataPoint {
+                plot_name,
+                position,
+                ..
+            } if !plot_name.is_empty() => {
+                let angle = position.x.atan2(position.y).to_degrees();
+                let v = value_at(position.x.hypot(position.y), log);
+                Some(format!(
+                    "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
+                    angle,
+                    curves::fmt_value(v)
+                ))
+            }
+            _ => None,
+        });
 
         let span: i32 = if transmits { 180 } else { 90 };
         let brdfs = &scene.brdfs;

@@ -23,7 +23,7 @@ use super::{Scene, View};
 use crate::session::command::Command;
 use bv_core::frame;
 use eframe::egui::{self, RichText, Ui};
-use egui_plot::{Corner, Legend, Line, LineStyle, Plot, PlotPoints, VLine};
+use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoints, VLine};
 use std::f64::consts::FRAC_PI_2;
 
 /// Samples over 0..90° (D, F); twice as many over −90..90° (G).
@@ -301,25 +301,27 @@ pub struct TermsView {
 /// Draws a chart with egui_plot into `height` points.
 fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
     let width = ui.available_width().max(50.0);
-    let mut plot = Plot::new(id)
-        .width(width)
-        .height(height.max(40.0))
-        .legend(Legend::default().position(Corner::RightTop))
-        .x_axis_label(c.x_label.clone())
-        .y_axis_label(c.y_label.clone())
-        .y_axis_min_width(40.0)
-        .include_x(c.x_range.0)
-        .include_x(c.x_range.1)
-        .include_y(c.y_range.0)
-        .include_y(c.y_range.1)
-        .allow_scroll(false)
-        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
-            if input.bounds.1 - input.bounds.0 > 100.0 {
-                [5.0, 15.0, 45.0]
-            } else {
-                [5.0, 15.0, 15.0]
-            }
-        }));
+    let mut plot = super::with_legend(
+        Plot::new(id).width(width).height(height.max(40.0)),
+        egui::vec2(width, height),
+        c.series.len(),
+        Corner::RightTop,
+    )
+    .x_axis_label(c.x_label.clone())
+    .y_axis_label(c.y_label.clone())
+    .y_axis_min_width(40.0)
+    .include_x(c.x_range.0)
+    .include_x(c.x_range.1)
+    .include_y(c.y_range.0)
+    .include_y(c.y_range.1)
+    .allow_scroll(false)
+    .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+        if input.bounds.1 - input.bounds.0 > 100.0 {
+            [5.0, 15.0, 45.0]
+        } else {
+            [5.0, 15.0, 15.0]
+        }
+    }));
     if log_y {
         plot = plot
             .y_axis_formatter(|mark, _| {
