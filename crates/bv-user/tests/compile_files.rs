@@ -214,3 +214,17 @@ fn the_cpu_evaluates_the_leniencies_as_their_closed_forms() {
         assert_eq!(ints.eval(wi, DVec3::new(wo.x, wo.y, -wo.z)), DVec3::ZERO);
     }
 }
+
+#[test]
+fn claims_are_what_a_probe_observes() {
+    let c = |name: &str, p: serde_json::Value| built(name, p).claims();
+    let lambert = c("lambert.brdf", serde_json::json!({}));
+    assert!(lambert.reciprocal && lambert.isotropic && !lambert.energy_conserving);
+    // Phong's 1/cos θi breaks reciprocity.
+    assert!(!c("phong.brdf", serde_json::json!({})).reciprocal);
+    let ward = c(
+        "ward.brdf",
+        serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.4}),
+    );
+    assert!(ward.reciprocal && !ward.isotropic);
+}
