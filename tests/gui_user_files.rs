@@ -164,3 +164,80 @@ fn saving_an_open_file_reloads_it_and_a_broken_edit_keeps_the_last_lobe() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+fn viewer_on_gpu(state: AppState) -> Harness<'static, Viewer> {
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    bv::views::lobe_gpu::install(&rs);
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .with_max_steps(8)
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
+            rs.clone(),
+        ))
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state));
+    bv::views::gpu_image::install(&h.ctx, &rs);
+    h.run_steps(2);
+    h
+}
+
+/// The lit sphere's centre pixel (its red channel).
+fn lit_centre(h: &mut Harness<'_, Viewer>) -> Option<u8> {
+    use bv::views::lit_sphere::LitSphereView;
+    let rect = h.state().view::<LitSphereView>()?.view_rect?;
+    let img = h.render().ok()?;
+    let c = rect.center();
+    Some(img.get_pixel(c.x as u32 - 2, c.y as u32 - 2).0[0])
+}
+
+#[test]
+fn the_lit_sphere_draws_the_reloaded_shader() {
+    bv::session::user_models::install();
+    let dir = temp_dir("lit");
+    let path = dir.join("lit.brdf");
+    std::fs::write(&path, lambertish("1.0", "")).unwrap();
+    let mut state = AppState::default();
+    state
+        .add(ModelSpec::from_json(path.to_str().unwrap(), &serde_json::json!({"k": 0.6})).unwrap());
+    state.incident = bv::session::state::Incident {
+        theta_deg: 30.0,
+        phi_deg: 20.0,
+    };
+    state.lighting.env.target_spp = 1;
+    let mut h = viewer_on_gpu(state);
+    // The centre is f·cos θi·E = k/π · cos 30°, in sRGB.
+    let want = |scale: f64| {
+        bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
+            scale * 0.6 / std::f64::consts::PI * 30f64.to_radians().cos(),
+        ))
+    };
+    let close = |px: Option<u8>, w: u8| px.is_some_and(|p| p.abs_diff(w) <= 2);
+    let t0 = Instant::now();
+    while !close(lit_centre(&mut h), want(1.0)) {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "{:?}",
+            lit_centre(&mut h)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    // Save a version with 1.5 × the value: the renderer is rebuilt for the
+    // new shader and the centre follows.
+    std::fs::write(&path, lambertish("1.5", "")).unwrap();
+    let t0 = Instant::now();
+    while !close(lit_centre(&mut h), want(1.5)) {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "centre {:?}, want {}",
+            lit_centre(&mut h),
+            want(1.5)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+        h.run_steps(1);
+    }
+    println!("lit sphere redrawn {:?} after the save", t0.elapsed());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

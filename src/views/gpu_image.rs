@@ -67,6 +67,8 @@ pub struct Deferred<T> {
     revision: u64,
     /// The renderer of an earlier revision, drawn while the slot rebuilds.
     previous: Option<T>,
+    /// Counts the renderers that became ready.
+    generation: u64,
 }
 
 impl<T> Default for Deferred<T> {
@@ -75,6 +77,7 @@ impl<T> Default for Deferred<T> {
             slot: Slot::Empty,
             revision: 0,
             previous: None,
+            generation: 0,
         }
     }
 }
@@ -137,6 +140,7 @@ impl<T: Send + 'static> Deferred<T> {
                 Ok(Ok(t)) => {
                     self.slot = Slot::Ready(t);
                     self.previous = None;
+                    self.generation += 1;
                 }
                 Ok(Err(e)) => self.slot = Slot::Failed(e),
                 Err(std::sync::mpsc::TryRecvError::Empty) => {}
@@ -161,6 +165,7 @@ impl<T: Send + 'static> Deferred<T> {
     pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
         self.follow_catalogue();
         if let Slot::Building(rx) = &self.slot {
+            self.generation += 1;
             self.slot = match rx.recv() {
                 Ok(Ok(t)) => Slot::Ready(t),
                 Ok(Err(e)) => Slot::Failed(e),
@@ -169,6 +174,7 @@ impl<T: Send + 'static> Deferred<T> {
         }
         if !matches!(self.slot, Slot::Ready(_)) {
             self.revision = bv_core::registry::revision();
+            self.generation += 1;
             self.slot = match build() {
                 Ok(t) => Slot::Ready(t),
                 Err(e) => Slot::Failed(e),
@@ -196,6 +202,13 @@ impl<T: Send + 'static> Deferred<T> {
             Slot::Ready(t) => Some(t),
             _ => self.previous.as_mut(),
         }
+    }
+
+    /// Changes whenever another renderer becomes the one returned (a first
+    /// build, or a rebuild for a changed catalogue): what was drawn with the
+    /// one before must be drawn again.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// Whether it is being built.
