@@ -14,7 +14,8 @@
 //! guard at the top of its body: one per-invocation counter shared by all
 //! loops, and a `break` once it passes [`MAX_GPU_ITERATIONS`]; the value an
 //! aborted evaluation returns is meaningless but finite time is kept.
-//! Recursion is refused by naga's validator (WGSL has none).
+//! Recursion never reaches the GPU: GLSL's front end refuses a call to a
+//! function not yet defined, and naga's validator refuses recursion in WGSL.
 
 use crate::error::{Result, UserError};
 use crate::front::Translated;

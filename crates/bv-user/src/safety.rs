@@ -2,7 +2,7 @@
 //! either evaluator. The file size and the parameter count are bounded by
 //! the container parser; time on the CPU by the interpreter's step budget,
 //! on the GPU by the loop guards of [`crate::port`]; recursion is refused by
-//! naga's validator. What is left is memory: an array a shader declares
+//! the front ends (see [`crate::port`]). What is left is memory: an array a shader declares
 //! lives in every GPU invocation's private memory (and the interpreter's
 //! stack), so its size is bounded here.
 
