@@ -77,7 +77,12 @@ pub fn model_info(c: &Compiled, path: &Path) -> Result<ModelInfo> {
     Ok(ModelInfo {
         id,
         name: leak(file_name),
-        summary: leak(format!("User BRDF file {}", path.display())),
+        summary: match c.file.language {
+            bv_core::user::brdf_file::Language::Glsl => {
+                "User BRDF file (BRDF Explorer format, GLSL shader)"
+            }
+            bv_core::user::brdf_file::Language::Wgsl => "User BRDF file (bv's WGSL variant)",
+        },
         citation: leak(path.display().to_string()),
         params: c.decls,
         aliases: &[],
