@@ -121,6 +121,7 @@ fn the_gpu_evaluates_every_test_file_as_its_closed_form() {
     let features = spec("features.brdf", serde_json::json!({}));
     let native = spec("native.brdf", serde_json::json!({}));
     let looping = spec("hostile_loop.brdf", serde_json::json!({}));
+    let names = spec("names.brdf", serde_json::json!({"Ks": 0.125}));
     let Some((eval, ())) = gpu() else {
         return;
     };
@@ -187,6 +188,7 @@ fn the_gpu_evaluates_every_test_file_as_its_closed_form() {
         let lobe = wi.dot(wo).max(0.0).powf(10.0) * 11.0 / (2.0 * PI);
         [0.8 / PI + lobe, 0.6 / PI + lobe, 0.4 / PI + lobe]
     });
+    gpu_matches(&eval, &names, "names", |_, _| [0.375, 0.25, 0.125]);
     // An endless loop ends on the GPU (the guard breaks out of it) with a
     // finite value: the guard's count.
     let got = eval.eval(&looping, &f32_pairs(&pairs()[..4])).unwrap();

@@ -46,6 +46,13 @@ pub fn model_id(path: &Path) -> String {
             }
         })
         .collect();
+    // One `-` between words and none at the ends: the id's WGSL form (`-`
+    // becomes `_`) then has no `__`, which shader composition refuses.
+    let stem = stem
+        .split('-')
+        .filter(|w| !w.is_empty())
+        .collect::<Vec<_>>()
+        .join("-");
     let hash = fnv1a(path.to_string_lossy().as_bytes()) as u32;
     format!(
         "{}-{hash:08x}",
@@ -222,5 +229,6 @@ mod tests {
         );
         assert!(is_file_name("x/y.BRDF"));
         assert!(!is_file_name("lambert"));
+        assert!(model_id(Path::new("/x/_a__b-.brdf")).starts_with("a-b-"));
     }
 }
