@@ -21,6 +21,12 @@ pub const MERL_FILES: Filter = Filter {
     extensions: &["binary"],
 };
 
+/// What the open dialog offers: measured tables and user BRDF files.
+pub const OPENABLE_FILES: Filter = Filter {
+    name: "MERL table (.binary) or BRDF file (.brdf)",
+    extensions: &["binary", "brdf"],
+};
+
 /// Progress bars of the reads in flight (nothing when idle).
 pub fn progress_ui(ui: &mut Ui, loader: &Loader) {
     for job in loader.jobs() {

@@ -53,6 +53,9 @@ pub struct Viewer {
     load_errors: Vec<LoadError>,
     last_load: Option<String>,
     files: Files<()>,
+    /// Hot reload of the user BRDF files drawn.
+    reloader: crate::session::user_models::Reloader,
+    reloader_woken: bool,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
     /// Draw as a figure (a screenshot of the window): views finish slow work
@@ -79,6 +82,8 @@ impl Viewer {
             load_errors: Vec::new(),
             last_load: None,
             files: Files::default(),
+            reloader: Default::default(),
+            reloader_woken: false,
             force_interacting: false,
             figure: false,
             export: ExportUi::default(),
@@ -485,8 +490,11 @@ impl Viewer {
                 self.loader.start(path.into(), target);
             }
             if r.open_dialog && !self.files.is_open() {
-                self.files
-                    .open((), "Load a MERL table (.binary)", measured_ui::MERL_FILES);
+                self.files.open(
+                    (),
+                    "Open a MERL table (.binary) or a BRDF file (.brdf)",
+                    measured_ui::OPENABLE_FILES,
+                );
             }
         }
     }
@@ -521,6 +529,7 @@ impl Viewer {
         self.sync_zoom(&ctx);
         self.apply_pending();
         self.finish_loads();
+        self.reload_user_files(&ctx);
         if self.loader.busy() {
             // Keep the progress bar moving while nothing else happens.
             ctx.request_repaint_after(std::time::Duration::from_millis(40));
@@ -584,6 +593,35 @@ impl Viewer {
             if self.state != before || self.help != help {
                 ctx.request_repaint();
             }
+        }
+    }
+
+    /// Applies saved edits of the user BRDF files drawn: the status line
+    /// says which file reloaded, the error window shows a file that no
+    /// longer compiles (with file, line and column) while its last working
+    /// version stays drawn.
+    fn reload_user_files(&mut self, ctx: &egui::Context) {
+        use crate::session::user_models::ReloadEvent;
+        for ev in self.reloader.update(&mut self.state) {
+            match ev {
+                ReloadEvent::Reloaded { path } => {
+                    self.load_errors.retain(|e| e.path != path);
+                    self.status = Some(format!("reloaded {path}"));
+                }
+                ReloadEvent::Failed { path, message } => {
+                    self.load_errors.retain(|e| e.path != path);
+                    self.load_errors.push(LoadError { path, message });
+                }
+            }
+            ctx.request_repaint();
+        }
+        if !self.reloader_woken {
+            let c = ctx.clone();
+            self.reloader.set_waker(move || c.request_repaint());
+            self.reloader_woken = true;
+        }
+        if self.reloader.pending() {
+            ctx.request_repaint_after(bv_user::watch::SETTLE);
         }
     }
 

@@ -99,6 +99,8 @@ pub fn main(shell: &Shell) -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
+    // Every model argument below (and the window's) may be a `.brdf` path.
+    crate::session::user_models::install();
     let result = match &cli.command {
         None => (shell.run_viewer)(&cli.viewer).map(|()| ExitCode::SUCCESS),
         Some(Command::Eval(a)) => eval::run(a),

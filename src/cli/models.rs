@@ -13,10 +13,25 @@ pub struct ModelsArgs {
     /// Print JSON (an array of models) instead of the readable listing.
     #[arg(long)]
     pub json: bool,
+    /// List only the model of this `.brdf` file (compiled, with its
+    /// parameters as bv declares them).
+    #[arg(long, value_name = "FILE")]
+    pub file: Option<std::path::PathBuf>,
 }
 
 /// Runs `bv models`.
 pub fn run(args: &ModelsArgs) -> anyhow::Result<()> {
+    if let Some(path) = &args.file {
+        let m = crate::session::user_models::resolve(&path.to_string_lossy())?;
+        if args.json {
+            let mut text = serde_json::to_string_pretty(&model_json(m))?;
+            text.push('\n');
+            return print(&text);
+        }
+        let mut s = String::new();
+        model_text(&mut s, m);
+        return print(&s);
+    }
     if args.json {
         let mut text = serde_json::to_string_pretty(&catalogue_json())?;
         text.push('\n');
@@ -124,16 +139,22 @@ pub fn catalogue_text() -> String {
         if models.len() == 1 { "" } else { "s" }
     );
     for m in models.iter() {
-        let _ = writeln!(s, "\n{}  ({})", m.id, m.name);
-        let _ = writeln!(s, "  {}", m.summary);
-        let _ = writeln!(s, "  source: {}", m.citation);
-        if m.params.is_empty() {
-            let _ = writeln!(s, "  (no parameters)");
-            continue;
-        }
-        param_table(&mut s, m.params, "  ");
+        s.push('\n');
+        model_text(&mut s, m);
     }
     s
+}
+
+/// One model's entry of the listing.
+fn model_text(s: &mut String, m: &ModelInfo) {
+    let _ = writeln!(s, "{}  ({})", m.id, m.name);
+    let _ = writeln!(s, "  {}", m.summary);
+    let _ = writeln!(s, "  source: {}", m.citation);
+    if m.params.is_empty() {
+        let _ = writeln!(s, "  (no parameters)");
+        return;
+    }
+    param_table(s, m.params, "  ");
 }
 
 /// Appends an aligned table of `decls` to `s`, each line prefixed by `indent`;

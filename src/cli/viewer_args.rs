@@ -42,7 +42,8 @@ pub struct ViewerArgs {
     pub light: bool,
 
     /// Open a measured BRDF (a MERL `.binary` file) as one more BRDF, read in
-    /// the background with a progress bar (repeat for several).
+    /// the background with a progress bar (repeat for several); a user BRDF
+    /// file (`.brdf`) is opened as a model and watched for edits.
     #[arg(long = "open", value_name = "FILE")]
     pub open: Vec<PathBuf>,
 

@@ -37,10 +37,18 @@ pub fn ident(id: &str) -> String {
 struct Consts {
     out: String,
     names: BTreeSet<String>,
+    /// Whether the model being written was registered at run time: its
+    /// parameter names come from a user's file (`ks` and `Ks`, `_x`), and a
+    /// name that cannot be a constant (defined twice, or with the `__`
+    /// composition refuses) is left out rather than failing every shader.
+    lenient: bool,
 }
 
 impl Consts {
     fn push(&mut self, name: String, value: u32, why: &str) -> Result<()> {
+        if self.lenient && (name.contains("__") || self.names.contains(&name)) {
+            return Ok(());
+        }
         if !self.names.insert(name.clone()) {
             bail!("generated WGSL constant `{name}` is defined twice ({why}); rename a parameter");
         }
@@ -80,6 +88,7 @@ pub fn layout_module() -> Result<String> {
              #define_import_path bv::layout\n\n",
         ),
         names: BTreeSet::new(),
+        lenient: false,
     };
     let models = bv_core::catalogue();
     c.push("MODEL_COUNT".into(), models.len() as u32, "catalogue")?;
@@ -89,6 +98,9 @@ pub fn layout_module() -> Result<String> {
         "mix table",
     )?;
     for m in models.iter() {
+        c.lenient = !bv_core::models::BUILT_IN
+            .iter()
+            .any(|b| std::ptr::eq(*b, *m));
         let id = ident(m.id);
         c.push(format!("MODEL_{id}"), gpu_model_index(m.id)?, m.id)?;
         let layout = gpu_layout(m.params);

@@ -271,6 +271,16 @@ impl Command {
                 state.lighting.env = v;
                 state.lighting = std::mem::take(&mut state.lighting).sanitised();
             }
+            // A user BRDF file is a model of its own (compiled now, small),
+            // not a table for the background loader.
+            Command::OpenFile { path, .. } if super::user_models::is_file(&path) => {
+                match super::user_models::resolve(&path).map(ModelSpec::defaults) {
+                    Ok(spec) => {
+                        state.add(spec);
+                    }
+                    Err(e) => out.message = Some(format!("{e:#}")),
+                }
+            }
             Command::OpenFile { path, into } => {
                 let target = match into.and_then(|id| state.entry(id)) {
                     Some(e) => match path_param(&e.spec) {

@@ -3,7 +3,7 @@
 //! change it ([`command`]), the evaluators built from it ([`runtime`]), the
 //! background reads of file-backed models ([`loader`]), the scene file format
 //! ([`scene_file`]) and lecture decks of scenes ([`deck`]), presentation
-//! mode's sizes ([`presentation`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
+//! mode's sizes ([`presentation`]), user BRDF files ([`user_models`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
 //! and the per-frame scene every view reads ([`frame`]).
 //!
 //! Nothing here draws: no egui, no wgpu. The window (`app`), the views, the
@@ -20,6 +20,7 @@ pub mod presentation;
 pub mod runtime;
 pub mod scene_file;
 pub mod state;
+pub mod user_models;
 pub mod views;
 
 pub use command::Command;

@@ -463,7 +463,15 @@ mod spec_json {
     use super::*;
 
     pub fn serialize<S: Serializer>(spec: &ModelSpec, s: S) -> Result<S::Ok, S::Error> {
-        spec.to_json().serialize(s)
+        let mut v = spec.to_json();
+        // A user file's model is saved by its path, which a later run can
+        // open; its id names it only in the process that loaded it.
+        if let Some(path) = crate::session::user_models::path_of(spec.id())
+            && let Some(m) = v.get_mut("model")
+        {
+            *m = Value::String(path);
+        }
+        v.serialize(s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ModelSpec, D::Error> {

@@ -154,7 +154,7 @@ impl EnvironmentView {
     /// A view that creates its renderer on first use.
     pub fn new() -> Self {
         Self {
-            renderer: Deferred::Empty,
+            renderer: Deferred::default(),
             image: GpuImage::default(),
             map_in_use: None,
             map_requested: None,

@@ -55,8 +55,35 @@ pub fn library() -> anyhow::Result<ShaderLibrary> {
 /// all, the driver's compilation of the pipelines (seconds for the
 /// environment shader on lavapipe with a cold shader cache) must not freeze
 /// the window.
+///
+/// A renderer's shaders are composed from the catalogue as it was when it
+/// was built; when the catalogue changes (a user file opened or reloaded:
+/// [`bv_core::registry::revision`]) it is built again, and the one built
+/// before is kept and used until the new one is ready (or if it fails), so
+/// that the view keeps drawing the last working version.
+pub struct Deferred<T> {
+    slot: Slot<T>,
+    /// The catalogue revision the current slot was (or is being) built for.
+    revision: u64,
+    /// The renderer of an earlier revision, drawn while the slot rebuilds.
+    previous: Option<T>,
+    /// Counts the renderers that became ready.
+    generation: u64,
+}
+
+impl<T> Default for Deferred<T> {
+    fn default() -> Self {
+        Self {
+            slot: Slot::Empty,
+            revision: 0,
+            previous: None,
+            generation: 0,
+        }
+    }
+}
+
 #[derive(Default)]
-pub enum Deferred<T> {
+enum Slot<T> {
     /// Not asked for yet.
     #[default]
     Empty,
@@ -69,15 +96,31 @@ pub enum Deferred<T> {
 }
 
 impl<T: Send + 'static> Deferred<T> {
-    /// Starts `build` on a worker thread the first time, takes its result when
-    /// it is there: `Ok(Some(_))` when ready, `Ok(None)` while building (the
-    /// worker asks `ctx` for a frame when it is done).
+    /// Starts a rebuild when the catalogue changed since the slot was built,
+    /// keeping a built renderer as `previous`.
+    fn follow_catalogue(&mut self) {
+        let now = bv_core::registry::revision();
+        if self.revision == now || matches!(self.slot, Slot::Empty | Slot::Building(_)) {
+            return;
+        }
+        if let Slot::Ready(t) = std::mem::take(&mut self.slot) {
+            self.previous = Some(t);
+        }
+    }
+
+    /// Starts `build` on a worker thread the first time (and again after the
+    /// catalogue changed), takes its result when it is there: `Ok(Some(_))`
+    /// when ready, `Ok(None)` while building (the worker asks `ctx` for a
+    /// frame when it is done). While a rebuild runs, or after it failed, the
+    /// renderer built before is returned.
     pub fn poll(
         &mut self,
         ctx: &egui::Context,
         build: impl FnOnce() -> Result<T, String> + Send + 'static,
     ) -> Result<Option<&mut T>, String> {
-        if matches!(self, Deferred::Empty) {
+        self.follow_catalogue();
+        if matches!(self.slot, Slot::Empty) {
+            self.revision = bv_core::registry::revision();
             let (tx, rx) = std::sync::mpsc::channel();
             let ctx2 = ctx.clone();
             let spawned = std::thread::Builder::new()
@@ -87,71 +130,90 @@ impl<T: Send + 'static> Deferred<T> {
                     let _ = tx.send(build());
                     ctx2.request_repaint();
                 });
-            *self = match spawned {
-                Ok(_) => Deferred::Building(rx),
-                Err(e) => Deferred::Failed(format!("cannot start a worker thread: {e}")),
+            self.slot = match spawned {
+                Ok(_) => Slot::Building(rx),
+                Err(e) => Slot::Failed(format!("cannot start a worker thread: {e}")),
             };
         }
-        if let Deferred::Building(rx) = self {
+        if let Slot::Building(rx) = &self.slot {
             match rx.try_recv() {
-                Ok(Ok(t)) => *self = Deferred::Ready(t),
-                Ok(Err(e)) => *self = Deferred::Failed(e),
-                Err(std::sync::mpsc::TryRecvError::Empty) => return Ok(None),
+                Ok(Ok(t)) => {
+                    self.slot = Slot::Ready(t);
+                    self.previous = None;
+                    self.generation += 1;
+                }
+                Ok(Err(e)) => self.slot = Slot::Failed(e),
+                Err(std::sync::mpsc::TryRecvError::Empty) => {}
                 Err(std::sync::mpsc::TryRecvError::Disconnected) => {
-                    *self = Deferred::Failed("the renderer build stopped".into())
+                    self.slot = Slot::Failed("the renderer build stopped".into())
                 }
             }
         }
-        match self {
-            Deferred::Ready(t) => Ok(Some(t)),
-            Deferred::Failed(e) => Err(e.clone()),
-            Deferred::Empty | Deferred::Building(_) => Ok(None),
+        match &mut self.slot {
+            Slot::Ready(t) => Ok(Some(t)),
+            Slot::Failed(e) => match &mut self.previous {
+                Some(t) => Ok(Some(t)),
+                None => Err(e.clone()),
+            },
+            Slot::Empty | Slot::Building(_) => Ok(self.previous.as_mut()),
         }
     }
 
     /// The value now: built on this thread if not asked for yet (or after a
-    /// failure), waited for if a worker is building it. For figures, which
-    /// are drawn in one go.
+    /// failure, or for a changed catalogue), waited for if a worker is
+    /// building it. For figures, which are drawn in one go.
     pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
-        if let Deferred::Building(rx) = self {
-            *self = match rx.recv() {
-                Ok(Ok(t)) => Deferred::Ready(t),
-                Ok(Err(e)) => Deferred::Failed(e),
-                Err(_) => Deferred::Empty,
+        self.follow_catalogue();
+        if let Slot::Building(rx) = &self.slot {
+            self.generation += 1;
+            self.slot = match rx.recv() {
+                Ok(Ok(t)) => Slot::Ready(t),
+                Ok(Err(e)) => Slot::Failed(e),
+                Err(_) => Slot::Empty,
             };
         }
-        if !matches!(self, Deferred::Ready(_)) {
-            *self = match build() {
-                Ok(t) => Deferred::Ready(t),
-                Err(e) => Deferred::Failed(e),
+        if !matches!(self.slot, Slot::Ready(_)) {
+            self.revision = bv_core::registry::revision();
+            self.generation += 1;
+            self.slot = match build() {
+                Ok(t) => Slot::Ready(t),
+                Err(e) => Slot::Failed(e),
             };
         }
-        match self {
-            Deferred::Ready(t) => Ok(t),
-            Deferred::Failed(e) => Err(e.clone()),
-            Deferred::Empty | Deferred::Building(_) => Err("no renderer".into()),
+        self.previous = None;
+        match &mut self.slot {
+            Slot::Ready(t) => Ok(t),
+            Slot::Failed(e) => Err(e.clone()),
+            Slot::Empty | Slot::Building(_) => Err("no renderer".into()),
         }
     }
 
-    /// The built value, if ready.
+    /// The built value, if ready (or the one drawn while rebuilding).
     pub fn ready(&self) -> Option<&T> {
-        match self {
-            Deferred::Ready(t) => Some(t),
-            _ => None,
+        match &self.slot {
+            Slot::Ready(t) => Some(t),
+            _ => self.previous.as_ref(),
         }
     }
 
-    /// The built value, if ready.
+    /// The built value, if ready (or the one drawn while rebuilding).
     pub fn ready_mut(&mut self) -> Option<&mut T> {
-        match self {
-            Deferred::Ready(t) => Some(t),
-            _ => None,
+        match &mut self.slot {
+            Slot::Ready(t) => Some(t),
+            _ => self.previous.as_mut(),
         }
+    }
+
+    /// Changes whenever another renderer becomes the one returned (a first
+    /// build, or a rebuild for a changed catalogue): what was drawn with the
+    /// one before must be drawn again.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// Whether it is being built.
     pub fn building(&self) -> bool {
-        matches!(self, Deferred::Building(_))
+        matches!(self.slot, Slot::Building(_))
     }
 }
 

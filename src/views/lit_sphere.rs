@@ -41,6 +41,8 @@ struct FrameKey {
     size: (u32, u32),
     /// Resolution relative to the view's pixels.
     scale: f32,
+    /// Which renderer drew it (a rebuilt one draws a reloaded model anew).
+    renderer: u64,
 }
 
 /// The lit sphere view.
@@ -131,6 +133,7 @@ impl LitSphereView {
                 .and_then(|mut lib| LitSphereRenderer::new(gpu, &mut lib))
                 .map_err(|e| format!("cannot build the lit sphere renderer: {e:#}"))
         };
+        let generation = self.renderer.generation();
         let built = if figure {
             self.renderer.now(build).map(Some)
         } else {
@@ -149,6 +152,7 @@ impl LitSphereView {
             settings,
             size,
             scale,
+            renderer: generation,
         };
         if self.drawn.as_ref() == Some(&key) {
             return self.image.current();

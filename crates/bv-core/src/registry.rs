@@ -8,7 +8,7 @@
 use crate::model::ModelInfo;
 use crate::{BvError, Result, models};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, LazyLock, RwLock};
+use std::sync::{Arc, LazyLock, OnceLock, RwLock};
 
 /// A snapshot of the catalogue.
 pub type Catalogue = Arc<Vec<&'static ModelInfo>>;
@@ -34,16 +34,36 @@ pub fn revision() -> u64 {
     REVISION.load(Ordering::Acquire)
 }
 
-/// The model with id `id`.
+/// Turns a name that no catalogue entry has as its id into a model, or says
+/// it is not one of its names (`Ok(None)`): the application installs one
+/// that opens user files by path (a name ending in `.brdf`), which bv-core
+/// cannot compile itself.
+pub type Resolver = fn(&str) -> Result<Option<&'static ModelInfo>>;
+
+static RESOLVER: OnceLock<Resolver> = OnceLock::new();
+
+/// Installs the [`Resolver`] every [`find`] falls back on. Only the first
+/// call installs one; returns whether this one did.
+pub fn set_resolver(resolver: Resolver) -> bool {
+    RESOLVER.set(resolver).is_ok()
+}
+
+/// The model with id `id`, or the model the installed [`Resolver`] makes of
+/// the name (a user file's path).
 pub fn find(id: &str) -> Result<&'static ModelInfo> {
     let c = catalogue();
-    c.iter()
-        .copied()
-        .find(|m| m.id == id)
-        .ok_or_else(|| BvError::UnknownModel {
-            id: id.to_string(),
-            known: c.iter().map(|m| m.id).collect::<Vec<_>>().join(", "),
-        })
+    if let Some(m) = c.iter().copied().find(|m| m.id == id) {
+        return Ok(m);
+    }
+    if let Some(resolve) = RESOLVER.get()
+        && let Some(m) = resolve(id)?
+    {
+        return Ok(m);
+    }
+    Err(BvError::UnknownModel {
+        id: id.to_string(),
+        known: c.iter().map(|m| m.id).collect::<Vec<_>>().join(", "),
+    })
 }
 
 /// Adds a model built at run time to the catalogue, or replaces the run-time
