@@ -93,6 +93,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
             scale,
             transparent: false,
             layout: FigureLayout::Screen,
+            caption: false,
         };
         let msg = v
             .export
@@ -120,6 +121,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
         scale: 2,
         transparent: false,
         layout: FigureLayout::Figure,
+        caption: false,
     };
     v.export
         .export_figure(
@@ -142,6 +144,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
         scale: 1,
         transparent: true,
         layout: FigureLayout::Figure,
+        caption: false,
     };
     v.export
         .export_figure(
@@ -170,6 +173,7 @@ fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
             scale: 1,
             transparent: false,
             layout: FigureLayout::Screen,
+            caption: false,
         };
         v.export
             .export_figure(

@@ -63,6 +63,8 @@ pub struct FigureSettings {
     pub transparent: bool,
     /// How a view's figure is laid out.
     pub layout: FigureLayout,
+    /// A caption under a view's figure (models, parameters, light).
+    pub caption: bool,
 }
 
 impl Default for FigureSettings {
@@ -73,6 +75,7 @@ impl Default for FigureSettings {
             scale: 2,
             transparent: false,
             layout: FigureLayout::Figure,
+            caption: false,
         }
     }
 }
@@ -292,6 +295,11 @@ impl ExportUi {
                             });
                             ui.end_row();
                         }
+                        if matches!(s.target, Target::View(_)) && s.format == Format::Png {
+                            ui.label("Caption");
+                            ui.checkbox(&mut s.caption, "models, parameters and θi under it");
+                            ui.end_row();
+                        }
                         if s.format != Format::Mesh {
                             ui.label("Background");
                             ui.checkbox(&mut s.transparent, "transparent");
@@ -400,6 +408,11 @@ impl ExportUi {
                 };
                 let mut off = self.offscreen()?;
                 let img = match entry {
+                    Some(e) if settings.caption => {
+                        let mut captioned = state.clone();
+                        captioned.display.caption = true;
+                        export::render_view(&mut off, &captioned, e, frame)?
+                    }
                     Some(e) => export::render_view(&mut off, state, e, frame)?,
                     None => export::render_window(&mut off, state, frame, window)?,
                 };

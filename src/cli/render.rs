@@ -118,6 +118,11 @@ pub struct RenderArgs {
     #[arg(long)]
     pub svg: bool,
 
+    /// Write a caption under each view's figure: every drawn BRDF with its
+    /// model and parameters, and the light's direction.
+    #[arg(long)]
+    pub caption: bool,
+
     /// Output file (or folder with --view all).
     #[arg(short, long, value_name = "PATH")]
     pub out: PathBuf,
@@ -218,6 +223,7 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
     }
     state.display.log |= a.log;
     state.display.cosine |= a.cosine;
+    state.display.caption |= a.caption;
     state.maximised = None;
     Ok(state.sanitised())
 }

@@ -83,6 +83,17 @@ pub fn render_view(
         } else {
             ui.visuals().panel_fill
         };
+        if state.display.caption {
+            egui::Panel::bottom("bv figure caption")
+                .frame(egui::Frame::NONE.fill(fill).inner_margin(FIGURE_MARGIN))
+                .show_separator_line(false)
+                .show(ui, |ui| {
+                    ui.label(
+                        egui::RichText::new(crate::session::naming::figure_caption(state))
+                            .color(crate::views::strong_text(ui)),
+                    );
+                });
+        }
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE.fill(fill).inner_margin(FIGURE_MARGIN))
             .show(ui, |ui| {

@@ -55,3 +55,100 @@ pub fn display_name(state: &AppState, e: &BrdfEntry) -> String {
         Some(k) => format!("{name} {}", k + 1),
     }
 }
+
+/// A figure's caption: one line per drawn BRDF (its name, its model when the
+/// name is not the model's, and the parameters that apply, in declaration
+/// order) and the light's direction.
+pub fn figure_caption(state: &AppState) -> String {
+    use bv_core::ParamValue;
+    use bv_core::text::fmt_deg;
+    // Four significant digits without trailing zeros ("0.15", not "0.1500").
+    let fmt_value = |x: f64| {
+        let s = bv_core::text::fmt_value(x);
+        if s.contains('.') && !s.contains('e') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    };
+    let value = |v: &ParamValue| match v {
+        ParamValue::Float(x) => fmt_value(*x),
+        ParamValue::Color([r, g, b]) if r == g && g == b => fmt_value(*r),
+        ParamValue::Color([r, g, b]) => {
+            format!("({}, {}, {})", fmt_value(*r), fmt_value(*g), fmt_value(*b))
+        }
+        ParamValue::Text(t) => std::path::Path::new(t)
+            .file_name()
+            .map_or_else(|| t.clone(), |f| f.to_string_lossy().into_owned()),
+        ParamValue::Bool(b) => if *b { "on" } else { "off" }.to_string(),
+        ParamValue::List(items) => format!("{} items", items.len()),
+        ParamValue::Components(c) => format!("{} components", c.len()),
+    };
+    let mut lines: Vec<String> = state
+        .brdfs
+        .iter()
+        .filter(|e| state.is_drawn(e))
+        .map(|e| {
+            let info = e.spec.model();
+            let name = display_name(state, e);
+            let params: Vec<String> = info
+                .params
+                .iter()
+                .filter(|d| d.applies_to(e.spec.params()))
+                .filter_map(|d| {
+                    let v = e.spec.params().get(d.id).ok()?;
+                    Some(format!("{} = {}", d.label, value(v)))
+                })
+                .collect();
+            let model = if name.starts_with(info.name) {
+                String::new()
+            } else {
+                format!(" ({})", info.name)
+            };
+            format!("{name}{model}: {}", params.join(", "))
+        })
+        .collect();
+    lines.push(format!(
+        "light at θi = {}°, φi = {}°",
+        fmt_deg(state.incident.theta_deg),
+        fmt_deg(state.incident.phi_deg)
+    ));
+    lines.join("\n")
+}
+
+#[cfg(test)]
+mod caption_tests {
+    use super::*;
+    use bv_core::ModelSpec;
+
+    #[test]
+    fn the_caption_names_models_parameters_and_the_light() {
+        let mut s = AppState::default();
+        s.add(
+            ModelSpec::from_json("lambert", &serde_json::json!({"albedo": [0.2, 0.4, 0.6]}))
+                .unwrap(),
+        );
+        s.add(
+            ModelSpec::from_json(
+                "cook-torrance",
+                &serde_json::json!({"alpha_x": 0.3, "alpha_y": 0.3, "fresnel": "conductor"}),
+            )
+            .unwrap(),
+        );
+        s.incident.theta_deg = 30.0;
+        let c = figure_caption(&s);
+        let lines: Vec<&str> = c.lines().collect();
+        assert_eq!(lines.len(), 3, "{c}");
+        assert!(
+            lines[0].starts_with("Lambert: ") && lines[0].contains("(0.2, 0.4, 0.6)"),
+            "{c}"
+        );
+        assert!(
+            lines[1].contains("Fresnel = conductor") && lines[1].contains("k = "),
+            "{c}"
+        );
+        // f0 does not apply to a conductor.
+        assert!(!lines[1].contains("F0"), "{c}");
+        assert_eq!(lines[2], "light at θi = 30°, φi = 0°");
+    }
+}

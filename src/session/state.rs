@@ -145,6 +145,10 @@ pub struct Display {
     /// anisotropic highlight turns with the surface; an isotropic one does
     /// not. Every view draws the turned surface.
     pub turn_deg: f64,
+    /// Figures of one view (the export dialog, `bv render --caption`) carry
+    /// a caption: each drawn BRDF with its model and parameters, and the
+    /// light's direction.
+    pub caption: bool,
 }
 
 impl Default for Display {
@@ -160,6 +164,7 @@ impl Default for Display {
             factor_overlay: false,
             factor_terms: 2,
             turn_deg: 0.0,
+            caption: false,
         }
     }
 }
