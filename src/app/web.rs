@@ -10,6 +10,10 @@
 //! clipboard; pasting another link into the same tab (only the fragment
 //! changes, so the page does not reload) opens its scene.
 //!
+//! A scene file (`.toml`) dropped on the page opens; *Save scene* downloads
+//! the current one. Other files (MERL tables, environment maps) are not read
+//! in the page yet: dropping one says so.
+//!
 //! If the browser takes the WebGPU device back (headless Chromium on a
 //! software adapter does so at the first present), the page notes it in the
 //! tab's session storage and reloads on WebGL2; `?webgl` in the address asks
@@ -19,6 +23,7 @@
 //! `bv: …` lines (`console.info`), never as errors.
 
 use super::{BvApp, STORAGE_KEY, Viewer};
+use crate::session::scene_file::{self, Builds};
 use crate::session::{AppState, link, platform};
 use eframe::egui;
 use std::sync::{Arc, Mutex};
@@ -125,6 +130,32 @@ struct WebApp {
     reported: bool,
     /// Whether the device is the browser's WebGPU (a loss reloads on WebGL2).
     webgpu: bool,
+    /// Dropped files being read (the browser reads them asynchronously).
+    reads: Vec<std::sync::mpsc::Receiver<DroppedRead>>,
+}
+
+/// A dropped file's name and its bytes, or why they could not be read.
+type DroppedRead = (String, Result<Vec<u8>, String>);
+
+/// Offers `bytes` to the user as a download named `name`.
+fn download(name: &str, mime: &str, bytes: &[u8]) -> Result<(), String> {
+    let js = |e: wasm_bindgen::JsValue| format!("{e:?}");
+    let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
+    let options = web_sys::BlobPropertyBag::new();
+    options.set_type(mime);
+    let blob =
+        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(js)?;
+    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(js)?;
+    let anchor = document()
+        .ok_or("no document")?
+        .create_element("a")
+        .map_err(js)?
+        .dyn_into::<web_sys::HtmlAnchorElement>()
+        .map_err(|_| "not an anchor".to_string())?;
+    anchor.set_href(&url);
+    anchor.set_download(name);
+    anchor.click();
+    web_sys::Url::revoke_object_url(&url).map_err(js)
 }
 
 /// The state of a link's fragment, or the default scene and a message.
@@ -202,6 +233,7 @@ impl WebApp {
             copied: None,
             reported: false,
             webgpu,
+            reads: Vec::new(),
         }
     }
 
@@ -243,6 +275,64 @@ impl WebApp {
         }
     }
 
+    /// Takes the files dropped on the page before the viewer sees them (it
+    /// would look for them on a disk the page does not have) and starts
+    /// reading them; opens the scene files that have been read.
+    fn dropped(&mut self, ctx: &egui::Context) {
+        let files = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
+        for f in files {
+            let (tx, rx) = std::sync::mpsc::channel();
+            let ctx2 = ctx.clone();
+            wasm_bindgen_futures::spawn_local(async move {
+                let name = f.path().display().to_string();
+                let bytes = f.bytes_async().await;
+                let _ = tx.send((name, bytes));
+                ctx2.request_repaint();
+            });
+            self.reads.push(rx);
+        }
+        let mut read = Vec::new();
+        self.reads.retain(|rx| match rx.try_recv() {
+            Ok(r) => {
+                read.push(r);
+                false
+            }
+            Err(std::sync::mpsc::TryRecvError::Empty) => true,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => false,
+        });
+        for (name, bytes) in read {
+            if !name.ends_with(&format!(".{}", scene_file::EXTENSION)) {
+                self.message = Some(format!(
+                    "{name}: the page opens scene files (.{}) only; MERL tables and \
+                     environment maps need the desktop bv for now",
+                    scene_file::EXTENSION
+                ));
+                continue;
+            }
+            let opened = bytes.and_then(scene_file::utf8_text).and_then(|t| {
+                scene_file::from_toml_in(&t, None, Builds::Warn).map_err(|e| e.to_string())
+            });
+            match opened {
+                Ok(loaded) => {
+                    info(&format!("opened the scene file {name}"));
+                    self.inner.viewer.replace_state(loaded.state);
+                    self.message = (!loaded.warnings.is_empty())
+                        .then(|| format!("{name}:\n{}", loaded.warnings.join("\n")));
+                }
+                Err(e) => self.message = Some(format!("{name}: {e}")),
+            }
+        }
+    }
+
+    fn save_scene(&mut self) {
+        let saved = scene_file::to_toml(self.inner.viewer.state())
+            .map_err(|e| e.to_string())
+            .and_then(|t| download("bv-scene.toml", "application/toml", t.as_bytes()));
+        if let Err(e) = saved {
+            self.message = Some(format!("The scene could not be saved: {e}"));
+        }
+    }
+
     fn overlay(&mut self, ctx: &egui::Context) {
         let recent = self
             .copied
@@ -251,14 +341,25 @@ impl WebApp {
             .anchor(egui::Align2::RIGHT_BOTTOM, egui::vec2(-8.0, -8.0))
             .order(egui::Order::Foreground)
             .show(ctx, |ui| {
-                let label = if recent { "Link copied" } else { "Copy link" };
-                if ui
-                    .add(egui::Button::new(label).wrap_mode(egui::TextWrapMode::Extend))
-                    .on_hover_text("Put this scene into the address bar and on the clipboard")
-                    .clicked()
-                {
-                    self.copy_link(ctx);
-                }
+                ui.horizontal(|ui| {
+                    if ui
+                        .add(egui::Button::new("Save scene").wrap_mode(egui::TextWrapMode::Extend))
+                        .on_hover_text(
+                            "Download this scene as a scene file (drop one on the page to open it)",
+                        )
+                        .clicked()
+                    {
+                        self.save_scene();
+                    }
+                    let label = if recent { "Link copied" } else { "Copy link" };
+                    if ui
+                        .add(egui::Button::new(label).wrap_mode(egui::TextWrapMode::Extend))
+                        .on_hover_text("Put this scene into the address bar and on the clipboard")
+                        .clicked()
+                    {
+                        self.copy_link(ctx);
+                    }
+                });
             });
         if recent {
             ctx.request_repaint_after(Duration::from_millis(250));
@@ -303,6 +404,7 @@ impl eframe::App for WebApp {
             }
         }
         self.follow_hash();
+        self.dropped(&ctx);
         // Work the desktop runs on threads runs here between frames; the
         // rest of each frame keeps the page answering meanwhile.
         if platform::run_pending(Duration::from_millis(30)) {
