@@ -323,6 +323,26 @@ async function webgpuChecks(context, base) {
     await p.page.close();
   }
 
+  // A scene file dropped on the page opens.
+  {
+    const p = await open(context, gl, "a page a scene file is dropped on");
+    const dt = await p.page.evaluateHandle((text) => {
+      const d = new DataTransfer();
+      d.items.add(new File([text], "dropped.toml", { type: "application/toml" }));
+      return d;
+    }, withMaximised(toml, "polar"));
+    await p.page.dispatchEvent("#bv_canvas", "dragover", { dataTransfer: dt });
+    await p.page.dispatchEvent("#bv_canvas", "drop", { dataTransfer: dt });
+    for (let i = 0; i < 100 && !p.log.some((l) => l.startsWith("bv: opened the scene file")); i++) {
+      await p.page.waitForTimeout(50);
+    }
+    check(p.log.some((l) => l === "bv: opened the scene file dropped.toml"), "a dropped scene file opens");
+    await p.page.waitForTimeout(SETTLE_MS);
+    notBlank(await shot(p.page, "webgpu-dropped-scene"), "the dropped scene");
+    noErrors(p, "a page a scene file is dropped on");
+    await p.page.close();
+  }
+
   // The session persists: a page without a link starts from the stored
   // state (θi as dragged; the views' pages above saved theirs meanwhile).
   {
