@@ -9,6 +9,9 @@
 BV_RUN_PACKAGES=(libvulkan1 mesa-vulkan-drivers libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 # Tests: also a virtual X server and screenshots (ImageMagick's `import`).
 BV_CI_PACKAGES=("${BV_RUN_PACKAGES[@]}" xvfb xauth imagemagick)
+# The web build's test: a headless browser and Node.js for its driver
+# (playwright-core, from npm, pinned in web/package-lock.json).
+BV_WEB_PACKAGES=(chromium nodejs npm)
 
 bv_log() { printf '==> %s\n' "$*" >&2; }
 bv_warn() { printf 'warning: %s\n' "$*" >&2; }

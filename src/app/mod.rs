@@ -17,6 +17,8 @@ pub mod presets_ui;
 pub mod screenshot;
 pub mod shortcuts;
 pub mod viewer;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 pub use viewer::Viewer;
 
@@ -28,22 +30,30 @@ pub const SHELL: crate::cli::Shell = crate::cli::Shell {
     slide: viewer::slide_window,
 };
 
-use crate::cli::viewer_args::{ViewerArgs, parse_size};
+use crate::cli::viewer_args::ViewerArgs;
+#[cfg(not(target_arch = "wasm32"))]
+use crate::cli::viewer_args::parse_size;
+#[cfg(not(target_arch = "wasm32"))]
+use crate::session::AppState;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::session::scene_file as scene;
-use crate::session::{AppState, Command, state};
+use crate::session::{Command, state};
 
+#[cfg(not(target_arch = "wasm32"))]
 use crate::gpu::errors::no_gpu_message;
+use crate::session::platform::Instant;
 use anyhow::{Context as _, bail};
 use bv_core::{ParamKind, ParamValue};
 use eframe::egui;
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Key of the saved state in eframe's storage.
 pub const STORAGE_KEY: &str = "bv-state";
 
 /// The state the window starts with.
+#[cfg(not(target_arch = "wasm32"))]
 fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppState> {
     let mut state = if let Some(path) = &args.scene {
         let loaded = scene::load(path).with_context(|| format!("opening {}", path.display()))?;
@@ -86,7 +96,16 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
     Ok(state.sanitised())
 }
 
+/// The viewer window of a desktop build; a page starts the viewer from
+/// [`web`] instead, and has no command line to ask for a window.
+#[cfg(target_arch = "wasm32")]
+pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
+    let _ = args;
+    bail!("in a browser the viewer starts with the page")
+}
+
 /// Opens the viewer window and returns when it is closed.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
     // Validate `--model` before a window opens (and before the size, which
     // the smoke script relies on to probe the catalogue).
@@ -303,6 +322,7 @@ struct Bench {
 }
 
 impl Bench {
+    #[cfg(not(target_arch = "wasm32"))]
     fn new(frames: usize, adapter: String) -> Self {
         Self {
             adapter,
@@ -435,6 +455,7 @@ impl Shot {
     /// converging on a software renderer).
     const MAX_BUSY: Duration = Duration::from_secs(40);
 
+    #[cfg(not(target_arch = "wasm32"))]
     fn new(path: PathBuf) -> Self {
         Self {
             path,

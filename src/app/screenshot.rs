@@ -9,13 +9,14 @@
 //! pixels per point: a 4× PNG is drawn at 4×, not upscaled.
 
 use crate::export::{self, Offscreen};
+use crate::session::platform::Instant;
 use crate::session::scene_file as scene;
 use crate::session::state::AppState;
 use crate::views::REGISTRY;
 use crate::widgets::files::{self, Files, Filter};
 use eframe::egui::{self, Align2, RichText};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// How long a toast stays.
 pub const TOAST_TIME: Duration = Duration::from_secs(6);

@@ -89,6 +89,9 @@ impl Offscreen {
         );
         Self {
             rs: egui_wgpu::RenderState {
+                // egui-wgpu lists the adapters only where it can enumerate
+                // them (not in a browser).
+                #[cfg(not(target_arch = "wasm32"))]
                 available_adapters: vec![adapter.clone()],
                 adapter,
                 instance,

@@ -165,13 +165,7 @@ impl Gpu {
     /// A buffer holding `contents` (the per-frame parameter, tile and uniform
     /// buffers of every renderer are made this way).
     pub fn buffer(&self, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
-        use wgpu::util::DeviceExt;
-        self.device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
+        buffer_init(&self.device, &self.queue, label, contents, usage)
     }
 
     /// Reads an `Rgba8Unorm` texture (with `COPY_SRC`) back as an image
@@ -241,5 +235,45 @@ impl Target {
             *slot = Some(Target::new(gpu, width, height)?);
         }
         slot.as_ref().context("target")
+    }
+}
+
+/// A buffer of `device` holding `contents`. On the desktop it is mapped at
+/// creation (wgpu's `create_buffer_init`). In a browser a buffer mapped at
+/// creation throws once the page's GPU device is lost, and wgpu's web
+/// backend turns that into a panic; a plain buffer written through the queue
+/// only records an error there, so the page shows the loss instead.
+pub fn buffer_init(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        use wgpu::util::DeviceExt;
+        let _ = queue;
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents,
+            usage,
+        })
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        // Writes through the queue come in multiples of four bytes.
+        let align = wgpu::COPY_BUFFER_ALIGNMENT as usize;
+        let size = contents.len().max(1).div_ceil(align) * align;
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size as u64,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut padded = contents.to_vec();
+        padded.resize(size, 0);
+        queue.write_buffer(&buffer, 0, &padded);
+        buffer
     }
 }

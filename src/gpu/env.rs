@@ -14,7 +14,6 @@ use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use anyhow::{Context, Result, bail};
 use bv_core::ModelSpec;
-use wgpu::util::DeviceExt;
 
 pub use super::envmap::{EnvironmentMap, MAX_ENV_SIDE, STUDIO_HDR};
 
@@ -315,13 +314,11 @@ impl EnvRenderer {
             "use a smaller map",
         )?;
         let buffer = gpu.scoped(&format!("uploading {what}"), || {
-            Ok(gpu
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("env data"),
-                    contents: bytemuck::cast_slice(&data),
-                    usage: wgpu::BufferUsages::STORAGE,
-                }))
+            Ok(gpu.buffer(
+                "env data",
+                bytemuck::cast_slice(&data),
+                wgpu::BufferUsages::STORAGE,
+            ))
         })?;
         Ok(EnvBuffers {
             data: buffer,
@@ -715,11 +712,9 @@ impl EnvRenderer {
                     y0: band.y0,
                     pad: [0; 3],
                 };
-                let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("show"),
-                    contents: bytemuck::bytes_of(&u),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                let ubuf =
+                    self.gpu
+                        .buffer("show", bytemuck::bytes_of(&u), wgpu::BufferUsages::UNIFORM);
                 let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("env display"),
                     layout: &layout,

@@ -18,7 +18,7 @@
 //! [`no_gpu_message`] is what a user is told when no adapter can be opened
 //! (by the window or by a headless device).
 
-use anyhow::{Result, anyhow, bail};
+use anyhow::{Result, bail};
 use std::collections::HashMap;
 use std::hash::{Hash, Hasher};
 use std::sync::{Arc, Mutex, OnceLock};
@@ -116,6 +116,7 @@ pub fn describe(e: &wgpu::Error) -> String {
 ///
 /// Scopes are per thread: the GPU calls must be made by `work` on this
 /// thread.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn scoped<T>(device: &wgpu::Device, what: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
     let oom = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
     let validation = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -128,9 +129,19 @@ pub fn scoped<T>(device: &wgpu::Device, what: &str, work: impl FnOnce() -> Resul
         pollster::block_on(oom.pop()),
     ];
     if let Some(e) = errors.into_iter().flatten().next() {
-        return Err(anyhow!("{what}: GPU error: {}", describe(&e)));
+        return Err(anyhow::anyhow!("{what}: GPU error: {}", describe(&e)));
     }
     result
+}
+
+/// Runs `work`. In a browser an error scope's answer is a promise that only
+/// settles once this frame has returned to the page, so it cannot be waited
+/// for here: errors reach the device's uncaptured-error handler ([`watch`])
+/// instead, which records them for the views to show.
+#[cfg(target_arch = "wasm32")]
+pub fn scoped<T>(device: &wgpu::Device, what: &str, work: impl FnOnce() -> Result<T>) -> Result<T> {
+    let _ = (device, what);
+    work()
 }
 
 /// What to tell a user whose machine has no GPU adapter wgpu can use.

@@ -13,11 +13,12 @@
 //! nothing: its message goes to an error dialog, and everything already
 //! loaded stays as it was.
 
+use super::platform::{self, Instant};
 use bv_core::model::{FileData, FileFormat, ModelInfo};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, mpsc};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// The catalogue's file-backed model that reads `path`, with its file
 /// parameter's id and format: the first whose format lists the file's
@@ -124,22 +125,20 @@ impl Loader {
         let (tx, rx) = mpsc::channel();
         let (r, t, d, p) = (read.clone(), total.clone(), done.clone(), path.clone());
         let tx2 = tx.clone();
-        let spawned = std::thread::Builder::new()
-            .name("bv load".into())
-            .spawn(move || {
-                let result = match file_model_for(&p) {
-                    Some((_, _, format)) => format
-                        .load(&p, &mut |a, b| {
-                            t.store(b, Ordering::Relaxed);
-                            r.store(a, Ordering::Relaxed);
-                        })
-                        .map_err(|e| e.to_string()),
-                    None => Err("no model of this bv reads files".to_string()),
-                };
-                // The receiver is gone only if the viewer closed meanwhile.
-                let _ = tx.send(result);
-                d.store(true, Ordering::Release);
-            });
+        let spawned = platform::spawn("bv load", move || {
+            let result = match file_model_for(&p) {
+                Some((_, _, format)) => format
+                    .load(&p, &mut |a, b| {
+                        t.store(b, Ordering::Relaxed);
+                        r.store(a, Ordering::Relaxed);
+                    })
+                    .map_err(|e| e.to_string()),
+                None => Err("no model of this bv reads files".to_string()),
+            };
+            // The receiver is gone only if the viewer closed meanwhile.
+            let _ = tx.send(result);
+            d.store(true, Ordering::Release);
+        });
         if let Err(e) = spawned {
             // No thread: report it like a failed read.
             let _ = tx2.send(Err(format!("cannot start a reading thread: {e}")));

@@ -3,8 +3,10 @@
 //! change it ([`command`]), the evaluators built from it ([`runtime`]), the
 //! background reads of file-backed models ([`loader`]), the scene file format
 //! ([`scene_file`]) and lecture decks of scenes ([`deck`]), presentation
-//! mode's sizes ([`presentation`]), user BRDF files ([`user_models`]), the names of BRDFs ([`naming`]) and of views ([`views`]),
-//! and the per-frame scene every view reads ([`frame`]).
+//! mode's sizes ([`presentation`]), user BRDF files ([`user_models`]), the
+//! names of BRDFs ([`naming`]) and of views ([`views`]), the per-frame scene
+//! every view reads ([`frame`]), what differs in a browser ([`platform`]) and
+//! the scene as a link ([`link`]).
 //!
 //! Nothing here draws: no egui, no wgpu. The window (`app`), the views, the
 //! figure export and the command line all build on this layer, and it imports
@@ -14,8 +16,10 @@ pub mod command;
 pub mod deck;
 pub mod frame;
 pub mod lighting;
+pub mod link;
 pub mod loader;
 pub mod naming;
+pub mod platform;
 pub mod presentation;
 pub mod runtime;
 pub mod scene_file;

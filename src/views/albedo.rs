@@ -181,19 +181,17 @@ fn start(key: &Key, brdf: Arc<dyn Brdf>, phi_i: f64, ctx: &egui::Context) -> Arc
         },
     );
     let (p, k, ctx) = (progress.clone(), key.clone(), ctx.clone());
-    let spawned = std::thread::Builder::new()
-        .name("bv albedo".into())
-        .spawn(move || {
-            match AlbedoData::compute(brdf.as_ref(), phi_i, &p, &cancel) {
-                Some(d) => store(k, Arc::new(d)),
-                None => {
-                    if let Ok(mut c) = CACHE.lock() {
-                        c.running.remove(&k);
-                    }
+    let spawned = crate::session::platform::spawn("bv albedo", move || {
+        match AlbedoData::compute(brdf.as_ref(), phi_i, &p, &cancel) {
+            Some(d) => store(k, Arc::new(d)),
+            None => {
+                if let Ok(mut c) = CACHE.lock() {
+                    c.running.remove(&k);
                 }
             }
-            ctx.request_repaint();
-        });
+        }
+        ctx.request_repaint();
+    });
     if spawned.is_err() {
         c.running.remove(key);
     }

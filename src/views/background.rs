@@ -10,10 +10,11 @@
 //! (the 3D lobe and the polar plot) asking for the same key share one job and
 //! one result without any other plumbing.
 
+use crate::session::platform::{self, Instant};
 use eframe::egui;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 type Job<V> = Box<dyn FnOnce() -> V + Send>;
 
@@ -219,11 +220,7 @@ where
                 me.spawn(slot, k, j, notify);
             }
         };
-        if std::thread::Builder::new()
-            .name("bv compute".into())
-            .spawn(run)
-            .is_err()
-        {
+        if platform::spawn("bv compute", run).is_err() {
             // No thread to be had: forget the job rather than block the UI.
             let mut g = self.lock();
             if let Some(s) = g.slots.get_mut(&slot) {

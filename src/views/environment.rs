@@ -20,12 +20,12 @@ use super::{Scene, View};
 use crate::gpu::{EnvRenderer, EnvSettings, EnvironmentMap};
 use crate::session::command::Command;
 use crate::session::lighting::{EnvObject, EnvView, MAX_TARGET_SPP};
+use crate::session::platform::Instant;
 use crate::widgets::files::{Files, Filter};
 use bv_core::ModelSpec;
 use eframe::egui::{self, Align2, Color32, Rect, Sense, Ui, Vec2};
 use std::path::PathBuf;
 use std::sync::mpsc;
-use std::time::Instant;
 
 /// Largest pass (samples per pixel per frame).
 pub const MAX_PASS_SPP: u32 = 64;
@@ -284,13 +284,11 @@ impl EnvironmentView {
                     let (tx, rx) = mpsc::channel();
                     let p = PathBuf::from(path);
                     let ctx2 = ctx.clone();
-                    let spawned = std::thread::Builder::new()
-                        .name("bv env load".into())
-                        .spawn(move || {
-                            // The receiver may be gone (another map asked for).
-                            let _ = tx.send(EnvironmentMap::load(&p));
-                            ctx2.request_repaint();
-                        });
+                    let spawned = crate::session::platform::spawn("bv env load", move || {
+                        // The receiver may be gone (another map asked for).
+                        let _ = tx.send(EnvironmentMap::load(&p));
+                        ctx2.request_repaint();
+                    });
                     match spawned {
                         Ok(_) => {
                             self.loading = Some(Loading {
@@ -692,11 +690,11 @@ impl View for EnvironmentView {
                 .any(|f| f.path.as_deref().is_some_and(is_environment_file))
         });
 
-        if gpu_image::render_state(ui.ctx()).is_none() {
+        if let Some(why) = gpu_image::unavailable(ui.ctx(), "The environment view") {
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
-                "The environment view needs the wgpu renderer",
+                why,
                 egui::FontId::proportional(14.0),
                 weak,
             );

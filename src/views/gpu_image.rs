@@ -23,10 +23,63 @@ fn key() -> egui::Id {
     egui::Id::unique("bv wgpu render state")
 }
 
+fn lost_key() -> egui::Id {
+    egui::Id::unique("bv wgpu device lost")
+}
+
+/// Why the device was lost, once it was (shared with its lost callback).
+type Lost = std::sync::Arc<std::sync::Mutex<Option<String>>>;
+
 /// Makes egui's render state (device, queue, renderer) available to the
-/// rendered views of `ctx`.
+/// rendered views of `ctx`, and notes when its device is lost (a browser
+/// may take it back, e.g. when its GPU process restarts; every later buffer
+/// the views create would then fail).
 pub fn install(ctx: &egui::Context, render_state: &RenderState) {
-    ctx.data_mut(|d| d.insert_temp(key(), render_state.clone()));
+    let lost: Lost = Default::default();
+    let sink = lost.clone();
+    let ctx2 = ctx.clone();
+    render_state
+        .device
+        .set_device_lost_callback(move |reason, message| {
+            // Dropping the device at exit reports a loss too: not news.
+            if reason != wgpu::DeviceLostReason::Destroyed || crate::session::platform::WEB {
+                if let Ok(mut l) = sink.lock() {
+                    *l = Some(format!("{reason:?}: {message}"));
+                }
+                ctx2.request_repaint();
+            }
+        });
+    ctx.data_mut(|d| {
+        d.insert_temp(key(), render_state.clone());
+        d.insert_temp(lost_key(), lost);
+    });
+}
+
+/// Why a rendered view (`what`, e.g. "The lit sphere") cannot draw here, if
+/// it cannot: no wgpu renderer, a device that was lost, or a device without
+/// storage buffers (a browser's WebGL2, which the parameter tables and the
+/// environment's sampling need).
+pub fn unavailable(ctx: &egui::Context, what: &str) -> Option<String> {
+    let Some(rs) = render_state(ctx) else {
+        return Some(format!("{what} needs the wgpu renderer"));
+    };
+    if let Some(why) = device_lost(ctx) {
+        return Some(format!(
+            "{what} cannot draw: the GPU device was lost ({why}); reload the page"
+        ));
+    }
+    if rs.device.limits().max_storage_buffers_per_shader_stage == 0 {
+        return Some(format!(
+            "{what} needs WebGPU\n(storage buffers); this\nbrowser gave WebGL2 only"
+        ));
+    }
+    None
+}
+
+/// Why the device of `ctx`'s render state was lost, if it was.
+pub fn device_lost(ctx: &egui::Context) -> Option<String> {
+    let lost: Option<Lost> = ctx.data(|d| d.get_temp(lost_key()));
+    lost.and_then(|l| l.lock().ok().and_then(|g| g.clone()))
 }
 
 /// The render state [`install`]ed into `ctx`, if any.
@@ -123,13 +176,11 @@ impl<T: Send + 'static> Deferred<T> {
             self.revision = bv_core::registry::revision();
             let (tx, rx) = std::sync::mpsc::channel();
             let ctx2 = ctx.clone();
-            let spawned = std::thread::Builder::new()
-                .name("bv renderer build".into())
-                .spawn(move || {
-                    // The receiver is gone only if the view was dropped.
-                    let _ = tx.send(build());
-                    ctx2.request_repaint();
-                });
+            let spawned = crate::session::platform::spawn("bv renderer build", move || {
+                // The receiver is gone only if the view was dropped.
+                let _ = tx.send(build());
+                ctx2.request_repaint();
+            });
             self.slot = match spawned {
                 Ok(_) => Slot::Building(rx),
                 Err(e) => Slot::Failed(format!("cannot start a worker thread: {e}")),

@@ -16,6 +16,7 @@
 use super::BrdfColor as _;
 use super::{Scene, View, curves};
 use crate::session::command::Command;
+use crate::session::platform::Instant;
 use bv_core::{Brdf, Rgb, frame};
 use eframe::egui::{
     self, Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Role, Sense, Stroke,
@@ -25,7 +26,6 @@ use rayon::prelude::*;
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// Slice resolution at rest (θh columns, θd rows).
 pub const IDLE_RESOLUTION: usize = 256;

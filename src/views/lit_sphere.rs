@@ -23,11 +23,11 @@ use crate::gpu::sphere::{light_from_drag, sphere_at};
 use crate::gpu::{LitSphereRenderer, LitSphereSettings};
 use crate::session::command::Command;
 use crate::session::lighting::{BackgroundChoice, EV_RANGE, LitView, Tone};
+use crate::session::platform::Instant;
 use crate::session::state::Incident;
 use bv_core::ModelSpec;
 use eframe::egui::{self, Align2, Color32, Rect, Sense, Stroke, Ui, Vec2};
 use glam::{DVec2, DVec3};
-use std::time::Instant;
 
 /// Resolution of the image while a pointer button is held, on a software
 /// renderer (relative to the view's pixels).
@@ -221,11 +221,11 @@ impl View for LitSphereView {
         let (drawables, mut errors) =
             gpu_image::drawables(scene, lit.side_by_side, &mut self.pack_check);
         self.tiles = drawables.len();
-        if gpu_image::render_state(ui.ctx()).is_none() {
+        if let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
-                "The lit sphere needs the wgpu renderer",
+                why,
                 egui::FontId::proportional(14.0),
                 weak,
             );

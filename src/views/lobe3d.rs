@@ -644,14 +644,28 @@ impl View for Lobe3dView {
         self.set_sh(sh_overlay::request(ui.ctx(), scene));
         self.set_factor(factor_overlay::request(ui.ctx(), scene));
         let frame = self.frame(scene, rect.size(), bg, dark);
-        ui.painter().add(
-            LobeCallback {
-                view: self.key,
-                rect,
-                frame: frame.clone(),
-            }
-            .shape(),
-        );
+        // A lost device (a browser took it back) fails every buffer the
+        // renderer would create: say so instead of drawing.
+        if let Some(why) = super::gpu_image::device_lost(ui.ctx()) {
+            ui.painter().text(
+                rect.center(),
+                egui::Align2::CENTER_CENTER,
+                format!(
+                    "The 3D lobe cannot draw: the GPU device was lost ({why});\nreload the page"
+                ),
+                egui::FontId::proportional(14.0),
+                ui.visuals().weak_text_color(),
+            );
+        } else {
+            ui.painter().add(
+                LobeCallback {
+                    view: self.key,
+                    rect,
+                    frame: frame.clone(),
+                }
+                .shape(),
+            );
+        }
 
         // The frame's camera, with the viewport in points that projecting
         // labels and pointer rays needs.

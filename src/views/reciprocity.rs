@@ -15,6 +15,7 @@
 use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
 use crate::session::command::Command;
+use crate::session::platform::Instant;
 use bv_core::analysis::reciprocity_map::{ReciprocityMap, hemisphere_to_disc, reciprocity_map};
 use eframe::egui::{
     self, Align2, Color32, ColorImage, FontId, Pos2, Rect, Sense, Stroke, TextureHandle,
@@ -22,7 +23,7 @@ use eframe::egui::{
 };
 use glam::DVec3;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Map resolution in the window (pixels per side): 16 384 pairs, a few
 /// milliseconds for an analytic model.

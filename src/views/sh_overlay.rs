@@ -160,7 +160,7 @@ pub fn request(ctx: &egui::Context, scene: &Scene<'_>) -> Option<ShDone> {
         if let Some(d) = slots.latest(id).filter(|d| d.key == key) {
             return Some(d);
         }
-        let t0 = std::time::Instant::now();
+        let t0 = crate::session::platform::Instant::now();
         let v = compute(brdf.as_ref(), id, key);
         return Some(slots.insert(id, key, v, t0.elapsed()));
     }

@@ -2,8 +2,8 @@
 //! a [`LobeMesh`], and the uniform of its style.
 
 use super::frame::{MeshDraw, StyleUniform};
+use crate::gpu::context::buffer_init;
 use bv_core::lobe::LobeMesh;
-use wgpu::util::DeviceExt as _;
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -51,6 +51,7 @@ pub fn wire_indices(mesh: &LobeMesh) -> Vec<u32> {
 
 pub(super) fn upload_mesh(
     device: &wgpu::Device,
+    queue: &wgpu::Queue,
     style_layout: &wgpu::BindGroupLayout,
     d: &MeshDraw,
 ) -> GpuMesh {
@@ -83,26 +84,34 @@ pub(super) fn upload_mesh(
     };
     let wire = wire_indices(m);
     let wire = if wire.is_empty() { vec![0u32; 2] } else { wire };
-    let vb = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bv lobe vertices"),
-        contents: bytemuck::cast_slice(&vertices),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let ib = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bv lobe indices"),
-        contents: bytemuck::cast_slice(&indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    let wb = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bv lobe wire indices"),
-        contents: bytemuck::cast_slice(&wire),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    let style = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bv lobe style"),
-        contents: bytemuck::bytes_of(&StyleUniform::new(&d.style)),
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-    });
+    let vb = buffer_init(
+        device,
+        queue,
+        "bv lobe vertices",
+        bytemuck::cast_slice(&vertices),
+        wgpu::BufferUsages::VERTEX,
+    );
+    let ib = buffer_init(
+        device,
+        queue,
+        "bv lobe indices",
+        bytemuck::cast_slice(&indices),
+        wgpu::BufferUsages::INDEX,
+    );
+    let wb = buffer_init(
+        device,
+        queue,
+        "bv lobe wire indices",
+        bytemuck::cast_slice(&wire),
+        wgpu::BufferUsages::INDEX,
+    );
+    let style = buffer_init(
+        device,
+        queue,
+        "bv lobe style",
+        bytemuck::bytes_of(&StyleUniform::new(&d.style)),
+        wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+    );
     let style_bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("bv lobe style"),
         layout: style_layout,

@@ -188,7 +188,7 @@ impl LobeRenderer {
                 .is_none_or(|g| g.revision != d.revision);
             if stale {
                 vr.meshes
-                    .insert(d.key, upload_mesh(device, style_layout, d));
+                    .insert(d.key, upload_mesh(device, queue, style_layout, d));
             }
             if let Some(g) = vr.meshes.get_mut(&d.key) {
                 g.used = true;

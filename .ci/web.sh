@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The browser build's check: installs what a fresh Debian machine lacks
+# (chromium, Node.js and npm; the wasm32 target and wasm-bindgen-cli come
+# with web/build.sh), builds the bundle in the dev profile (quicker to build;
+# the page is the same), installs the pinned test driver and runs the
+# headless-browser test. Screenshots are left in web/shots for a human.
+#
+#   bash .ci/web.sh
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+# shellcheck source=.ci/deps.sh
+. .ci/deps.sh
+
+bv_apt_install "${BV_WEB_PACKAGES[@]}"
+bv_ensure_rust
+BV_WEB_PROFILE=${BV_WEB_PROFILE:-dev} bash web/build.sh
+npm ci --prefix web --no-audit --no-fund
+# Chromium and Mesa want a private runtime directory (see .ci/run).
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+    XDG_RUNTIME_DIR=$(mktemp -d)
+    chmod 700 "$XDG_RUNTIME_DIR"
+    export XDG_RUNTIME_DIR
+fi
+node web/test.mjs
