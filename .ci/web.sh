@@ -13,7 +13,13 @@ cd "$root"
 # shellcheck source=.ci/deps.sh
 . .ci/deps.sh
 
-bv_apt_install "${BV_WEB_PACKAGES[@]}"
+# Node.js and npm may come from elsewhere (NodeSource's nodejs carries its
+# own npm and conflicts with Debian's npm package): only what is missing as a
+# command is installed.
+web_packages=(chromium)
+command -v node >/dev/null 2>&1 || web_packages+=(nodejs)
+command -v npm >/dev/null 2>&1 || web_packages+=(npm)
+bv_apt_install "${web_packages[@]}"
 bv_ensure_rust
 BV_WEB_PROFILE=${BV_WEB_PROFILE:-dev} bash web/build.sh
 npm ci --prefix web --no-audit --no-fund

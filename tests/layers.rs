@@ -209,3 +209,30 @@ fn no_view_export_or_cli_code_names_a_model() {
         hits.join("\n")
     );
 }
+
+/// The browser has no `std::time::Instant` (calling it panics there): code
+/// that the web build runs takes its clock from `session::platform`. The
+/// command line (desktop only) and the platform module itself may use std's.
+#[test]
+fn code_the_browser_runs_takes_its_clock_from_the_platform_module() {
+    let mut files = Vec::new();
+    rust_files(Path::new("src"), &mut files);
+    let mut offenders = Vec::new();
+    for f in files {
+        let p = f.to_string_lossy().replace('\\', "/");
+        if p.starts_with("src/cli/") || p == "src/session/platform.rs" {
+            continue;
+        }
+        let code = without_comments(&std::fs::read_to_string(&f).unwrap());
+        let std_instant = code.contains("std::time::Instant")
+            || code.split("use std::time::{").skip(1).any(|rest| {
+                rest.split('}')
+                    .next()
+                    .is_some_and(|l| l.contains("Instant"))
+            });
+        if std_instant {
+            offenders.push(p);
+        }
+    }
+    assert!(offenders.is_empty(), "std::time::Instant in {offenders:?}");
+}

@@ -167,6 +167,10 @@ function viewIds() {
 // ---- a page of the viewer ----
 async function open(context, url, what) {
   const page = await context.newPage();
+  // Whole stacks in panic messages (Chromium keeps 10 frames by default).
+  await page.addInitScript(() => {
+    Error.stackTraceLimit = 60;
+  });
   const log = [];
   const errors = [];
   page.on("console", (m) => {

@@ -75,6 +75,11 @@ impl Reloader {
     }
 
     fn watcher_mut(&mut self) -> Option<&mut bv_user::watch::Watcher> {
+        // A browser page has no files to watch (and notify's polling
+        // watcher reads the clock std has no source for there).
+        if cfg!(target_arch = "wasm32") {
+            return None;
+        }
         if self.watcher.is_none() && self.unavailable.is_none() {
             match bv_user::watch::Watcher::new() {
                 Ok(w) => self.watcher = Some(w),

@@ -17,6 +17,7 @@ use super::background::{self, Slots};
 use super::factor_overlay::{self, Factored};
 use super::{Scene, SceneBrdf, View};
 use crate::session::command::Command;
+use crate::session::platform::Instant;
 use crate::session::state::Display;
 use bv_core::measured::merl::theta_h_centre;
 use bv_core::represent::sh;
@@ -26,7 +27,7 @@ use eframe::egui::{
 };
 use egui_plot::{Corner, GridMark, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Factors drawn below the chart.
 pub const SHOWN: usize = 3;

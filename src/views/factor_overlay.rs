@@ -53,7 +53,7 @@ pub fn factored(
     if let Some(d) = slots.latest(id).filter(|d| d.key == revision) {
         return d.value.clone();
     }
-    let t0 = std::time::Instant::now();
+    let t0 = crate::session::platform::Instant::now();
     let v = factor::factor_model(
         brdf,
         factor::VIEW_DIMS,
@@ -197,7 +197,7 @@ pub fn request(ctx: &egui::Context, scene: &Scene<'_>) -> Option<FactorDone> {
         if let Some(d) = slots.latest(id).filter(|d| d.key == key) {
             return Some(d);
         }
-        let t0 = std::time::Instant::now();
+        let t0 = crate::session::platform::Instant::now();
         let v = compute(brdf.as_ref(), id, key, &tables);
         return Some(slots.insert(id, key, v, t0.elapsed()));
     }

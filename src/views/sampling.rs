@@ -15,6 +15,7 @@
 use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
 use crate::session::command::Command;
+use crate::session::platform::Instant;
 use bv_core::analysis::reciprocity_map::hemisphere_to_disc;
 use bv_core::analysis::sample_histogram::{HistogramOptions, SampleHistogram, sample_histogram};
 use eframe::egui::{
@@ -23,7 +24,7 @@ use eframe::egui::{
 use glam::DVec3;
 use std::f64::consts::PI;
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Bins in `cos θ`: 10 rings of equal solid angle.
 pub const N_THETA: usize = 10;
