@@ -204,7 +204,7 @@ fn the_load_button_opens_a_file_dialog() {
     h.get_by_label("Load MERL…").click();
     h.run();
     assert!(h.state().dialog_open());
-    h.get_by_label_contains("Load a MERL table (.binary)");
+    h.get_by_label_contains("Open a MERL table (.binary) or a BRDF file (.brdf)");
     h.key_press(egui::Key::Escape);
     h.run();
     assert!(!h.state().dialog_open());
