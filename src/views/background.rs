@@ -157,6 +157,42 @@ where
             .is_some_and(|s| s.running.is_some() || s.waiting.is_some())
     }
 
+    /// A view's result for this frame and whether a job of `slot` still
+    /// runs. A figure (`now`) gets the result of `key`, computed here unless
+    /// it is finished; a window frame gets the latest finished result (with
+    /// `true` when it is of an older key) while `compute` runs in the
+    /// background, `ctx` asked for a frame when the job ends and every
+    /// `poll` while it runs.
+    pub fn for_frame(
+        self: &Arc<Self>,
+        ctx: &egui::Context,
+        slot: u64,
+        key: K,
+        now: bool,
+        poll: Duration,
+        compute: impl FnOnce() -> V + Send + 'static,
+    ) -> (Option<(V, bool)>, bool)
+    where
+        V: Clone,
+    {
+        if now {
+            if let Some(d) = self.latest(slot).filter(|d| d.key == key) {
+                return (Some((d.value.clone(), false)), false);
+            }
+            let t0 = Instant::now();
+            let v = compute();
+            self.insert(slot, key, v.clone(), t0.elapsed());
+            return (Some((v, false)), false);
+        }
+        let c = ctx.clone();
+        let done = self.request(slot, key.clone(), compute, move || c.request_repaint());
+        let busy = self.busy(slot);
+        if busy {
+            ctx.request_repaint_after(poll);
+        }
+        (done.map(|d| (d.value.clone(), d.key != key)), busy)
+    }
+
     /// Waits until no job of any slot runs (tests and scripted drivers).
     pub fn wait_idle(&self, timeout: Duration) -> bool {
         let t0 = Instant::now();

@@ -17,7 +17,6 @@ use super::background::{self, Slots};
 use super::factor_overlay::{self, Factored};
 use super::{Scene, SceneBrdf, View};
 use crate::session::command::Command;
-use crate::session::platform::Instant;
 use crate::session::state::Display;
 use bv_core::measured::merl::theta_h_centre;
 use bv_core::represent::sh;
@@ -108,32 +107,19 @@ impl FactorView {
         scene: &Scene<'_>,
         b: &SceneBrdf,
     ) -> Option<(Outcome, bool)> {
-        let slots = slots(ctx);
         let tables = factor_overlay::factorizations(ctx);
         let (id, rev) = (b.id, b.revision);
-        if scene.figure {
-            if let Some(d) = slots.latest(id).filter(|d| d.key == rev) {
-                return Some((d.value.clone(), false));
-            }
-            let t0 = Instant::now();
-            let v = compute(b.brdf.as_ref(), id, rev, &tables);
-            slots.insert(id, rev, v.clone(), t0.elapsed());
-            return Some((v, false));
-        }
         let brdf = b.brdf.clone();
-        let c = ctx.clone();
-        let done = slots.request(
+        let (shown, busy) = slots(ctx).for_frame(
+            ctx,
             id,
             rev,
+            scene.figure,
+            Duration::from_millis(100),
             move || compute(brdf.as_ref(), id, rev, &tables),
-            move || c.request_repaint(),
         );
-        self.waiting = slots.busy(id);
-        if self.waiting {
-            ctx.request_repaint_after(Duration::from_millis(100));
-        }
-        let d = done?;
-        Some((d.value.clone(), d.key != rev))
+        self.waiting = busy;
+        shown
     }
 }
 

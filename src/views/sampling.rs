@@ -15,7 +15,6 @@
 use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
 use crate::session::command::Command;
-use crate::session::platform::Instant;
 use bv_core::analysis::reciprocity_map::hemisphere_to_disc;
 use bv_core::analysis::sample_histogram::{HistogramOptions, SampleHistogram, sample_histogram};
 use eframe::egui::{
@@ -110,34 +109,18 @@ impl SamplingView {
         scene: &Scene<'_>,
         b: &SceneBrdf,
     ) -> Option<(Outcome, bool)> {
-        let key = key_of(scene, b);
         let wi = scene.wi();
-        let slots = slots(ctx);
-        if scene.figure {
-            if let Some(d) = slots.latest(b.id)
-                && d.key == key
-            {
-                return Some((d.value.clone(), false));
-            }
-            let t0 = Instant::now();
-            let h = compute(b.brdf.as_ref(), wi);
-            slots.insert(b.id, key, h.clone(), t0.elapsed());
-            return Some((h, false));
-        }
         let brdf = b.brdf.clone();
-        let c = ctx.clone();
-        let done = slots.request(
+        let (shown, busy) = slots(ctx).for_frame(
+            ctx,
             b.id,
-            key,
+            key_of(scene, b),
+            scene.figure,
+            Duration::from_millis(50),
             move || compute(brdf.as_ref(), wi),
-            move || c.request_repaint(),
         );
-        self.waiting = slots.busy(b.id);
-        if self.waiting {
-            ctx.request_repaint_after(Duration::from_millis(50));
-        }
-        let d = done?;
-        Some((d.value.clone(), d.key != key))
+        self.waiting = busy;
+        shown
     }
 }
 
