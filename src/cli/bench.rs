@@ -168,11 +168,7 @@ pub fn measure(
                         }
                         let o = [&r[..len], &g[..len], &b[..len]];
                         std::hint::black_box(o);
-                        (0..len)
-                            .filter(|&i| {
-                                !(o[0][i].is_finite() && o[1][i].is_finite() && o[2][i].is_finite())
-                            })
-                            .count()
+                        batch::count_non_finite(o, len)
                     },
                 )
                 .sum()

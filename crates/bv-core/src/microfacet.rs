@@ -558,9 +558,9 @@ pub fn sample_reflection_pdf(ndf: &Microfacet, wi: DVec3, wo: DVec3) -> f64 {
 
 /// One roughness scale in f32 lanes, for the batch kernels (see
 /// [`crate::batch`]): [`beckmann_d`], [`ggx_d`], [`beckmann_lambda`] and
-/// [`ggx_lambda`] ported to f32, the distribution a const parameter
-/// ([`ScaleLanes::BECKMANN`] or [`ScaleLanes::GGX`]). Blinn's D (an `atan2`
-/// of the half vector) has no lane form yet.
+/// [`ggx_lambda`] ported to f32, and [`blinn_d`] with Beckmann's Λ of its one
+/// α (as [`Scale::lambda`] pairs them), the distribution a const parameter
+/// ([`ScaleLanes::BECKMANN`], [`ScaleLanes::GGX`] or [`ScaleLanes::BLINN`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ScaleLanes {
     inv_ax2: f32,
@@ -569,7 +569,7 @@ pub struct ScaleLanes {
     inv_ay: f32,
     ax2: f32,
     ay2: f32,
-    /// 1/(π αx αy).
+    /// 1/(π αx αy); Blinn: its normalisation constant `c`.
     norm: f32,
 }
 
@@ -579,14 +579,28 @@ impl ScaleLanes {
     /// GGX.
     pub const GGX: u8 = 1;
 
-    /// The lane form of `s`, with its const tag; `None` for Blinn.
+    /// Blinn (`exp(−(θh/α)²)`, with Beckmann's Λ).
+    pub const BLINN: u8 = 2;
+
+    /// The lane form of `s`, with its const tag. (`Option` for a distribution
+    /// that has no lane form; every one has one today.)
     pub fn new(s: &Scale) -> Option<(u8, Self)> {
         let tag = match s.dist {
             Distribution::Beckmann => Self::BECKMANN,
             Distribution::Ggx => Self::GGX,
-            Distribution::Blinn => return None,
+            Distribution::Blinn => Self::BLINN,
         };
-        let (ax, ay) = (s.ax, s.ay);
+        // Blinn has one α; its Λ is Beckmann's at αx = αy = α.
+        let (ax, ay) = if tag == Self::BLINN {
+            (s.ax, s.ax)
+        } else {
+            (s.ax, s.ay)
+        };
+        let norm = if tag == Self::BLINN {
+            s.blinn_c
+        } else {
+            FRAC_1_PI / (ax * ay)
+        };
         Some((
             tag,
             Self {
@@ -596,7 +610,7 @@ impl ScaleLanes {
                 inv_ay: (1.0 / ay) as f32,
                 ax2: (ax * ax) as f32,
                 ay2: (ay * ay) as f32,
-                norm: (FRAC_1_PI / (ax * ay)) as f32,
+                norm: norm as f32,
             },
         ))
     }
@@ -609,6 +623,11 @@ impl ScaleLanes {
             let (u, v) = (x * self.inv_ax, y * self.inv_ay);
             let t = u * u + v * v + z * z;
             self.norm / (t * t)
+        } else if DIST == Self::BLINN {
+            // As `blinn_d`: θh = atan2(√(x² + y²), z), e = θh/α.
+            let theta = crate::batch::math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
+            let e = theta * self.inv_ax;
+            crate::batch::math::exp(-e * e) * self.norm
         } else {
             let z2 = z * z;
             let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) / z2;

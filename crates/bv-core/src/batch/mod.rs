@@ -80,6 +80,24 @@ impl Out<'_> {
     }
 }
 
+/// Lanes among the first `n` of `rgb` where some channel is NaN or infinite.
+/// A branch-free pass, compiled in the optimised core so that callers built
+/// without optimisation (`bv bench` in a debug build) do not spend more time
+/// counting than evaluating.
+pub fn count_non_finite(rgb: [&[f32]; 3], n: usize) -> usize {
+    let n = n.min(rgb[0].len()).min(rgb[1].len()).min(rgb[2].len());
+    let (r, g, b) = (&rgb[0][..n], &rgb[1][..n], &rgb[2][..n]);
+    // |x| < ∞ is false for NaN and ±∞; summing 0/1 keeps the loop vectorisable.
+    (0..n)
+        .map(|i| {
+            let ok = r[i].abs() < f32::INFINITY
+                && g[i].abs() < f32::INFINITY
+                && b[i].abs() < f32::INFINITY;
+            usize::from(!ok)
+        })
+        .sum()
+}
+
 /// Owned structure-of-arrays direction pairs.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PairBuf {
@@ -260,5 +278,23 @@ pub fn scalar(brdf: &dyn Brdf, dirs: &Dirs<'_>, out: &mut Out<'_>) {
         for c in 0..3 {
             out.rgb[c][i] = f[c] as f32;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn count_non_finite_counts_lanes_not_channels() {
+        let r = [0.0, f32::NAN, 1.0, f32::MAX, -f32::MAX, 1e-42, 0.0];
+        let g = [0.0, f32::NAN, f32::INFINITY, 0.0, 0.0, 0.0, 0.0];
+        let b = [0.0, 0.0, 0.0, f32::NEG_INFINITY, 0.0, -0.0, f32::NAN];
+        // Lanes 1, 2, 3 and 6 each hold at least one NaN or infinity.
+        assert_eq!(count_non_finite([&r, &g, &b], 7), 4);
+        // Only the first n lanes are looked at, and n is clipped to the arrays.
+        assert_eq!(count_non_finite([&r, &g, &b], 2), 1);
+        assert_eq!(count_non_finite([&r, &g, &b], 100), 4);
+        assert_eq!(count_non_finite([&r[..0], &g, &b], 7), 0);
     }
 }

@@ -139,7 +139,7 @@ pub struct CookTorrance {
     fresnel: Fresnel,
     /// Probability of drawing the diffuse lobe in [`Brdf::sample`].
     p_diffuse: f64,
-    /// The f32 batch kernel (none for Blinn's D).
+    /// The f32 batch kernel.
     kernel: Option<CtKernel>,
 }
 
@@ -448,10 +448,10 @@ impl Kernel for CtKernel {
                 }
             };
         }
-        if self.dist == ScaleLanes::GGX {
-            go!({ ScaleLanes::GGX })
-        } else {
-            go!({ ScaleLanes::BECKMANN })
+        match self.dist {
+            ScaleLanes::GGX => go!({ ScaleLanes::GGX }),
+            ScaleLanes::BLINN => go!({ ScaleLanes::BLINN }),
+            _ => go!({ ScaleLanes::BECKMANN }),
         }
     }
 }
