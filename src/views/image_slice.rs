@@ -17,7 +17,7 @@ use super::BrdfColor as _;
 use super::{Scene, View, curves};
 use crate::session::command::Command;
 use crate::session::platform::Instant;
-use bv_core::{Brdf, Rgb, frame};
+use bv_core::{Brdf, Rgb, batch, frame};
 use eframe::egui::{
     self, Align2, Color32, ColorImage, FontId, Pos2, Rect, RichText, Role, Sense, Stroke,
     TextureHandle, TextureOptions, Ui, Vec2, WidgetInfo,
@@ -147,17 +147,51 @@ pub fn value_at(brdf: &dyn Brdf, theta_h: f64, theta_d: f64, phi_d: f64) -> Opti
     Some(if f.is_finite() { f } else { Rgb::ZERO })
 }
 
-/// Evaluates a `n × n` slice at pixel centres.
+/// Evaluates a `n × n` slice at pixel centres, a row per batch through the
+/// model's f32 SIMD kernel where it has one (`bv_core::batch::eval`; the
+/// display needs f32 only), rows in parallel.
 pub fn compute(brdf: &dyn Brdf, phi_d: f64, sqrt_axis: bool, n: usize) -> SliceData {
     let t0 = Instant::now();
     let n = n.max(2);
     let mut values = vec![None; n * n];
     values.par_chunks_mut(n).enumerate().for_each(|(row, out)| {
         let theta_d = theta_d_at((row as f64 + 0.5) / n as f64);
-        for (col, o) in out.iter_mut().enumerate() {
+        let mut pairs = batch::PairBuf::default();
+        let mut above = Vec::with_capacity(n);
+        for col in 0..n {
             let theta_h = theta_h_at((col as f64 + 0.5) / n as f64, sqrt_axis);
-            *o = value_at(brdf, theta_h, theta_d, phi_d)
-                .map(|f| [f.x as f32, f.y as f32, f.z as f32]);
+            let (wi, wo) = frame::from_half_diff(frame::HalfDiff {
+                theta_h,
+                phi_h: 0.0,
+                theta_d,
+                phi_d,
+            });
+            let ok = wi.z > 0.0 && wo.z > 0.0;
+            above.push(ok);
+            // Pixels below the horizon are evaluated too (the kernel gives 0
+            // there) so that the lanes stay in step with the columns.
+            pairs.push(wi, wo);
+        }
+        let mut rgb = [vec![0f32; n], vec![0f32; n], vec![0f32; n]];
+        {
+            let [r, g, b] = &mut rgb;
+            batch::eval(
+                brdf,
+                &pairs.dirs(0..n),
+                &mut batch::Out {
+                    rgb: [&mut r[..], &mut g[..], &mut b[..]],
+                },
+            );
+        }
+        for (col, o) in out.iter_mut().enumerate() {
+            let f = [rgb[0][col], rgb[1][col], rgb[2][col]];
+            *o = above[col].then(|| {
+                if f.iter().all(|v| v.is_finite()) {
+                    f
+                } else {
+                    [0.0; 3]
+                }
+            });
         }
     });
     SliceData {
@@ -705,6 +739,52 @@ mod tests {
         // At φd = 90° both directions stay above the horizon everywhere.
         let d90 = compute(b.as_ref(), FRAC_PI_2, false, 16);
         assert!(d90.values.iter().all(Option::is_some));
+    }
+
+    #[test]
+    fn batched_slice_equals_the_f64_model_pixel_by_pixel() {
+        // The rows go through the f32 kernels; `value_at` is the f64 `eval`.
+        for (id, p) in [
+            (
+                "cook-torrance",
+                serde_json::json!({"distribution": "ggx", "alpha": 0.2, "fresnel": "conductor",
+                    "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14]}),
+            ),
+            (
+                "cook-torrance",
+                serde_json::json!({"distribution": "blinn", "alpha": 0.3}),
+            ),
+            ("ward", serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.3})),
+            ("disney", serde_json::Value::Null),
+        ] {
+            let b = bv_core::ModelSpec::from_json(id, &p)
+                .unwrap()
+                .build()
+                .unwrap();
+            for (phi_d, sqrt_axis) in [(0.0, true), (1.0, false), (FRAC_PI_2, true)] {
+                let n = 24;
+                let d = compute(b.as_ref(), phi_d, sqrt_axis, n);
+                for row in 0..n {
+                    let td = theta_d_at((row as f64 + 0.5) / n as f64);
+                    for col in 0..n {
+                        let th = theta_h_at((col as f64 + 0.5) / n as f64, sqrt_axis);
+                        let want = value_at(b.as_ref(), th, td, phi_d);
+                        let got = d.values[row * n + col];
+                        assert_eq!(got.is_some(), want.is_some(), "{id} ({row}, {col})");
+                        if let (Some(g), Some(w)) = (got, want) {
+                            for (c, w) in [w.x, w.y, w.z].into_iter().enumerate() {
+                                let err = (f64::from(g[c]) - w).abs();
+                                assert!(
+                                    err <= 1e-4 * w.abs() + 1e-6,
+                                    "{id} {p} ({row}, {col}) channel {c}: {} vs {w}",
+                                    g[c]
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]
