@@ -56,8 +56,8 @@ impl FileProgram {
         Program::new(c.module.clone()).map_err(|e| interp_error(file, &e))?;
         let sampler = match &c.sampler {
             Sampler::Ready(m) => {
-                Program::new(m.clone()).map_err(|e| interp_error(file, &e))?;
-                Some(m.clone())
+                Program::new((**m).clone()).map_err(|e| interp_error(file, &e))?;
+                Some((**m).clone())
             }
             Sampler::None | Sampler::Unused(_) => None,
         };

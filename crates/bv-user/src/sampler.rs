@@ -64,7 +64,7 @@ pub enum Sampler {
     None,
     /// A sampler and its density: the module (parameters renamed as in the
     /// model's module), with [`SAMPLE_FN`] and [`PDF_FN`].
-    Ready(Module),
+    Ready(Box<Module>),
     /// A sampler without a density function: not used (the reason says
     /// why).
     Unused(String),
@@ -209,5 +209,5 @@ pub fn compile(file: &BrdfFile, name: &str) -> Result<Sampler> {
             g.name = Some(crate::port::param_global(k));
         }
     }
-    Ok(Sampler::Ready(module))
+    Ok(Sampler::Ready(Box::new(module)))
 }
