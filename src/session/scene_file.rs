@@ -34,10 +34,11 @@
 //! lost tail with defaults. A BRDF that cannot be built (a MERL table that is
 //! missing) refuses the scene on the command line and is a warning in the
 //! window ([`Builds`]); a value that would be clamped into range is a
-//! warning. File paths in a scene (MERL tables, the environment map) are
-//! relative to the scene file's folder: [`load`] resolves them there and
-//! [`save`] writes paths inside that folder relative to it, so a folder of a
-//! scene and its tables can move as a whole. Reading refuses anything but a
+//! warning. File paths in a scene (MERL tables, the environment map, the
+//! `.brdf` files of file models, alone or in a mix) are relative to the
+//! scene file's folder: [`load`] resolves them there and [`save`] writes
+//! paths inside that folder relative to it, so a folder of a scene and its
+//! tables can move as a whole. Reading refuses anything but a
 //! regular file of at most 1 MiB ([`fsio::read_capped`]). Saving writes a
 //! temporary file beside the target, syncs it and renames it over the target,
 //! so a crash or a full disk leaves the old scene intact; FIFOs, devices and
@@ -160,6 +161,17 @@ pub enum Builds {
 /// [`from_toml`] for a file in the folder `base`: relative paths (MERL
 /// tables, the environment map) are resolved against `base`.
 pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<Loaded, SceneError> {
+    match base {
+        // `.brdf` model paths are read relative to the folder too (the
+        // specs' serde resolves them: `user_models::with_scene_dir`).
+        Some(base) => {
+            super::user_models::with_scene_dir(base, || from_toml_in_dir(text, Some(base), builds))
+        }
+        None => from_toml_in_dir(text, None, builds),
+    }
+}
+
+fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<Loaded, SceneError> {
     let text = text.trim_start_matches('\u{feff}');
     let mut warnings = Vec::new();
     let table: toml::Table =
@@ -352,7 +364,7 @@ fn map_paths(state: &mut AppState, f: &dyn Fn(&str) -> String) {
 }
 
 /// `p` (from a scene file in `base`) as a path usable from here.
-fn resolve_in(base: &Path, p: &str) -> String {
+pub(crate) fn resolve_in(base: &Path, p: &str) -> String {
     let path = Path::new(p);
     if path.is_absolute() || base.as_os_str().is_empty() {
         return p.to_string();
@@ -363,14 +375,21 @@ fn resolve_in(base: &Path, p: &str) -> String {
 /// `p` (relative to the current directory, or absolute) as it is written
 /// into a scene file in `dir`: relative to `dir` when it lies inside it, so
 /// that a folder of a scene and its tables can be moved as a whole.
-fn portable_in(dir: &Path, p: &str) -> String {
-    let (Ok(abs), Ok(dir)) = (std::path::absolute(p), std::path::absolute(dir)) else {
+pub(crate) fn portable_in(dir: &Path, p: &str) -> String {
+    let (Ok(abs), Ok(absolute_dir)) = (std::path::absolute(p), std::path::absolute(dir)) else {
         return p.to_string();
     };
-    match abs.strip_prefix(&dir) {
-        Ok(rel) if !rel.as_os_str().is_empty() => rel.display().to_string(),
-        _ => abs.display().to_string(),
+    // A file model's path is canonical (symlinks resolved); the folder is
+    // compared in both forms.
+    let canonical_dir = std::fs::canonicalize(dir).ok();
+    for d in std::iter::once(absolute_dir).chain(canonical_dir) {
+        if let Ok(rel) = abs.strip_prefix(&d)
+            && !rel.as_os_str().is_empty()
+        {
+            return rel.display().to_string();
+        }
     }
+    abs.display().to_string()
 }
 
 /// The scene text [`save`] writes to `path`: file paths relative to the
@@ -383,7 +402,8 @@ pub fn to_toml_for(path: &Path, state: &AppState) -> Result<String, SceneError> 
     };
     let mut state = state.clone();
     map_paths(&mut state, &|p| portable_in(&dir, p));
-    to_toml(&state)
+    // File models' paths are written by the specs' serde, in the folder.
+    super::user_models::with_scene_dir(&dir, || to_toml(&state))
 }
 
 fn ends_with_marker(text: &str) -> bool {

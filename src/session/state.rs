@@ -469,18 +469,14 @@ mod spec_json {
 
     pub fn serialize<S: Serializer>(spec: &ModelSpec, s: S) -> Result<S::Ok, S::Error> {
         let mut v = spec.to_json();
-        // A user file's model is saved by its path, which a later run can
-        // open; its id names it only in the process that loaded it.
-        if let Some(path) = crate::session::user_models::path_of(spec.id())
-            && let Some(m) = v.get_mut("model")
-        {
-            *m = Value::String(path);
-        }
+        // A user file's model (alone or in a mix) is saved by its path.
+        crate::session::user_models::model_names_for_save(&mut v);
         v.serialize(s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ModelSpec, D::Error> {
-        let v = Value::deserialize(d)?;
+        let mut v = Value::deserialize(d)?;
+        crate::session::user_models::model_names_for_load(&mut v);
         spec_from_json(&v).map_err(serde::de::Error::custom)
     }
 }

@@ -7,7 +7,8 @@
 use super::state::AppState;
 use anyhow::{Context as _, Result};
 use bv_core::ModelInfo;
-use std::path::Path;
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
 
 /// Makes every model lookup accept a `.brdf` path (idempotent).
 pub fn install() {
@@ -34,6 +35,91 @@ pub fn resolve(name: &str) -> Result<&'static ModelInfo> {
         return bv_user::open(Path::new(name)).with_context(|| format!("cannot open `{name}`"));
     }
     Ok(bv_core::find(name)?)
+}
+
+thread_local! {
+    /// The folder of the scene file being read or written on this thread:
+    /// the model paths of its specs are relative to it.
+    static SCENE_DIR: RefCell<Option<PathBuf>> = const { RefCell::new(None) };
+}
+
+/// Runs `body` with the model paths of every spec it reads or writes
+/// (through the state's serde: [`model_names_for_save`],
+/// [`model_names_for_load`]) taken relative to the scene folder `dir`, so a
+/// folder holding a scene and its `.brdf` files can move as a whole, and a
+/// scene opened from another current directory finds its files. Nested
+/// calls restore the outer folder.
+pub fn with_scene_dir<R>(dir: &Path, body: impl FnOnce() -> R) -> R {
+    struct Restore(Option<PathBuf>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let old = self.0.take();
+            SCENE_DIR.with(|d| *d.borrow_mut() = old);
+        }
+    }
+    let old = SCENE_DIR.with(|d| d.borrow_mut().replace(dir.to_path_buf()));
+    let _restore = Restore(old);
+    body()
+}
+
+fn scene_dir() -> Option<PathBuf> {
+    SCENE_DIR.with(|d| d.borrow().clone())
+}
+
+/// Applies `f` to the `model` of every spec in a spec's JSON form: the spec
+/// itself (`{"model", "params"}`) and every mix component inside its
+/// parameters (`{"weight", "model", "params"}`), at any depth.
+fn map_model_names(v: &mut serde_json::Value, f: &dyn Fn(&str) -> Option<String>) {
+    match v {
+        serde_json::Value::Object(m) => {
+            let spec_like = m.get("model").is_some_and(serde_json::Value::is_string)
+                && m.keys()
+                    .all(|k| matches!(k.as_str(), "model" | "params" | "weight"));
+            if spec_like
+                && let Some(serde_json::Value::String(name)) = m.get_mut("model")
+                && let Some(new) = f(name)
+            {
+                *name = new;
+            }
+            for (_, x) in m.iter_mut() {
+                map_model_names(x, f);
+            }
+        }
+        serde_json::Value::Array(items) => {
+            for x in items {
+                map_model_names(x, f);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// A spec's JSON as it is saved: every file model (mix components
+/// included) named by its path, which a later run can open (its catalogue
+/// id names it only in the process that loaded it). Inside
+/// [`with_scene_dir`] a path under the scene's folder is written relative
+/// to it, any other path absolute.
+pub fn model_names_for_save(v: &mut serde_json::Value) {
+    let dir = scene_dir();
+    map_model_names(v, &|id| {
+        let path = path_of(id)?;
+        Some(match &dir {
+            Some(d) => super::scene_file::portable_in(d, &path),
+            None => path,
+        })
+    });
+}
+
+/// A spec's JSON as it is read: inside [`with_scene_dir`], every relative
+/// `.brdf` path (mix components included) is taken relative to the scene's
+/// folder, not the current directory.
+pub fn model_names_for_load(v: &mut serde_json::Value) {
+    let Some(dir) = scene_dir() else {
+        return;
+    };
+    map_model_names(v, &|name| {
+        is_file(name).then(|| super::scene_file::resolve_in(&dir, name))
+    });
 }
 
 /// What a reload did, for the window to show.

@@ -84,11 +84,22 @@ pub fn model_info(c: &Compiled, path: &Path) -> Result<ModelInfo> {
     Ok(ModelInfo {
         id,
         name: leak(file_name),
-        summary: match c.file.language {
-            bv_core::user::brdf_file::Language::Glsl => {
-                "User BRDF file (BRDF Explorer format, GLSL shader)"
+        summary: {
+            let kind = match c.file.language {
+                bv_core::user::brdf_file::Language::Glsl => {
+                    "User BRDF file (BRDF Explorer format, GLSL shader)"
+                }
+                bv_core::user::brdf_file::Language::Wgsl => "User BRDF file (bv's WGSL variant)",
+            };
+            match &c.sampler {
+                crate::sampler::Sampler::None => kind,
+                crate::sampler::Sampler::Ready(_) => {
+                    leak(format!("{kind}; samples with its isFunc section"))
+                }
+                crate::sampler::Sampler::Unused(why) => {
+                    leak(format!("{kind}; samples with bv's default sampler: {why}"))
+                }
             }
-            bv_core::user::brdf_file::Language::Wgsl => "User BRDF file (bv's WGSL variant)",
         },
         citation: leak(path.display().to_string()),
         params: c.decls,

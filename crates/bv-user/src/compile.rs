@@ -20,6 +20,8 @@ pub struct Compiled {
     pub module: naga::Module,
     /// The module as WGSL (before the loop guards and the wrapper).
     pub wgsl: String,
+    /// The file's own sampler (its `isFunc` section), if it has a usable one.
+    pub sampler: crate::sampler::Sampler,
 }
 
 /// The container parser's error, placed when its message starts with
@@ -56,11 +58,13 @@ pub fn compile(text: &str, name: &str) -> Result<Compiled> {
     safety::check(&t.module, name)?;
     let module = port::renamed(&t, name)?;
     let wgsl = port::emit(&module, name)?;
+    let sampler = crate::sampler::compile(&file, name)?;
     let decls: Vec<ParamDecl> = file.params.iter().map(|p| p.to_decl()).collect();
     Ok(Compiled {
         file,
         decls: Box::leak(decls.into_boxed_slice()),
         module,
         wgsl,
+        sampler,
     })
 }

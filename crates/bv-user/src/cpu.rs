@@ -15,20 +15,29 @@
 //! 0 below the horizon (the Explorer draws only the upper hemisphere), and
 //! a NaN or infinite channel (a division by a vanishing cosine) reads as 0.
 //! Negative values are kept, so that `bv check` reports them.
+//!
+//! A file with a usable `isFunc` section ([`crate::sampler`]) samples with
+//! it: `sample` calls the file's `sampleBRDF` and `pdf` its `pdfBRDF`, in
+//! the same frame, the fixed direction as V and the drawn one as L. A draw
+//! that fails, is not finite or is not a direction reads as no direction;
+//! a density that fails or is not a finite non-negative number reads as 0.
 
 use crate::compile::Compiled;
 use crate::error::{Result, UserError};
 use crate::port;
+use crate::sampler::{PDF_FN, SAMPLE_FN, Sampler};
 use bv_core::params::ParamKind;
 use bv_core::{Brdf, Claims, ParamDecl, Params, Rgb};
 use bv_interp::{InterpError, Limits, Program, Value};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use std::sync::Arc;
 
 /// A file's module and declaration, ready to be given parameter values.
 #[derive(Debug, Clone)]
 pub struct FileProgram {
     module: naga::Module,
+    /// The module of the file's sampler, if it has a usable one.
+    sampler: Option<naga::Module>,
     decls: &'static [ParamDecl],
     file: String,
 }
@@ -45,8 +54,16 @@ impl FileProgram {
     /// the module (a feature it lacks).
     pub fn new(c: &Compiled, file: &str) -> Result<Self> {
         Program::new(c.module.clone()).map_err(|e| interp_error(file, &e))?;
+        let sampler = match &c.sampler {
+            Sampler::Ready(m) => {
+                Program::new((**m).clone()).map_err(|e| interp_error(file, &e))?;
+                Some((**m).clone())
+            }
+            Sampler::None | Sampler::Unused(_) => None,
+        };
         Ok(Self {
             module: c.module.clone(),
+            sampler,
             decls: c.decls,
             file: file.to_string(),
         })
@@ -55,34 +72,16 @@ impl FileProgram {
     /// An evaluator for parameter values `p` (validated by the spec against
     /// the file's declaration).
     pub fn build(&self, id: &'static str, p: &Params) -> Result<FileBrdf> {
-        let mut program =
-            Program::new(self.module.clone()).map_err(|e| interp_error(&self.file, &e))?;
-        let bad = |e: bv_core::BvError| UserError::Model {
-            file: self.file.clone(),
-            reason: e.to_string(),
+        let values = self.values(p)?;
+        let program = self.program(&self.module, &values, false)?;
+        let sampler = match &self.sampler {
+            Some(m) => Some(Arc::new(self.program(m, &values, true)?)),
+            None => None,
         };
-        for (k, d) in self.decls.iter().enumerate() {
-            let v = match d.kind {
-                ParamKind::Float(_) => Value::f(p.float(d.id).map_err(bad)?),
-                ParamKind::Bool { .. } => Value::Bool(p.bool(d.id).map_err(bad)?),
-                ParamKind::Color(_) => {
-                    let c = p.color(d.id).map_err(bad)?;
-                    Value::vec3(c.x, c.y, c.z)
-                }
-                _ => {
-                    return Err(UserError::Model {
-                        file: self.file.clone(),
-                        reason: format!("internal: parameter `{}` has no file kind", d.id),
-                    });
-                }
-            };
-            program
-                .set_global(&port::param_global(k), v)
-                .map_err(|e| interp_error(&self.file, &e))?;
-        }
         let mut b = FileBrdf {
             id,
             program: Arc::new(program),
+            sampler,
             limits: Limits::default(),
             claims: Claims {
                 reciprocal: false,
@@ -92,8 +91,58 @@ impl FileProgram {
         };
         b.try_eval(DVec3::Z, DVec3::Z)
             .map_err(|e| interp_error(&self.file, &e))?;
+        if b.sampler.is_some() {
+            // The sampler and its density run once too, so that one the
+            // interpreter cannot finish is a build error, not silence.
+            b.try_sample(DVec3::Z, DVec2::splat(0.5))
+                .map_err(|e| interp_error(&self.file, &e))?;
+            b.try_pdf(DVec3::Z, DVec3::Z)
+                .map_err(|e| interp_error(&self.file, &e))?;
+        }
         b.claims = b.observed_claims();
         Ok(b)
+    }
+
+    /// The value of each declared parameter, validated by the spec.
+    fn values(&self, p: &Params) -> Result<Vec<Value>> {
+        let bad = |e: bv_core::BvError| UserError::Model {
+            file: self.file.clone(),
+            reason: e.to_string(),
+        };
+        self.decls
+            .iter()
+            .map(|d| {
+                Ok(match d.kind {
+                    ParamKind::Float(_) => Value::f(p.float(d.id).map_err(bad)?),
+                    ParamKind::Bool { .. } => Value::Bool(p.bool(d.id).map_err(bad)?),
+                    ParamKind::Color(_) => {
+                        let c = p.color(d.id).map_err(bad)?;
+                        Value::vec3(c.x, c.y, c.z)
+                    }
+                    _ => {
+                        return Err(UserError::Model {
+                            file: self.file.clone(),
+                            reason: format!("internal: parameter `{}` has no file kind", d.id),
+                        });
+                    }
+                })
+            })
+            .collect()
+    }
+
+    /// A program of `module` with the parameters' globals set. In the
+    /// sampler's module (`lenient`) a parameter that the code never reads
+    /// may be gone; it is skipped.
+    fn program(&self, module: &naga::Module, values: &[Value], lenient: bool) -> Result<Program> {
+        let mut program = Program::new(module.clone()).map_err(|e| interp_error(&self.file, &e))?;
+        for (k, v) in values.iter().enumerate() {
+            match program.set_global(&port::param_global(k), v.clone()) {
+                Ok(()) => {}
+                Err(InterpError::UnknownGlobal(_)) if lenient => {}
+                Err(e) => return Err(interp_error(&self.file, &e)),
+            }
+        }
+        Ok(program)
     }
 }
 
@@ -101,6 +150,8 @@ impl FileProgram {
 pub struct FileBrdf {
     id: &'static str,
     program: Arc<Program>,
+    /// The file's sampler (`isFunc`), if it has a usable one.
+    sampler: Option<Arc<Program>>,
     limits: Limits,
     claims: Claims,
 }
@@ -124,6 +175,47 @@ impl FileBrdf {
             .as_vec3()
             .ok_or_else(|| InterpError::Invalid("the BRDF function returned no vec3".into()))?;
         Ok(Rgb::new(r, g, b))
+    }
+
+    /// The file's draw for fixed direction `v` and uniform point `u`:
+    /// `(L, the pdf the file reported)`, as the sampler returns them
+    /// (`None` without a sampler).
+    pub fn try_sample(&self, v: DVec3, u: DVec2) -> Result<Option<(DVec3, f64)>, InterpError> {
+        let Some(s) = &self.sampler else {
+            return Ok(None);
+        };
+        let args = [
+            Value::f(u.x),
+            Value::f(u.y),
+            v3(v),
+            v3(DVec3::Z),
+            v3(DVec3::X),
+            v3(DVec3::Y),
+        ];
+        let out = s.call(SAMPLE_FN, &args, &self.limits)?;
+        match out.as_vec() {
+            Some(&[x, y, z, pdf]) => Ok(Some((DVec3::new(x, y, z), pdf))),
+            _ => Err(InterpError::Invalid(
+                "the sampler returned no (L, pdf)".into(),
+            )),
+        }
+    }
+
+    /// The file's `pdfBRDF(L, V, N, X, Y)` (`None` without a sampler).
+    pub fn try_pdf(&self, v: DVec3, l: DVec3) -> Result<Option<f64>, InterpError> {
+        let Some(s) = &self.sampler else {
+            return Ok(None);
+        };
+        let args = [v3(l), v3(v), v3(DVec3::Z), v3(DVec3::X), v3(DVec3::Y)];
+        let out = s.call(PDF_FN, &args, &self.limits)?;
+        out.as_f()
+            .map(Some)
+            .ok_or_else(|| InterpError::Invalid("pdfBRDF returned no float".into()))
+    }
+
+    /// Whether the model samples with the file's own sampler.
+    pub fn has_own_sampler(&self) -> bool {
+        self.sampler.is_some()
     }
 }
 
@@ -179,6 +271,45 @@ impl Brdf for FileBrdf {
         match self.try_eval(wi, wo) {
             Ok(f) => Rgb::from_array(f.to_array().map(|x| if x.is_finite() { x } else { 0.0 })),
             Err(_) => Rgb::ZERO,
+        }
+    }
+
+    /// A user's shader is not a closed form a quadrature may trust to its
+    /// stated accuracy: its literals are f32 (π to 7 digits), and it may
+    /// branch or cut off anywhere (`if (NdotL < 0) return vec3(0)`, a `pow`
+    /// of a negative base that reads as 0). Adaptive quadrature spends its
+    /// whole panel budget chasing such steps, millions of interpreted
+    /// evaluations per albedo value (minutes for `bv check`); Monte Carlo
+    /// gives an honest standard error at a fixed cost. `--albedo quadrature`
+    /// still asks for the quadrature.
+    fn is_analytic(&self) -> bool {
+        false
+    }
+
+    fn sample(&self, wi: DVec3, u: DVec2) -> Option<DVec3> {
+        if self.sampler.is_none() {
+            return Some(bv_core::sampling::cosine_hemisphere(u));
+        }
+        let (l, _) = self.try_sample(wi, u).ok()??;
+        let len = l.length();
+        // A direction, give or take the rounding of the shader's own
+        // normalisation (f32 in the Explorer).
+        if !l.is_finite() || (len - 1.0).abs() > 1e-3 {
+            return None;
+        }
+        Some(l / len)
+    }
+
+    fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
+        if self.sampler.is_none() {
+            return bv_core::sampling::cosine_hemisphere_pdf(wo);
+        }
+        if wo.z <= 0.0 {
+            return 0.0;
+        }
+        match self.try_pdf(wi, wo) {
+            Ok(Some(p)) if p.is_finite() && p >= 0.0 => p,
+            _ => 0.0,
         }
     }
 

@@ -57,7 +57,7 @@ pub fn brdf_name(language: Language) -> &'static str {
     }
 }
 
-fn glsl_type(kind: &FileParamKind) -> &'static str {
+pub(crate) fn glsl_type(kind: &FileParamKind) -> &'static str {
     match kind {
         FileParamKind::Float { .. } => "float",
         FileParamKind::Bool { .. } => "bool",
@@ -75,7 +75,7 @@ fn wgsl_type(kind: &FileParamKind) -> &'static str {
 
 /// The user's section with `#version` lines blanked (the one rewrite; see
 /// the module docs).
-fn lenient_copy(text: &str) -> String {
+pub(crate) fn lenient_copy(text: &str) -> String {
     text.lines()
         .map(|l| {
             if l.trim_start().starts_with("#version") {

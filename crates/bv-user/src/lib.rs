@@ -5,8 +5,8 @@
 //! ([`front`]: GLSL or WGSL in a generated prelude, to a validated naga
 //! module), the GPU port ([`port`]: WGSL out, wrapped as a bv shader module),
 //! the CPU evaluator ([`cpu`]), safety limits ([`safety`]), catalogue
-//! registration and the by-path resolver ([`catalogue`]) and hot reload
-//! ([`watch`]).
+//! registration and the by-path resolver ([`catalogue`]), hot reload
+//! ([`watch`]) and a file's own importance sampler ([`sampler`]).
 //!
 //! The container itself (sections, parameter lines) is parsed by
 //! `bv_core::user::brdf_file`; bv-core stays free of naga.
@@ -18,6 +18,7 @@ pub mod error;
 pub mod front;
 pub mod port;
 pub mod safety;
+pub mod sampler;
 pub mod source_map;
 pub mod watch;
 

@@ -228,3 +228,70 @@ fn claims_are_what_a_probe_observes() {
     );
     assert!(ward.reciprocal && !ward.isotropic);
 }
+
+fn sampler_of(name: &str) -> bv_user::sampler::Sampler {
+    compile(name)
+        .unwrap_or_else(|e| panic!("{name}: {e}"))
+        .sampler
+}
+
+#[test]
+fn an_isfunc_section_is_the_models_sampler_when_it_states_its_density() {
+    use bv_user::sampler::Sampler;
+    assert!(matches!(sampler_of("lambert.brdf"), Sampler::None));
+    assert!(matches!(sampler_of("isfunc_lobe.brdf"), Sampler::Ready(_)));
+    assert!(matches!(
+        sampler_of("isfunc_mirror.brdf"),
+        Sampler::Ready(_)
+    ));
+    // Without pdfBRDF, or without sampleBRDF at all, bv says why it keeps
+    // its default sampler.
+    for name in ["isfunc_no_pdf.brdf", "features.brdf"] {
+        match sampler_of(name) {
+            Sampler::Unused(why) => assert!(why.contains("isFunc"), "{name}: {why}"),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    let info = bv_user::load(&data("isfunc_no_pdf.brdf")).unwrap();
+    assert!(info.summary.contains("default sampler"), "{}", info.summary);
+    let info = bv_user::load(&data("isfunc_lobe.brdf")).unwrap();
+    assert!(info.summary.contains("isFunc"), "{}", info.summary);
+
+    // The file's draws and density against the closed form written here:
+    // cos θ = u^(1/(n+1)), φ = 2π v, pdf = (n+1)/(2π) cos^n θ.
+    let n = 7.0;
+    let b = built("isfunc_lobe.brdf", serde_json::json!({"n": n}));
+    let v = DVec3::new(0.3, -0.2, 0.9).normalize();
+    for (ux, uy) in [(0.1, 0.2), (0.5, 0.5), (0.93, 0.71), (0.02, 0.99)] {
+        let w = b.sample(v, glam::DVec2::new(ux, uy)).unwrap();
+        let c = f64::powf(ux, 1.0 / (n + 1.0));
+        let s = (1.0 - c * c).sqrt();
+        let phi = 2.0 * std::f64::consts::PI * uy;
+        let want = DVec3::new(s * phi.cos(), s * phi.sin(), c);
+        // The section's arithmetic is f64 but its literals are f32 (π).
+        assert!((w - want).length() < 1e-6, "{w} vs {want}");
+        let pdf = (n + 1.0) / (2.0 * std::f64::consts::PI) * c.powf(n);
+        assert!((b.pdf(v, w) / pdf - 1.0).abs() < 1e-6);
+    }
+    assert_eq!(b.pdf(v, DVec3::new(0.0, 0.6, -0.8)), 0.0);
+
+    // Without a usable sampler: bv's cosine sampler and its density.
+    let d = built("isfunc_no_pdf.brdf", serde_json::json!({}));
+    let u = glam::DVec2::new(0.3, 0.6);
+    assert_eq!(
+        d.sample(v, u),
+        Some(bv_core::sampling::cosine_hemisphere(u))
+    );
+    let w = DVec3::new(0.1, 0.2, 0.9).normalize();
+    assert_eq!(d.pdf(v, w), bv_core::sampling::cosine_hemisphere_pdf(w));
+}
+
+#[test]
+fn a_broken_isfunc_section_is_refused_at_its_place() {
+    let e = error("broken_isfunc.brdf");
+    let text = e.to_string();
+    assert!(text.contains("undefined_thing"), "{text}");
+    let p = e.place().unwrap_or_else(|| panic!("no place in {text}"));
+    // `    wi = N * undefined_thing;` is file line 11.
+    assert_eq!((p.line, p.column), (11, 14), "{text}");
+}
