@@ -8,8 +8,11 @@
 // slider dragged on the canvas changes the picture, Copy link then opening
 // that link reproduces the scene (screenshots compared), every view drawn
 // maximised (through links made from the copied one) is not blank, the
-// session persists in local storage, and hostile fragments fall back to the
-// default scene with a message. Then the
+// session persists in local storage, hostile fragments fall back to the
+// default scene with a message, long computations (albedo, sampling) run in
+// many short steps while frames keep coming, Save scene downloads the scene
+// file, and a dropped MERL table, .brdf model and environment map open. Then
+// the
 // first-frame checks again with WebGPU off (WebGL2 only). Screenshots go to
 // web/shots (or --shots DIR); timings and the renderer are printed.
 import { chromium } from "playwright-core";
@@ -168,8 +171,22 @@ function viewIds() {
 async function open(context, url, what) {
   const page = await context.newPage();
   // Whole stacks in panic messages (Chromium keeps 10 frames by default).
+  // The page's frames (requestAnimationFrame times) and bv's console lines
+  // with their page times, for the checks that long work keeps it drawing.
   await page.addInitScript(() => {
     Error.stackTraceLimit = 60;
+    window.__bvFrames = [];
+    const tick = (t) => {
+      window.__bvFrames.push(t);
+      requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+    window.__bvLog = [];
+    const info = console.info.bind(console);
+    console.info = (...a) => {
+      window.__bvLog.push([performance.now(), String(a[0])]);
+      info(...a);
+    };
   });
   const log = [];
   const errors = [];
@@ -224,6 +241,87 @@ function lastLink(log) {
   return l && l.slice("bv: link ".length);
 }
 
+// Waits until some console line satisfies `pred` (at most `ms`).
+async function waitLog(p, pred, ms = 60_000) {
+  const t0 = Date.now();
+  while (Date.now() - t0 < ms && !p.log.some(pred) && !p.errors.length) await p.page.waitForTimeout(50);
+  return p.log.find(pred);
+}
+
+// The frames drawn while the page's first background work after page time
+// `since` ran: the job's length, the frames in it and the longest gap
+// between two of them (ms), and the page's own count of steps.
+async function framesDuringWork(p, since) {
+  const t0 = Date.now();
+  let w = null;
+  while (Date.now() - t0 < 120_000 && !p.errors.length) {
+    w = await p.page.evaluate((since) => {
+      const log = window.__bvLog;
+      const start = log.find(([t, l]) => l === "bv: background work started" && t >= since);
+      const end = start && log.find(([t, l]) => l.startsWith("bv: background work finished") && t >= start[0]);
+      if (!end) return null;
+      const f = window.__bvFrames.filter((t) => t >= start[0] && t <= end[0]);
+      const edges = [start[0], ...f, end[0]];
+      let gap = 0;
+      for (let i = 1; i < edges.length; i++) gap = Math.max(gap, edges[i] - edges[i - 1]);
+      return { ms: end[0] - start[0], frames: f.length, gap, steps: end[1].replace(/^.*\(|\)$/g, "") };
+    }, since);
+    if (w) break;
+    await p.page.waitForTimeout(100);
+  }
+  return w;
+}
+
+// Drops files ({name, base64}) on the canvas.
+async function drop(page, files) {
+  const dt = await page.evaluateHandle((files) => {
+    const d = new DataTransfer();
+    for (const f of files) {
+      const bytes = Uint8Array.from(atob(f.base64), (c) => c.charCodeAt(0));
+      d.items.add(new File([bytes], f.name));
+    }
+    return d;
+  }, files);
+  await page.dispatchEvent("#bv_canvas", "dragover", { dataTransfer: dt });
+  await page.dispatchEvent("#bv_canvas", "drop", { dataTransfer: dt });
+}
+
+// A small MERL table (θh × θd × φd cells, three channels of doubles after
+// a header of three int32 dimensions): a lobe that falls off with θh.
+function merlTable(nh = 8, nd = 8, np = 16) {
+  const cells = nh * nd * np;
+  const buf = Buffer.alloc(12 + 24 * cells);
+  buf.writeInt32LE(nh, 0);
+  buf.writeInt32LE(nd, 4);
+  buf.writeInt32LE(np, 8);
+  const tint = [1.0, 0.6, 0.3];
+  for (let c = 0; c < 3; c++) {
+    for (let i = 0; i < cells; i++) {
+      const ih = Math.floor(i / (nd * np));
+      buf.writeDoubleLE(1500 * tint[c] * (0.05 + 3 * Math.exp(-1.5 * ih)), 12 + 8 * (c * cells + i));
+    }
+  }
+  return buf;
+}
+
+// A .brdf model of our own (Disney's format, GLSL): a tinted Lambertian
+// with a sharp Phong lobe.
+const BRDF_FILE = `analytic
+# A test model: tinted Lambert plus a Phong lobe.
+::begin parameters
+color tint 0.9 0.2 0.1
+float shininess 1 200 40
+::end parameters
+::begin shader
+vec3 BRDF(vec3 L, vec3 V, vec3 N, vec3 X, vec3 Y)
+{
+    vec3 R = reflect(-L, N);
+    float s = pow(max(dot(R, V), 0.0), shininess);
+    return tint / 3.14159265 + vec3(s * (shininess + 2.0) / 6.2831853);
+}
+::end shader
+`;
+
 async function run() {
   if (!fs.existsSync(path.join(dist, "bv_bg.wasm"))) throw new Error(`no bundle in ${dist}: run web/build.sh`);
   const wasmBytes = fs.statSync(path.join(dist, "bv_bg.wasm")).size;
@@ -258,8 +356,18 @@ async function run() {
 // in the first-run scene: its knob at x = 62 on the row y = 183; egui draws
 // no DOM to find it by).
 const SLIDER = { y: 183, x0: 62, x1: 112 };
-// The Copy link button, at the window's bottom right corner.
+// The Copy link button, at the window's bottom right corner, and Save scene
+// left of it.
 const COPY_LINK = { x: W - 42, y: H - 18 };
+const SAVE_SCENE = { x: W - 120, y: H - 18 };
+// A frame gap that says the page was blocked: software rendering of the
+// dev build draws a busy view's frame in a few hundred milliseconds; a
+// computation done in one go blocks it for seconds.
+const MAX_FRAME_GAP = 1500;
+// The longest step of background work allowed (the page runs steps for
+// turns of 50–250 ms between frames; a step should not take much longer
+// than a frame of the dev build under software rendering).
+const MAX_STEP_MS = 400;
 
 async function webgpuChecks(context, base) {
   const a = await open(context, base, "WebGPU page");
@@ -321,6 +429,9 @@ async function webgpuChecks(context, base) {
   for (const view of viewIds()) {
     const p = await open(context, linkOf(gl, withMaximised(toml, view)), `view ${view}`);
     await p.page.waitForTimeout(SETTLE_MS);
+    // A view whose work still runs (the factorisation: a minute of steps in
+    // the dev build under software rendering) is drawn once it is done.
+    if (p.log.includes("bv: background work started")) await framesDuringWork(p, 0);
     // The view's area: right of the panel, below the menu.
     notBlank(await shot(p.page, `webgpu-view-${view}`), `view ${view}`, [320, 40, W - 10, H - 40]);
     noErrors(p, `view ${view}`);
@@ -383,6 +494,108 @@ async function webgpuChecks(context, base) {
     await p.page.close();
   }
   await a.page.close();
+
+  // After the session check: these pages store sessions of their own.
+  await longWorkChecks(context, gl, toml);
+  await downloadChecks(context, gl, toml);
+  await openFileChecks(context, gl, toml);
+}
+
+// Long computations run in steps between frames: the page keeps drawing
+// while the albedo curves, the sampling histogram and the factorisation are
+// computed. Each view is maximised on a page of its own; once the page has
+// settled (its start-up work done), a scene with another light azimuth and
+// albedo is dropped on it, which starts the view's work afresh.
+async function longWorkChecks(context, gl, toml) {
+  const changed = toml.replace(/^phi_deg = .*$/m, "phi_deg = 40.0")
+    .replace(/^albedo = .*$/m, "albedo = [0.7, 0.6, 0.5]");
+  // (The factorisation view's work, in 1585 steps, takes a minute in the
+  // dev build under software rendering: too long for CI.)
+  for (const view of ["albedo", "sampling"]) {
+    const p = await open(context, linkOf(gl, withMaximised(toml, view)), `long work (${view})`);
+    await framesDuringWork(p, 0);
+    await p.page.waitForTimeout(1000);
+    const since = await p.page.evaluate(() => performance.now());
+    await drop(p.page, [{ name: "changed.toml", base64: Buffer.from(withMaximised(changed, view)).toString("base64") }]);
+    const w = await framesDuringWork(p, since);
+    check(!!w, `long work (${view}): background work started and finished`);
+    if (w) {
+      console.log(`     ${view}: ${w.ms.toFixed(0)} ms of work (${w.steps}), ${w.frames} frames meanwhile, ` +
+        `longest gap ${w.gap.toFixed(0)} ms`);
+      // The page's own count: many short steps, not one long one. Then the
+      // browser's frames: a computation done in one go would leave a gap as
+      // long as itself.
+      const [, steps, longest] = (w.steps.match(/^(\d+) steps, the longest (\d+) ms$/) || []).map(Number);
+      check(steps >= 10 && longest <= MAX_STEP_MS,
+        `long work (${view}): done in ${steps} steps of at most ${longest} ms`);
+      check(w.gap < MAX_FRAME_GAP, `long work (${view}): frames keep coming (longest gap ${w.gap.toFixed(0)} ms)`);
+    }
+    await p.page.waitForTimeout(500);
+    notBlank(await shot(p.page, `webgl-work-${view}`), `long work (${view}) result`, [320, 40, W - 10, H - 40]);
+    noErrors(p, `long work (${view})`);
+    await p.page.close();
+  }
+}
+
+// Scenes are saved as downloads.
+async function downloadChecks(context, gl, toml) {
+  const p = await open(context, linkOf(gl, toml), "a page that saves downloads");
+  await p.page.waitForTimeout(SETTLE_MS);
+  // Save scene (bottom right, beside Copy link).
+  {
+    const download = p.page.waitForEvent("download", { timeout: 30_000 });
+    await p.page.mouse.click(SAVE_SCENE.x, SAVE_SCENE.y);
+    try {
+      const d = await download;
+      const file = path.join(shots, "downloaded-scene.toml");
+      await d.saveAs(file);
+      const text = fs.readFileSync(file, "utf8");
+      check(text.includes("[[brdfs]]") && text.trimEnd().endsWith("# end of bv scene"),
+        `the scene downloads as a whole scene file (${text.length} characters)`);
+    } catch (e) {
+      check(false, `the scene downloads: ${e}`);
+    }
+  }
+  noErrors(p, "a page that saves downloads");
+  await p.page.close();
+}
+
+// Files dropped on the page open: a MERL table, a .brdf model, an
+// environment map.
+async function openFileChecks(context, gl, toml) {
+  const p = await open(context, linkOf(gl, withMaximised(toml, "polar")), "a page files are opened on");
+  await p.page.waitForTimeout(SETTLE_MS);
+  let before = await shot(p.page, "webgl-files-before");
+  const brdfs = () => Number((p.log.filter((l) => /^bv: \d+ BRDFs$/.test(l)).pop() || "0").match(/\d+/)[0]);
+  const opened = async (name, files, what) => {
+    const n = brdfs();
+    await drop(p.page, files);
+    await waitLog(p, (l) => l.startsWith(`bv: opening the file ${name}`), 10_000);
+    const t0 = Date.now();
+    while (Date.now() - t0 < 30_000 && brdfs() === n &&
+      !p.log.some((l) => l.startsWith(`bv: could not open ${name}`))) await p.page.waitForTimeout(50);
+    const failed = p.log.find((l) => l.startsWith(`bv: could not open ${name}`));
+    check(brdfs() === n + 1 && !failed, `${what} opens as a BRDF (${n} → ${brdfs()})${failed ? `: ${failed}` : ""}`);
+    await p.page.waitForTimeout(SETTLE_MS);
+    const after = await shot(p.page, `webgl-files-${name}`);
+    const d = difference(before, after, [320, 40, W - 10, H - 40]);
+    check(d > 0.005, `${what} changes the picture (${(100 * d).toFixed(1)}% of the pixels)`);
+    before = after;
+  };
+  await opened("test.binary", [{ name: "test.binary", base64: merlTable().toString("base64") }],
+    "a dropped MERL table");
+  await opened("phong.brdf", [{ name: "phong.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
+    "a dropped .brdf model");
+  {
+    const hdr = fs.readFileSync(path.join(here, "..", "assets", "studio.hdr"));
+    await drop(p.page, [{ name: "studio.hdr", base64: hdr.toString("base64") }]);
+    check(!!await waitLog(p, (l) => l === "bv: opened the environment map studio.hdr", 10_000),
+      "a dropped environment map is taken");
+  }
+  await p.page.waitForTimeout(SETTLE_MS);
+  notBlank(await shot(p.page, "webgl-files-opened"), "the page with the opened files");
+  noErrors(p, "a page files are opened on");
+  await p.page.close();
 }
 
 async function webglChecks(context, base) {

@@ -270,7 +270,9 @@ fn report(ctx: &egui::Context, id: u64, built: &Built) -> Option<(Arc<PropertyRe
     let done = slots(ctx).request(
         id,
         built.revision,
-        move || Arc::new(analysis::check(brdf.as_ref(), &options())),
+        crate::views::background::once(move || {
+            Arc::new(analysis::check(brdf.as_ref(), &options()))
+        }),
         move || c.request_repaint(),
     )?;
     Some((done.value.clone(), done.key != built.revision))

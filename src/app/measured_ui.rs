@@ -227,7 +227,7 @@ fn compare(
     slots.request(
         slot,
         key,
-        move || {
+        background::once(move || {
             bv_core::represent::sh::relative_l2(
                 a.as_ref(),
                 b.as_ref(),
@@ -236,7 +236,7 @@ fn compare(
                 COMPARE_RINGS,
             )
             .map_err(|e| e.to_string())
-        },
+        }),
         move || ctx2.request_repaint(),
     )
 }

@@ -10,9 +10,11 @@
 //! clipboard; pasting another link into the same tab (only the fragment
 //! changes, so the page does not reload) opens its scene.
 //!
-//! A scene file (`.toml`) dropped on the page opens; *Save scene* downloads
-//! the current one. Other files (MERL tables, environment maps) are not read
-//! in the page yet: dropping one says so.
+//! Files dropped on the page or picked in the browser's file chooser (what
+//! the viewer's *Open* dialogs open in a page) arrive as bytes and open as on
+//! the desktop: scene files, MERL tables, `.brdf` models, environment maps.
+//! What the desktop writes to a file (*Save scene*, figures) becomes a
+//! download.
 //!
 //! If the browser takes the WebGPU device back (headless Chromium on a
 //! software adapter does so at the first present), the page notes it in the
@@ -23,6 +25,7 @@
 //! `bv: …` lines (`console.info`), never as errors.
 
 use super::{BvApp, STORAGE_KEY, Viewer};
+use crate::session::command::Command;
 use crate::session::scene_file::{self, Builds};
 use crate::session::{AppState, link, platform};
 use eframe::egui;
@@ -132,31 +135,14 @@ struct WebApp {
     webgpu: bool,
     /// Dropped files being read (the browser reads them asynchronously).
     reads: Vec<std::sync::mpsc::Receiver<DroppedRead>>,
+    /// The BRDFs drawn and the load errors in the last frame (reported when
+    /// they change).
+    reported_brdfs: usize,
+    reported_errors: usize,
 }
 
 /// A dropped file's name and its bytes, or why they could not be read.
 type DroppedRead = (String, Result<Vec<u8>, String>);
-
-/// Offers `bytes` to the user as a download named `name`.
-fn download(name: &str, mime: &str, bytes: &[u8]) -> Result<(), String> {
-    let js = |e: wasm_bindgen::JsValue| format!("{e:?}");
-    let parts = js_sys::Array::of1(&js_sys::Uint8Array::from(bytes));
-    let options = web_sys::BlobPropertyBag::new();
-    options.set_type(mime);
-    let blob =
-        web_sys::Blob::new_with_u8_array_sequence_and_options(&parts, &options).map_err(js)?;
-    let url = web_sys::Url::create_object_url_with_blob(&blob).map_err(js)?;
-    let anchor = document()
-        .ok_or("no document")?
-        .create_element("a")
-        .map_err(js)?
-        .dyn_into::<web_sys::HtmlAnchorElement>()
-        .map_err(|_| "not an anchor".to_string())?;
-    anchor.set_href(&url);
-    anchor.set_download(name);
-    anchor.click();
-    web_sys::Url::revoke_object_url(&url).map_err(js)
-}
 
 /// The state of a link's fragment, or the default scene and a message.
 fn state_of_link(hash: &str) -> (AppState, Option<String>) {
@@ -216,6 +202,8 @@ impl WebApp {
                 .unwrap_or_else(AppState::first_run);
             (state.sanitised(), None)
         };
+        let ctx = cc.egui_ctx.clone();
+        platform::set_picked_waker(move || ctx.request_repaint());
         let mut viewer = Viewer::new(state);
         if let Some(rs) = &cc.wgpu_render_state {
             viewer.export.set_gpu(rs.clone());
@@ -234,6 +222,8 @@ impl WebApp {
             reported: false,
             webgpu,
             reads: Vec::new(),
+            reported_brdfs: 0,
+            reported_errors: 0,
         }
     }
 
@@ -277,7 +267,8 @@ impl WebApp {
 
     /// Takes the files dropped on the page before the viewer sees them (it
     /// would look for them on a disk the page does not have) and starts
-    /// reading them; opens the scene files that have been read.
+    /// reading them; opens the files that have been read, and those picked
+    /// in the browser's file chooser.
     fn dropped(&mut self, ctx: &egui::Context) {
         let files = ctx.input_mut(|i| std::mem::take(&mut i.raw.dropped_files));
         for f in files {
@@ -291,7 +282,7 @@ impl WebApp {
             });
             self.reads.push(rx);
         }
-        let mut read = Vec::new();
+        let mut read = platform::take_picked();
         self.reads.retain(|rx| match rx.try_recv() {
             Ok(r) => {
                 read.push(r);
@@ -300,16 +291,27 @@ impl WebApp {
             Err(std::sync::mpsc::TryRecvError::Empty) => true,
             Err(std::sync::mpsc::TryRecvError::Disconnected) => false,
         });
+        let several = read.len() > 1;
         for (name, bytes) in read {
-            if !name.ends_with(&format!(".{}", scene_file::EXTENSION)) {
-                self.message = Some(format!(
-                    "{name}: the page opens scene files (.{}) only; MERL tables and \
-                     environment maps need the desktop bv for now",
-                    scene_file::EXTENSION
-                ));
-                continue;
+            match bytes {
+                Ok(bytes) => self.open_bytes(&name, bytes, several),
+                Err(e) => self.message = Some(format!("{name} could not be read: {e}")),
             }
-            let opened = bytes.and_then(scene_file::utf8_text).and_then(|t| {
+        }
+    }
+
+    /// Opens a file the page was handed as bytes, as the desktop opens the
+    /// file of that name: a scene file replaces the scene; an environment
+    /// map becomes the environment view's; a MERL table or a `.brdf` model
+    /// becomes a BRDF (or the selected BRDF's file, as a drop on the desktop
+    /// does). The bytes are handed to bv's readers under the file's name
+    /// ([`bv_core::fsio::provide`]), so the one loading path reads them.
+    fn open_bytes(&mut self, name: &str, bytes: Vec<u8>, several: bool) {
+        let ext = name
+            .rsplit_once('.')
+            .map_or(String::new(), |(_, e)| e.to_ascii_lowercase());
+        if ext == scene_file::EXTENSION {
+            let opened = scene_file::utf8_text(bytes).and_then(|t| {
                 scene_file::from_toml_in(&t, None, Builds::Warn).map_err(|e| e.to_string())
             });
             match opened {
@@ -321,13 +323,57 @@ impl WebApp {
                 }
                 Err(e) => self.message = Some(format!("{name}: {e}")),
             }
+            return;
         }
+        let path = std::path::Path::new(name);
+        let viewer = &mut self.inner.viewer;
+        if crate::views::environment::ENVIRONMENT_FILES.accepts(path) {
+            bv_core::fsio::provide(name, bytes);
+            let mut env = viewer.state().lighting.env.clone();
+            env.map = Some(name.to_string());
+            viewer.push(Command::SetEnvView(env));
+            info(&format!("opened the environment map {name}"));
+            return;
+        }
+        let brdf_file = crate::session::user_models::is_file(name);
+        if brdf_file
+            || crate::session::loader::file_model_for(path)
+                .is_some_and(|(_, _, f)| f.extensions().contains(&ext.as_str()))
+        {
+            bv_core::fsio::provide(name, bytes);
+            let c = super::viewer::file_command(viewer.state(), viewer.runtime(), name, several);
+            viewer.push(c);
+            info(&format!("opening the file {name}"));
+            return;
+        }
+        self.message = Some(format!(
+            "{name}: not a file bv opens (scene files .{}, MERL tables, .brdf models, \
+             environment maps)",
+            scene_file::EXTENSION
+        ));
+    }
+
+    /// Tells the console when the number of BRDFs or of files that could not
+    /// be opened changes (what a test driver waits for after a drop).
+    fn report(&mut self) {
+        let n = self.inner.viewer.state().brdfs.len();
+        if n != self.reported_brdfs {
+            self.reported_brdfs = n;
+            info(&format!("{n} BRDFs"));
+        }
+        let errors = self.inner.viewer.load_errors();
+        if errors.len() > self.reported_errors {
+            for e in &errors[self.reported_errors..] {
+                info(&format!("could not open {}: {}", e.path, e.message));
+            }
+        }
+        self.reported_errors = errors.len();
     }
 
     fn save_scene(&mut self) {
         let saved = scene_file::to_toml(self.inner.viewer.state())
             .map_err(|e| e.to_string())
-            .and_then(|t| download("bv-scene.toml", "application/toml", t.as_bytes()));
+            .and_then(|t| platform::download("bv-scene.toml", t.as_bytes()));
         if let Err(e) = saved {
             self.message = Some(format!("The scene could not be saved: {e}"));
         }
@@ -405,13 +451,11 @@ impl eframe::App for WebApp {
         }
         self.follow_hash();
         self.dropped(&ctx);
-        // Work the desktop runs on threads runs here between frames; the
-        // rest of each frame keeps the page answering meanwhile.
-        if platform::run_pending(Duration::from_millis(30)) {
-            ctx.request_repaint();
-        }
+        let t0 = platform::Instant::now();
         self.inner.ui(ui, frame);
+        self.report();
         self.overlay(&ctx);
+        platform::set_frame_cost(t0.elapsed());
         if !self.reported {
             self.reported = true;
             info("first frame");

@@ -179,10 +179,24 @@ pub fn save_png(img: &image::RgbaImage, path: &Path) -> Result<()> {
 /// devices, directories and read-only files are refused and a symlink is
 /// written through to its target ([`bv_core::fsio::write_atomic`]); the
 /// error names the file once and says why.
+///
+/// In a browser page the file becomes a download named by `path`'s file
+/// name (the page has no file system to write to).
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    bv_core::fsio::create_parent_dirs(path)?;
-    bv_core::fsio::write_atomic(path, |f| f.write_all(bytes))?;
-    Ok(())
+    #[cfg(target_arch = "wasm32")]
+    {
+        let name = path
+            .file_name()
+            .map_or_else(|| "bv-figure".into(), |n| n.to_string_lossy().into_owned());
+        crate::session::platform::download(&name, bytes)
+            .map_err(|e| anyhow::anyhow!("the browser refused the download of {name}: {e}"))
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        bv_core::fsio::create_parent_dirs(path)?;
+        bv_core::fsio::write_atomic(path, |f| f.write_all(bytes))?;
+        Ok(())
+    }
 }
 
 /// Whether an image has more than one colour (a blank render is one colour).

@@ -551,9 +551,23 @@ pub fn utf8_text(bytes: Vec<u8>) -> Result<String, String> {
 }
 
 /// Writes a scene file atomically (see [`write_atomic`]), with its file
-/// paths as [`to_toml_for`] writes them.
+/// paths as [`to_toml_for`] writes them. In a browser page the file becomes
+/// a download named by `path`'s file name.
 pub fn save(path: &Path, state: &AppState) -> Result<(), SceneError> {
     let text = to_toml_for(path, state)?;
+    #[cfg(target_arch = "wasm32")]
+    {
+        let name = path
+            .file_name()
+            .map_or_else(|| "scene.toml".into(), |n| n.to_string_lossy().into_owned());
+        super::platform::download(&name, text.as_bytes()).map_err(|reason| {
+            SceneError::File(bv_core::BvError::File {
+                path: name.clone(),
+                reason: format!("the browser refused the download: {reason}"),
+            })
+        })
+    }
+    #[cfg(not(target_arch = "wasm32"))]
     write_atomic(path, |f| f.write_all(text.as_bytes()))
 }
 

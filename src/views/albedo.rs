@@ -59,6 +59,61 @@ pub struct AlbedoData {
     pub rho_hh: Estimate,
 }
 
+/// The computation of an [`AlbedoData`] in steps: a few θi per step (as
+/// many as there are worker threads, computed in parallel; one in a browser
+/// page, where a step must fit in a slice of a frame), then ρhh.
+#[derive(Debug)]
+pub struct AlbedoJob {
+    phi_i: f64,
+    thetas: Vec<f64>,
+    rho: Vec<Estimate>,
+    per_step: usize,
+}
+
+impl AlbedoJob {
+    /// A job for the curve at azimuth `phi_i` (radians) computing
+    /// `per_step` θi per step (at least one).
+    pub fn new(phi_i: f64, per_step: usize) -> Self {
+        Self {
+            phi_i,
+            thetas: theta_grid(N_THETA),
+            rho: Vec::with_capacity(N_THETA),
+            per_step: per_step.max(1),
+        }
+    }
+
+    /// Steps finished ([`STEPS`] in all).
+    pub fn done(&self) -> usize {
+        self.rho.len()
+    }
+
+    /// Computes the next θi of `brdf` (or, once all are done, ρhh) and
+    /// returns the curve once it is complete. `brdf` must be the same at
+    /// every step.
+    pub fn step(&mut self, brdf: &dyn Brdf) -> Option<AlbedoData> {
+        let k0 = self.rho.len();
+        if k0 < self.thetas.len() {
+            let k1 = (k0 + self.per_step).min(self.thetas.len());
+            let phi_i = self.phi_i;
+            let part: Vec<Estimate> = self.thetas[k0..k1]
+                .par_iter()
+                .enumerate()
+                .map(|(j, &t)| {
+                    rho_hd_auto(brdf, t, phi_i, &options(stream_seed(SEED, (k0 + j) as u64)))
+                })
+                .collect();
+            self.rho.extend(part);
+            return None;
+        }
+        let rho_hh = rho_hh_auto(brdf, RHH_SAMPLES, &options(SEED));
+        Some(AlbedoData {
+            theta_deg: self.thetas.iter().map(|t| t.to_degrees()).collect(),
+            rho: std::mem::take(&mut self.rho),
+            rho_hh,
+        })
+    }
+}
+
 impl AlbedoData {
     /// Computes the curve of `brdf` for light at azimuth `phi_i` (radians),
     /// counting finished steps in `progress` ([`STEPS`] in all); `None` when
@@ -69,30 +124,18 @@ impl AlbedoData {
         progress: &AtomicUsize,
         cancel: &AtomicBool,
     ) -> Option<Self> {
-        let thetas = theta_grid(N_THETA);
-        let rho: Option<Vec<Estimate>> = thetas
-            .par_iter()
-            .enumerate()
-            .map(|(k, &t)| {
-                if cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
-                let e = rho_hd_auto(brdf, t, phi_i, &options(stream_seed(SEED, k as u64)));
-                progress.fetch_add(1, Ordering::Relaxed);
-                Some(e)
-            })
-            .collect();
-        let rho = rho?;
-        if cancel.load(Ordering::Relaxed) {
-            return None;
+        // Every θi in one parallel step: the one-shot computation.
+        let mut job = AlbedoJob::new(phi_i, N_THETA);
+        loop {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let d = job.step(brdf);
+            progress.store(job.done() + usize::from(d.is_some()), Ordering::Relaxed);
+            if d.is_some() {
+                return d;
+            }
         }
-        let rho_hh = rho_hh_auto(brdf, RHH_SAMPLES, &options(SEED));
-        progress.fetch_add(1, Ordering::Relaxed);
-        Some(Self {
-            theta_deg: thetas.iter().map(|t| t.to_degrees()).collect(),
-            rho,
-            rho_hh,
-        })
     }
 
     /// The plotted value (channel mean) and its band half-width at sample `k`.
@@ -181,16 +224,25 @@ fn start(key: &Key, brdf: Arc<dyn Brdf>, phi_i: f64, ctx: &egui::Context) -> Arc
         },
     );
     let (p, k, ctx) = (progress.clone(), key.clone(), ctx.clone());
-    let spawned = crate::session::platform::spawn("bv albedo", move || {
-        match AlbedoData::compute(brdf.as_ref(), phi_i, &p, &cancel) {
-            Some(d) => store(k, Arc::new(d)),
-            None => {
-                if let Ok(mut c) = CACHE.lock() {
-                    c.running.remove(&k);
-                }
+    let mut job = AlbedoJob::new(phi_i, rayon::current_num_threads());
+    let spawned = crate::session::platform::spawn_steps("bv albedo", move || {
+        if cancel.load(Ordering::Relaxed) {
+            if let Ok(mut c) = CACHE.lock() {
+                c.running.remove(&k);
             }
+            ctx.request_repaint();
+            return true;
         }
-        ctx.request_repaint();
+        let d = job.step(brdf.as_ref());
+        p.store(job.done() + usize::from(d.is_some()), Ordering::Relaxed);
+        match d {
+            Some(d) => {
+                store(k.clone(), Arc::new(d));
+                ctx.request_repaint();
+                true
+            }
+            None => false,
+        }
     });
     if spawned.is_err() {
         c.running.remove(key);
@@ -527,6 +579,49 @@ mod tests {
         }
         assert!((mean_rgb(d.rho_hh.value) - 0.6).abs() < 0.01);
         assert!(!d.exceeds_one());
+    }
+
+    /// A job of one θi per step (as in a browser page) gives the curve that
+    /// bv-core's estimators give called one θi at a time here, and so the
+    /// one-shot computation's.
+    #[test]
+    fn the_curve_in_steps_is_the_one_shot_curve() {
+        let b = bv_core::ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"alpha": 0.3, "kd": 0.2}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let phi = 0.4;
+        let mut job = AlbedoJob::new(phi, 1);
+        let mut steps = 0;
+        let stepped = loop {
+            steps += 1;
+            if let Some(d) = job.step(b.as_ref()) {
+                break d;
+            }
+        };
+        assert_eq!(steps, STEPS);
+        let thetas = theta_grid(N_THETA);
+        let by_hand: Vec<Estimate> = thetas
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| rho_hd_auto(b.as_ref(), t, phi, &options(stream_seed(SEED, k as u64))))
+            .collect();
+        assert_eq!(stepped.rho, by_hand);
+        assert_eq!(
+            stepped.rho_hh,
+            rho_hh_auto(b.as_ref(), RHH_SAMPLES, &options(SEED))
+        );
+        let once = AlbedoData::compute(
+            b.as_ref(),
+            phi,
+            &AtomicUsize::new(0),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        assert_eq!(stepped, once);
     }
 
     #[test]

@@ -16,7 +16,26 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-type Job<V> = Box<dyn FnOnce() -> V + Send>;
+/// A job in steps: each call does a bounded slice of the work and gives the
+/// value once it is finished ([`platform::spawn_steps`] runs it).
+type Job<V> = Box<dyn FnMut() -> Option<V> + Send>;
+
+/// A one-shot computation as a job of one step.
+pub fn once<V>(
+    compute: impl FnOnce() -> V + Send + 'static,
+) -> impl FnMut() -> Option<V> + Send + 'static {
+    let mut compute = Some(compute);
+    move || compute.take().map(|f| f())
+}
+
+/// Runs a job of steps to its end on the calling thread (figures, tests).
+pub fn run_to_end<V>(mut step: impl FnMut() -> Option<V>) -> V {
+    loop {
+        if let Some(v) = step() {
+            return v;
+        }
+    }
+}
 
 /// A finished result.
 #[derive(Debug)]
@@ -77,13 +96,14 @@ where
     }
 
     /// The latest finished result of `slot` (whatever its key), starting
-    /// `compute` on a background thread if `key` is neither finished nor
-    /// running. `notify` runs when a job finishes (e.g. a repaint request).
+    /// `compute` (a job in steps, see [`once`] for a single one) in the
+    /// background if `key` is neither finished nor running. `notify` runs
+    /// when a job finishes (e.g. a repaint request).
     pub fn request(
         self: &Arc<Self>,
         slot: u64,
         key: K,
-        compute: impl FnOnce() -> V + Send + 'static,
+        compute: impl FnMut() -> Option<V> + Send + 'static,
         notify: impl Fn() + Send + Sync + 'static,
     ) -> Option<Arc<Done<K, V>>> {
         let mut g = self.lock();
@@ -158,8 +178,8 @@ where
     }
 
     /// A view's result for this frame and whether a job of `slot` still
-    /// runs. A figure (`now`) gets the result of `key`, computed here unless
-    /// it is finished; a window frame gets the latest finished result (with
+    /// runs. A figure (`now`) gets the result of `key`, computed here (all
+    /// steps of `compute`) unless it is finished; a window frame gets the latest finished result (with
     /// `true` when it is of an older key) while `compute` runs in the
     /// background, `ctx` asked for a frame when the job ends and every
     /// `poll` while it runs.
@@ -170,7 +190,7 @@ where
         key: K,
         now: bool,
         poll: Duration,
-        compute: impl FnOnce() -> V + Send + 'static,
+        compute: impl FnMut() -> Option<V> + Send + 'static,
     ) -> (Option<(V, bool)>, bool)
     where
         V: Clone,
@@ -180,7 +200,7 @@ where
                 return (Some((d.value.clone(), false)), false);
             }
             let t0 = Instant::now();
-            let v = compute();
+            let v = run_to_end(compute);
             self.insert(slot, key, v.clone(), t0.elapsed());
             return (Some((v, false)), false);
         }
@@ -216,21 +236,26 @@ where
         self: &Arc<Self>,
         slot: u64,
         key: K,
-        job: Job<V>,
+        mut job: Job<V>,
         notify: Arc<dyn Fn() + Send + Sync>,
     ) {
         let me = self.clone();
-        let run = move || {
-            let t0 = Instant::now();
+        let mut t0 = None;
+        let step = move || {
+            let t0 = *t0.get_or_insert_with(Instant::now);
             // A job that panics must not leave the slot "running" forever.
-            let out = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job));
+            let out = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(&mut job)) {
+                Ok(None) => return false,
+                Ok(Some(value)) => Some(value),
+                Err(_) => None,
+            };
             let elapsed = t0.elapsed();
             let next = {
                 let mut g = me.lock();
                 let s = g.slots.get_mut(&slot);
                 match s {
                     Some(s) => {
-                        if let Ok(value) = out {
+                        if let Some(value) = out {
                             s.done = Some(Arc::new(Done {
                                 key: key.clone(),
                                 value,
@@ -253,10 +278,11 @@ where
             };
             notify();
             if let Some((k, j)) = next {
-                me.spawn(slot, k, j, notify);
+                me.spawn(slot, k, j, notify.clone());
             }
+            true
         };
-        if platform::spawn("bv compute", run).is_err() {
+        if platform::spawn_steps("bv compute", step).is_err() {
             // No thread to be had: forget the job rather than block the UI.
             let mut g = self.lock();
             if let Some(s) = g.slots.get_mut(&slot) {
@@ -294,11 +320,11 @@ mod tests {
         let job = |v: u32| {
             let runs = runs.clone();
             let gate = gate.clone();
-            move || {
+            once(move || {
                 let _g = gate.lock();
                 runs.fetch_add(1, Ordering::SeqCst);
                 v * 10
-            }
+            })
         };
         assert!(s.request(1, 1, job(1), || {}).is_none());
         // Same key while running: nothing new. Keys 2 and 3 while running:
@@ -322,10 +348,10 @@ mod tests {
     #[test]
     fn a_panicking_job_frees_its_slot() {
         let s: Arc<Slots<u32, u32>> = Arc::new(Slots::default());
-        s.request(7, 1, || panic!("boom"), || {});
+        s.request(7, 1, once(|| panic!("boom")), || {});
         assert!(s.wait_idle(Duration::from_secs(10)));
         assert!(s.latest(7).is_none());
-        s.request(7, 2, || 5, || {});
+        s.request(7, 2, once(|| 5), || {});
         assert!(s.wait_idle(Duration::from_secs(10)));
         assert_eq!(s.latest(7).unwrap().value, 5);
     }

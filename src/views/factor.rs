@@ -9,7 +9,8 @@
 //! the order L, measured over the same table cells
 //! ([`bv_core::represent::sh_table`]); below it the first few factors: the
 //! g_k as curves over θh, the h_k as small images over (θd, φd). The work is
-//! done on a background thread and cached by the BRDF's build revision;
+//! done in the background (in steps, so that a browser page draws between
+//! them) and cached by the BRDF's build revision;
 //! figures compute it before drawing. Anisotropic models are refused with the
 //! reason: the table has no φh axis.
 
@@ -52,32 +53,80 @@ pub struct FactorData {
 /// The view's result: its data or why there is none.
 pub type Outcome = Arc<Result<FactorData, String>>;
 
+/// What [`step`] has finished so far.
+#[derive(Default)]
+struct Partial {
+    table: Option<(bv_core::measured::merl::MerlTable, Duration)>,
+    factored: Option<Arc<Factored>>,
+    sh_job: Option<sh_table::ShTableJob>,
+    sh_error: Option<TableErrors>,
+}
+
+#[cfg(test)]
 fn compute(
     brdf: &dyn bv_core::Brdf,
     id: u64,
     revision: u64,
     tables: &Slots<u64, factor_overlay::FactoredOutcome>,
 ) -> Outcome {
-    let run = || -> Result<FactorData, String> {
-        let factored = factor_overlay::factored(tables, id, revision, brdf)?;
-        let sh_error = sh_table::sh_table_error(
-            brdf,
-            &factored.table,
-            sh::MAX_ORDER,
-            sh_table::VIEW_INCIDENT,
-            super::sh_overlay::RINGS,
-            &|_| true,
-        )
-        .map_err(|e| e.to_string())?;
-        let svd_error = sh_table::factor_table_error(&factored.fac, &factored.table)
-            .map_err(|e| e.to_string())?;
-        Ok(FactorData {
+    let mut partial = Partial::default();
+    background::run_to_end(|| step(&mut partial, brdf, id, revision, tables))
+}
+
+/// Quadrature rings, and θh rows of the table, per step of SH's errors: a
+/// few per worker thread (one worker in a browser page, where a step must
+/// fit in a slice of a frame).
+fn sh_step_size() -> (usize, usize) {
+    let threads = rayon::current_num_threads();
+    (4 * threads, threads)
+}
+
+/// One step of the view's computation (so that a browser page draws
+/// between them): the factorisation (tabulation, then the SVDs), SH's errors
+/// over the table (a few rings of one lobe's projection, or a few rows of
+/// the table, a step), then the rank-K rebuilds' errors.
+fn step(
+    partial: &mut Partial,
+    brdf: &dyn bv_core::Brdf,
+    id: u64,
+    revision: u64,
+    tables: &Slots<u64, factor_overlay::FactoredOutcome>,
+) -> Option<Outcome> {
+    let fail = |e: String| Some(Arc::new(Err(e)));
+    let Some(factored) = partial.factored.clone() else {
+        match factor_overlay::factored_step(tables, id, revision, brdf, &mut partial.table)? {
+            Ok(f) => partial.factored = Some(f),
+            Err(e) => return fail(e),
+        }
+        return None;
+    };
+    let Some(sh_error) = partial.sh_error.take() else {
+        let job = match &mut partial.sh_job {
+            Some(j) => j,
+            None => match sh_table::ShTableJob::new(
+                sh::MAX_ORDER,
+                sh_table::VIEW_INCIDENT,
+                super::sh_overlay::RINGS,
+            ) {
+                Ok(j) => partial.sh_job.insert(j),
+                Err(e) => return fail(e.to_string()),
+            },
+        };
+        let (rings, rows) = sh_step_size();
+        match job.step(brdf, &factored.table, rings, rows)? {
+            Ok(e) => partial.sh_error = Some(e),
+            Err(e) => return fail(e.to_string()),
+        }
+        return None;
+    };
+    match sh_table::factor_table_error(&factored.fac, &factored.table) {
+        Ok(svd_error) => Some(Arc::new(Ok(FactorData {
             factored,
             svd_error,
             sh_error,
-        })
-    };
-    Arc::new(run())
+        }))),
+        Err(e) => fail(e.to_string()),
+    }
 }
 
 fn slots(ctx: &egui::Context) -> Arc<Slots<u64, Outcome>> {
@@ -110,14 +159,11 @@ impl FactorView {
         let tables = factor_overlay::factorizations(ctx);
         let (id, rev) = (b.id, b.revision);
         let brdf = b.brdf.clone();
-        let (shown, busy) = slots(ctx).for_frame(
-            ctx,
-            id,
-            rev,
-            scene.figure,
-            Duration::from_millis(100),
-            move || compute(brdf.as_ref(), id, rev, &tables),
-        );
+        let (shown, busy) =
+            slots(ctx).for_frame(ctx, id, rev, scene.figure, Duration::from_millis(100), {
+                let mut partial = Partial::default();
+                move || step(&mut partial, brdf.as_ref(), id, rev, &tables)
+            });
         self.waiting = busy;
         shown
     }

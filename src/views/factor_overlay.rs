@@ -50,21 +50,39 @@ pub fn factored(
     revision: u64,
     brdf: &dyn Brdf,
 ) -> FactoredOutcome {
+    let mut table = None;
+    background::run_to_end(|| factored_step(slots, id, revision, brdf, &mut table))
+}
+
+/// One step of [`factored`], for a job that must not block for long (a
+/// browser page draws between steps): the tabulation (kept in `table`),
+/// then the truncated SVDs ([`factor::factor_model`]'s two halves).
+pub fn factored_step(
+    slots: &Slots<u64, FactoredOutcome>,
+    id: u64,
+    revision: u64,
+    brdf: &dyn Brdf,
+    table: &mut Option<(MerlTable, std::time::Duration)>,
+) -> Option<FactoredOutcome> {
     if let Some(d) = slots.latest(id).filter(|d| d.key == revision) {
-        return d.value.clone();
+        return Some(d.value.clone());
     }
     let t0 = crate::session::platform::Instant::now();
-    let v = factor::factor_model(
-        brdf,
-        factor::VIEW_DIMS,
-        usize::from(Display::MAX_FACTOR_TERMS),
-        SPACE,
-        &|_| true,
-    )
-    .map(|(table, fac)| Arc::new(Factored { table, fac }))
-    .map_err(|e| e.to_string());
-    slots.insert(id, revision, v.clone(), t0.elapsed());
-    v
+    let Some((t, before)) = table.take() else {
+        if let Some(why) = factor::unsupported(brdf) {
+            return Some(Err(why));
+        }
+        match bv_core::measured::merl::tabulate(brdf, factor::VIEW_DIMS) {
+            Ok(t) => *table = Some((t, t0.elapsed())),
+            Err(e) => return Some(Err(e.to_string())),
+        }
+        return None;
+    };
+    let v = factor::factor(&t, usize::from(Display::MAX_FACTOR_TERMS), SPACE)
+        .map(|fac| Arc::new(Factored { table: t, fac }))
+        .map_err(|e| e.to_string());
+    slots.insert(id, revision, v.clone(), before + t0.elapsed());
+    Some(v)
 }
 
 /// The space the views factor in: `f cos θi cos θo`
@@ -202,10 +220,23 @@ pub fn request(ctx: &egui::Context, scene: &Scene<'_>) -> Option<FactorDone> {
         return Some(slots.insert(id, key, v, t0.elapsed()));
     }
     let ctx2 = ctx.clone();
+    // In steps (a browser page draws between them): the factorisation,
+    // unless another view made it, then the rebuilt lobe.
+    let mut table = None;
+    let mut factored_yet = false;
     slots.request(
         id,
         key,
-        move || compute(brdf.as_ref(), id, key, &tables),
+        move || {
+            if !factored_yet {
+                match factored_step(&tables, id, key.revision, brdf.as_ref(), &mut table)? {
+                    Ok(_) => factored_yet = true,
+                    Err(e) => return Some(Err(e)),
+                }
+                return None;
+            }
+            Some(compute(brdf.as_ref(), id, key, &tables))
+        },
         move || ctx2.request_repaint(),
     )
 }

@@ -116,7 +116,7 @@ impl ReciprocityView {
         let done = slots.request(
             b.id,
             key,
-            move || Arc::new(reciprocity_map(brdf.as_ref(), wi, res, res)),
+            background::once(move || Arc::new(reciprocity_map(brdf.as_ref(), wi, res, res))),
             move || c.request_repaint(),
         );
         self.waiting = slots.busy(b.id);

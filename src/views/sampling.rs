@@ -9,14 +9,15 @@
 //! All three panels use Lambert's azimuthal equal-area disc (centre: the
 //! normal, rim: the horizon), on which the bins of
 //! `bv_core::analysis::sample_histogram` are annulus sectors of equal area.
-//! The histogram is computed on a background thread and cached by the BRDF's
-//! revision and ωi; figures compute it before drawing.
+//! The histogram is computed in the background (in steps of a few thousand
+//! evaluations, so that a browser page keeps drawing) and cached by the
+//! BRDF's revision and ωi; figures compute it before drawing.
 
 use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
 use crate::session::command::Command;
 use bv_core::analysis::reciprocity_map::hemisphere_to_disc;
-use bv_core::analysis::sample_histogram::{HistogramOptions, SampleHistogram, sample_histogram};
+use bv_core::analysis::sample_histogram::{HistogramJob, HistogramOptions, SampleHistogram};
 use eframe::egui::{
     self, Align2, Color32, FontId, Mesh, Pos2, Rect, Sense, Shape, Stroke, Ui, Vec2,
 };
@@ -55,8 +56,21 @@ pub fn options() -> HistogramOptions {
 
 type Outcome = Arc<Result<SampleHistogram, String>>;
 
-fn compute(brdf: &dyn bv_core::Brdf, wi: DVec3) -> Outcome {
-    Arc::new(sample_histogram(brdf, wi, &options()).map_err(|e| e.to_string()))
+/// Draws or density evaluations per step of the background job: a few
+/// milliseconds of an analytic model in a browser page, where a step must
+/// fit in a slice of a frame.
+const WORK_PER_STEP: usize = 8192;
+
+/// One step of the histogram's computation (`job` holds it between steps).
+fn step(job: &mut Option<HistogramJob>, brdf: &dyn bv_core::Brdf, wi: DVec3) -> Option<Outcome> {
+    let j = match job {
+        Some(j) => j,
+        None => match HistogramJob::new(wi, &options()) {
+            Ok(j) => job.insert(j),
+            Err(e) => return Some(Arc::new(Err(e.to_string()))),
+        },
+    };
+    j.step(brdf, WORK_PER_STEP).map(|h| Arc::new(Ok(h)))
 }
 
 /// The verdict line of a histogram.
@@ -117,7 +131,10 @@ impl SamplingView {
             key_of(scene, b),
             scene.figure,
             Duration::from_millis(50),
-            move || compute(brdf.as_ref(), wi),
+            {
+                let mut job = None;
+                move || step(&mut job, brdf.as_ref(), wi)
+            },
         );
         self.waiting = busy;
         shown
@@ -343,6 +360,35 @@ impl View for SamplingView {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The view's histogram, computed in its background job's steps.
+    fn compute(brdf: &dyn bv_core::Brdf, wi: DVec3) -> Outcome {
+        let mut job = None;
+        background::run_to_end(|| step(&mut job, brdf, wi))
+    }
+
+    /// The steps of the background job add up to the one-shot histogram of
+    /// bv-core (same draws, same bins, same χ²), though the job takes
+    /// `SAMPLES / WORK_PER_STEP` and more steps.
+    #[test]
+    fn the_stepped_histogram_is_the_one_shot_one() {
+        let ct = bv_core::ModelSpec::new("cook-torrance")
+            .unwrap()
+            .build()
+            .unwrap();
+        let wi = DVec3::new(0.5, -0.2, 0.8).normalize();
+        let mut job = None;
+        let mut steps = 0;
+        let stepped = background::run_to_end(|| {
+            steps += 1;
+            step(&mut job, ct.as_ref(), wi)
+        });
+        assert!(steps > SAMPLES / WORK_PER_STEP, "{steps} steps");
+        let once =
+            bv_core::analysis::sample_histogram::sample_histogram(ct.as_ref(), wi, &options())
+                .unwrap();
+        assert_eq!(stepped.as_ref().as_ref().unwrap(), &once);
+    }
 
     /// Lambert's cosine sampler matches its density; a sampler that draws
     /// uniformly while claiming the cosine density is rejected.

@@ -6,9 +6,10 @@
 //! in a lecture: a sharp lobe needs L ≳ 1/width, so at low orders its peak is
 //! flattened and the reconstruction rings (and goes negative, drawn as 0).
 //!
-//! The projection costs tens of milliseconds at L = 16, so it runs on a
-//! background thread ([`super::background`]), keyed by everything it depends
-//! on; both views read the one result.
+//! The projection costs tens of milliseconds at L = 16, so it runs in the
+//! background ([`super::background`]; in steps of a few quadrature rings, so
+//! that a browser page keeps drawing), keyed by everything it depends on;
+//! both views read the one result.
 
 use super::background::{self, Done};
 use super::{Scene, curves};
@@ -100,9 +101,37 @@ impl Brdf for ShBrdf<'_> {
 
 /// Projects `brdf`'s lobe for `key` and builds what the views draw.
 pub fn compute(brdf: &dyn Brdf, brdf_id: u64, key: ShKey) -> ShOutcome {
+    let mut job = None;
+    background::run_to_end(|| step(&mut job, brdf, brdf_id, key))
+}
+
+/// Quadrature rings summed per step of the background job: a few per
+/// worker thread (one worker in a browser page, where a step must fit in a
+/// slice of a frame: 4 rings of 256 directions at L = 16 take a few
+/// milliseconds there).
+fn rings_per_step() -> usize {
+    4 * rayon::current_num_threads()
+}
+
+/// One step of [`compute`]: a few quadrature rings of the projection
+/// (`job` holds it between steps), and once it is done the mesh and the
+/// plane of incidence.
+fn step(
+    job: &mut Option<sh::ProjectJob>,
+    brdf: &dyn Brdf,
+    brdf_id: u64,
+    key: ShKey,
+) -> Option<ShOutcome> {
     let (t, p) = (key.incident.0.to_radians(), key.incident.1.to_radians());
     let wi = frame::from_spherical(t, p);
-    let lobe = sh::project(brdf, wi, key.order, key.cosine, RINGS).map_err(|e| e.to_string())?;
+    let j = match job {
+        Some(j) => j,
+        None => match sh::ProjectJob::for_brdf(brdf, key.order, RINGS) {
+            Ok(j) => job.insert(j),
+            Err(e) => return Some(Err(e.to_string())),
+        },
+    };
+    let lobe = j.step(&sh::lobe_fn(brdf, wi, key.cosine), rings_per_step())?;
     let view = ShBrdf(&lobe);
     let mesh = lobe::build(
         &view,
@@ -120,12 +149,12 @@ pub fn compute(brdf: &dyn Brdf, brdf_id: u64, key: ShKey) -> ShOutcome {
         },
     );
     let plane = curves::plane_of_incidence(&view, t, p, PLANE_SAMPLES, false);
-    Ok(ShResult {
+    Some(Ok(ShResult {
         lobe,
         mesh: Arc::new(mesh),
         plane,
         brdf_id,
-    })
+    }))
 }
 
 /// The key for the scene's primary BRDF, if the overlay is on.
@@ -165,10 +194,11 @@ pub fn request(ctx: &egui::Context, scene: &Scene<'_>) -> Option<ShDone> {
         return Some(slots.insert(id, key, v, t0.elapsed()));
     }
     let ctx2 = ctx.clone();
+    let mut job = None;
     slots.request(
         id,
         key,
-        move || compute(brdf.as_ref(), id, key),
+        move || step(&mut job, brdf.as_ref(), id, key),
         move || ctx2.request_repaint(),
     )
 }

@@ -130,6 +130,8 @@ fn confirm_window(ctx: &egui::Context, path: &Path) -> Option<Answer> {
 pub struct Files<T> {
     pending: Option<Pending<T>>,
     last_dir: Option<PathBuf>,
+    /// A browser page's save, chosen at once (see [`Files::save`]).
+    ready: Option<(T, PathBuf)>,
 }
 
 impl<T> Default for Files<T> {
@@ -137,6 +139,7 @@ impl<T> Default for Files<T> {
         Self {
             pending: None,
             last_dir: None,
+            ready: None,
         }
     }
 }
@@ -165,8 +168,16 @@ impl<T> Files<T> {
             .unwrap_or_else(|| PathBuf::from("."))
     }
 
-    /// Shows an open dialog for `filter`'s files.
+    /// Shows an open dialog for `filter`'s files. In a browser page, opens
+    /// the browser's file chooser instead: the page has no folders to show,
+    /// and the files chosen arrive as bytes
+    /// ([`crate::session::platform::take_picked`]), like dropped ones.
     pub fn open(&mut self, tag: T, title: &str, filter: Filter) {
+        if crate::session::platform::WEB {
+            let _ = (tag, title);
+            crate::session::platform::pick_files(filter.extensions);
+            return;
+        }
         let mut d = FileDialog::open_file()
             .title(title)
             .initial_path(self.start_dir())
@@ -183,8 +194,15 @@ impl<T> Files<T> {
         });
     }
 
-    /// Shows a save dialog proposing `default_name`.
+    /// Shows a save dialog proposing `default_name`. In a browser page the
+    /// name is taken at once (the file becomes a download, which the browser
+    /// names or asks about itself).
     pub fn save(&mut self, tag: T, title: &str, filter: Filter, default_name: &str) {
+        if crate::session::platform::WEB {
+            let _ = title;
+            self.ready = Some((tag, filter.with_extension(Path::new(default_name))));
+            return;
+        }
         let mut d = FileDialog::save_file()
             .title(title)
             .initial_path(self.start_dir())
@@ -209,6 +227,9 @@ impl<T> Files<T> {
     /// (saved names get the filter's extension; an existing file only once
     /// the user said to replace it). Cancelling drops the dialog.
     pub fn show(&mut self, ctx: &egui::Context) -> Option<(T, PathBuf)> {
+        if let Some(r) = self.ready.take() {
+            return Some(r);
+        }
         let p = self.pending.as_mut()?;
         if let Some(path) = p.confirm.clone() {
             if p.confirm_frames < 3 {

@@ -28,6 +28,13 @@
 //! - an existing file's permission bits (and, where allowed, owner) are
 //!   copied to the new file.
 //!
+//! # Files handed in as bytes ([`provide`])
+//! A process without a file system (a browser page) is handed the files the
+//! user drops or picks as bytes; it puts them here under their names, and
+//! bv's readers ([`read_capped`], the MERL reader, `.brdf` files) find them
+//! here before they look on a disk. Nothing is here unless a caller put it
+//! there, so on the desktop the readers behave as above.
+//!
 //! Errors are [`BvError::File`]: the path as given once, then one reason that
 //! includes the system's message once.
 
@@ -147,6 +154,12 @@ pub fn open_regular(path: &Path, cap: u64, what: &str) -> Result<(File, u64)> {
 /// Reads all of `path` (see [`open_regular`]) into memory, holding at most
 /// `cap` bytes even if the file grows meanwhile.
 pub fn read_capped(path: &Path, cap: u64, what: &str) -> Result<Vec<u8>> {
+    if let Some(p) = provided(path) {
+        if p.bytes.len() as u64 > cap {
+            return Err(too_big(path, Some(p.bytes.len() as u64), cap, what));
+        }
+        return Ok(p.bytes.to_vec());
+    }
     let (file, len) = open_regular(path, cap, what)?;
     let mut bytes = Vec::new();
     // `len` is at most `cap`; reserve what the file says, not more.
@@ -488,6 +501,48 @@ mod tests {
     }
 
     #[test]
+    fn provided_files_are_read_by_name_before_the_disk() {
+        // A name that no disk has, and one that shadows a real file.
+        let d = temp_dir("provided");
+        let real = d.join("real.txt");
+        std::fs::write(&real, b"on disk").unwrap();
+        let virtual_name = Path::new("bv-test-provided/only-in-memory.txt");
+        assert!(provided(virtual_name).is_none());
+        assert!(read_capped(virtual_name, 100, "a test file").is_err());
+        provide(virtual_name, b"first".to_vec());
+        let g1 = provided(virtual_name).unwrap().generation;
+        assert_eq!(
+            read_capped(virtual_name, 100, "a test file").unwrap(),
+            b"first"
+        );
+        provide(virtual_name, b"second".to_vec());
+        let p = provided(virtual_name).unwrap();
+        assert!(
+            p.generation > g1
+                && p.stamp()
+                    != Provided {
+                        generation: g1,
+                        ..p.clone()
+                    }
+                    .stamp()
+        );
+        assert_eq!(
+            read_capped(virtual_name, 100, "a test file").unwrap(),
+            b"second"
+        );
+        let e = read_capped(virtual_name, 3, "a test file")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("over the 3 bytes limit"), "{e}");
+        provide(&real, b"in memory".to_vec());
+        assert_eq!(
+            read_capped(&real, 100, "a test file").unwrap(),
+            b"in memory"
+        );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
     fn reads_regular_files_and_refuses_the_rest() {
         let d = temp_dir("read");
         let f = d.join("a.txt");
@@ -579,4 +634,65 @@ mod tests {
         assert_eq!(cap_text(1 << 20), "1 MiB");
         assert_eq!(human_bytes(100_000_000), "100000000 bytes (95.4 MiB)");
     }
+}
+
+/// Most files kept by [`provide`] (the oldest goes first); a full MERL table
+/// is 34 MB.
+pub const MAX_PROVIDED: usize = 8;
+
+/// A file handed in with [`provide`].
+#[derive(Debug, Clone)]
+pub struct Provided {
+    /// Its contents.
+    pub bytes: std::sync::Arc<[u8]>,
+    /// Counts the calls of [`provide`] in the process: a file handed in again
+    /// under the same name has a larger one (caches keyed by it read it
+    /// again).
+    pub generation: u64,
+}
+
+impl Provided {
+    /// A stand-in for the modification time, for caches keyed by one
+    /// (different for every generation; no clock is read).
+    pub fn stamp(&self) -> std::time::SystemTime {
+        std::time::UNIX_EPOCH + std::time::Duration::from_nanos(self.generation)
+    }
+}
+
+type ProvidedFiles = (u64, Vec<(PathBuf, Provided)>);
+
+fn provided_files() -> std::sync::MutexGuard<'static, ProvidedFiles> {
+    static FILES: std::sync::Mutex<ProvidedFiles> = std::sync::Mutex::new((0, Vec::new()));
+    // The list is whole between statements: a panic elsewhere leaves it usable.
+    FILES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Hands bv the contents of the file `path` (see the module's notes): from
+/// now on bv's readers find it here, before any disk. Handing in the same
+/// path again replaces its contents. At most [`MAX_PROVIDED`] files are kept.
+pub fn provide(path: impl Into<PathBuf>, bytes: impl Into<std::sync::Arc<[u8]>>) {
+    let path = path.into();
+    let mut g = provided_files();
+    g.0 += 1;
+    let generation = g.0;
+    g.1.retain(|(p, _)| *p != path);
+    if g.1.len() >= MAX_PROVIDED {
+        g.1.remove(0);
+    }
+    g.1.push((
+        path,
+        Provided {
+            bytes: bytes.into(),
+            generation,
+        },
+    ));
+}
+
+/// The file handed in under `path` with [`provide`], if any.
+pub fn provided(path: &Path) -> Option<Provided> {
+    provided_files()
+        .1
+        .iter()
+        .find(|(p, _)| p == path)
+        .map(|(_, f)| f.clone())
 }

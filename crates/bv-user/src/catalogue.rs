@@ -125,12 +125,19 @@ static LOADED: LazyLock<Mutex<HashMap<PathBuf, Stamp>>> =
     LazyLock::new(|| Mutex::new(HashMap::new()));
 
 fn stamp_of(path: &Path) -> Option<(Option<SystemTime>, u64)> {
+    if let Some(p) = bv_core::fsio::provided(path) {
+        return Some((Some(p.stamp()), p.bytes.len() as u64));
+    }
     let m = std::fs::metadata(path).ok()?;
     Some((m.modified().ok(), m.len()))
 }
 
 /// The canonical form of a user-named path (errors name it as given).
 pub fn canonical(path: &Path) -> Result<PathBuf> {
+    // A file handed in as bytes (a browser page's) is known by its name.
+    if bv_core::fsio::provided(path).is_some() {
+        return Ok(path.to_path_buf());
+    }
     std::fs::canonicalize(path).map_err(|e| UserError::Read {
         file: path.display().to_string(),
         reason: e.to_string(),

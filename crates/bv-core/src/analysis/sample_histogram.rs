@@ -116,96 +116,181 @@ pub fn sample_histogram(
     wo: DVec3,
     opts: &HistogramOptions,
 ) -> Result<SampleHistogram> {
-    let HistogramOptions {
-        n_theta,
-        n_phi,
-        samples,
-        ..
-    } = *opts;
-    if n_theta == 0 || n_phi == 0 || n_theta > MAX_BINS || n_phi > MAX_BINS {
-        return Err(BvError::Invalid(format!(
-            "histogram bins must be 1..={MAX_BINS} per axis, got {n_theta} × {n_phi}"
-        )));
-    }
-    if samples == 0 || samples > MAX_SAMPLES {
-        return Err(BvError::Invalid(format!(
-            "sample count must be 1..={MAX_SAMPLES}, got {samples}"
-        )));
-    }
-    if opts.quadrature_order == 0 || opts.quadrature_order > 64 {
-        return Err(BvError::Invalid(format!(
-            "quadrature order must be 1..=64, got {}",
-            opts.quadrature_order
-        )));
-    }
-    let mut observed = vec![0u64; n_theta * n_phi];
-    let mut failed = 0u64;
-    let mut points = Vec::with_capacity(opts.max_points.min(samples));
-    let mut rng = sampling::rng(opts.seed);
-    for _ in 0..samples {
-        let u = sampling::uniform2(&mut rng);
-        match brdf
-            .sample(wo, u)
-            .and_then(|w| bin_of(w, n_theta, n_phi).map(|b| (w, b)))
-        {
-            Some((w, (t, p))) => {
-                observed[t * n_phi + p] += 1;
-                if points.len() < opts.max_points {
-                    points.push(w);
-                }
-            }
-            None => failed += 1,
+    let mut job = HistogramJob::new(wo, opts)?;
+    loop {
+        if let Some(h) = job.step(brdf, usize::MAX) {
+            return Ok(h);
         }
+    }
+}
+
+/// [`sample_histogram`] in steps of bounded work, for a caller that cannot
+/// block for the whole computation (a browser page without threads runs a
+/// few steps per frame). The draws come from one random stream kept between
+/// steps and the bins are integrated one at a time, so the result does not
+/// depend on how the work is cut.
+#[derive(Debug, Clone)]
+pub struct HistogramJob {
+    wo: DVec3,
+    opts: HistogramOptions,
+    rng: sampling::BvRng,
+    drawn: usize,
+    observed: Vec<u64>,
+    failed: u64,
+    points: Vec<DVec3>,
+    gl: Vec<(f64, f64)>,
+    /// `∫_bin pdf dω` of the bins integrated so far, row-major.
+    mass: Vec<f64>,
+}
+
+impl HistogramJob {
+    /// A job for [`sample_histogram`]`(·, wo, opts)`; the options are checked
+    /// here.
+    pub fn new(wo: DVec3, opts: &HistogramOptions) -> Result<Self> {
+        let HistogramOptions {
+            n_theta,
+            n_phi,
+            samples,
+            ..
+        } = *opts;
+        if n_theta == 0 || n_phi == 0 || n_theta > MAX_BINS || n_phi > MAX_BINS {
+            return Err(BvError::Invalid(format!(
+                "histogram bins must be 1..={MAX_BINS} per axis, got {n_theta} × {n_phi}"
+            )));
+        }
+        if samples == 0 || samples > MAX_SAMPLES {
+            return Err(BvError::Invalid(format!(
+                "sample count must be 1..={MAX_SAMPLES}, got {samples}"
+            )));
+        }
+        if opts.quadrature_order == 0 || opts.quadrature_order > 64 {
+            return Err(BvError::Invalid(format!(
+                "quadrature order must be 1..=64, got {}",
+                opts.quadrature_order
+            )));
+        }
+        Ok(Self {
+            wo,
+            opts: *opts,
+            rng: sampling::rng(opts.seed),
+            drawn: 0,
+            observed: vec![0u64; n_theta * n_phi],
+            failed: 0,
+            points: Vec::with_capacity(opts.max_points.min(samples)),
+            gl: gauss_legendre(opts.quadrature_order),
+            mass: Vec::with_capacity(n_theta * n_phi),
+        })
     }
 
-    // ∫_bin pdf dω = ∫∫ pdf dz dφ (dω = dz dφ), Gauss–Legendre in each.
-    let gl = gauss_legendre(opts.quadrature_order);
-    let dz = 1.0 / n_theta as f64;
-    let dphi = 2.0 * PI / n_phi as f64;
-    let mut expected = vec![0.0f64; n_theta * n_phi];
-    for t in 0..n_theta {
-        let z_hi = 1.0 - t as f64 * dz;
-        for p in 0..n_phi {
-            let phi_lo = p as f64 * dphi;
-            let mut sum = 0.0;
-            for &(xz, wz) in &gl {
-                let z = z_hi - 0.5 * dz * (xz + 1.0);
-                let s = (1.0 - z * z).max(0.0).sqrt();
-                for &(xp, wp) in &gl {
-                    let phi = phi_lo + 0.5 * dphi * (xp + 1.0);
-                    let w = DVec3::new(s * phi.cos(), s * phi.sin(), z);
-                    let v = brdf.pdf(wo, w);
-                    if v.is_finite() && v > 0.0 {
-                        sum += wz * wp * v;
+    /// The share of the work done, in `[0, 1]`.
+    pub fn progress(&self) -> f64 {
+        let bins = self.observed.len();
+        let q2 = self.gl.len() * self.gl.len();
+        let total = self.opts.samples + bins * q2;
+        (self.drawn + self.mass.len() * q2) as f64 / total as f64
+    }
+
+    /// Does about `work` evaluations (draws, or density evaluations inside
+    /// the bins; at least one draw or one bin) and returns the histogram once
+    /// everything is done.
+    pub fn step(&mut self, brdf: &dyn Brdf, work: usize) -> Option<SampleHistogram> {
+        let HistogramOptions {
+            n_theta,
+            n_phi,
+            samples,
+            ..
+        } = self.opts;
+        if self.drawn < samples {
+            let n = work.clamp(1, samples - self.drawn);
+            for _ in 0..n {
+                let u = sampling::uniform2(&mut self.rng);
+                match brdf
+                    .sample(self.wo, u)
+                    .and_then(|w| bin_of(w, n_theta, n_phi).map(|b| (w, b)))
+                {
+                    Some((w, (t, p))) => {
+                        self.observed[t * n_phi + p] += 1;
+                        if self.points.len() < self.opts.max_points {
+                            self.points.push(w);
+                        }
                     }
+                    None => self.failed += 1,
                 }
             }
-            expected[t * n_phi + p] = sum * 0.25 * dz * dphi;
+            self.drawn += n;
+            return None;
+        }
+        let bins = n_theta * n_phi;
+        if self.mass.len() < bins {
+            let q2 = self.gl.len() * self.gl.len();
+            let n = (work / q2).clamp(1, bins - self.mass.len());
+            for _ in 0..n {
+                let k = self.mass.len();
+                self.mass.push(self.bin_mass(brdf, k / n_phi, k % n_phi));
+            }
+            if self.mass.len() < bins {
+                return None;
+            }
+        }
+        Some(self.finish())
+    }
+
+    /// `∫_bin pdf dω = ∫∫ pdf dz dφ` (dω = dz dφ) over bin `(t, p)`,
+    /// Gauss–Legendre in each.
+    fn bin_mass(&self, brdf: &dyn Brdf, t: usize, p: usize) -> f64 {
+        let dz = 1.0 / self.opts.n_theta as f64;
+        let dphi = 2.0 * PI / self.opts.n_phi as f64;
+        let z_hi = 1.0 - t as f64 * dz;
+        let phi_lo = p as f64 * dphi;
+        let mut sum = 0.0;
+        for &(xz, wz) in &self.gl {
+            let z = z_hi - 0.5 * dz * (xz + 1.0);
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            for &(xp, wp) in &self.gl {
+                let phi = phi_lo + 0.5 * dphi * (xp + 1.0);
+                let w = DVec3::new(s * phi.cos(), s * phi.sin(), z);
+                let v = brdf.pdf(self.wo, w);
+                if v.is_finite() && v > 0.0 {
+                    sum += wz * wp * v;
+                }
+            }
+        }
+        sum * 0.25 * dz * dphi
+    }
+
+    fn finish(&mut self) -> SampleHistogram {
+        let HistogramOptions {
+            n_theta,
+            n_phi,
+            samples,
+            ..
+        } = self.opts;
+        let mut expected = std::mem::take(&mut self.mass);
+        let pdf_mass: f64 = expected.iter().sum();
+        let n = samples as f64;
+        for e in &mut expected {
+            *e *= n;
+        }
+        let expected_failed = (n * (1.0 - pdf_mass)).max(0.0);
+        let observed = std::mem::take(&mut self.observed);
+        let mut obs_all = observed.clone();
+        obs_all.push(self.failed);
+        let mut exp_all = expected.clone();
+        exp_all.push(expected_failed);
+        let chi2 = chi_square(&obs_all, &exp_all, self.opts.min_expected);
+        SampleHistogram {
+            n_theta,
+            n_phi,
+            samples,
+            observed,
+            expected,
+            failed: self.failed,
+            expected_failed,
+            pdf_mass,
+            points: std::mem::take(&mut self.points),
+            chi2,
         }
     }
-    let pdf_mass: f64 = expected.iter().sum();
-    let n = samples as f64;
-    for e in &mut expected {
-        *e *= n;
-    }
-    let expected_failed = (n * (1.0 - pdf_mass)).max(0.0);
-    let mut obs_all = observed.clone();
-    obs_all.push(failed);
-    let mut exp_all = expected.clone();
-    exp_all.push(expected_failed);
-    let chi2 = chi_square(&obs_all, &exp_all, opts.min_expected);
-    Ok(SampleHistogram {
-        n_theta,
-        n_phi,
-        samples,
-        observed,
-        expected,
-        failed,
-        expected_failed,
-        pdf_mass,
-        points,
-        chi2,
-    })
 }
 
 #[cfg(test)]
@@ -250,6 +335,37 @@ mod tests {
         fn pdf(&self, _wi: DVec3, wo: DVec3) -> f64 {
             sampling::cosine_hemisphere_pdf(wo)
         }
+    }
+
+    #[test]
+    fn the_histogram_in_small_steps_is_the_one_shot_histogram() {
+        // The draws share one stream and the bins are integrated one at a
+        // time whatever the step, so any cut gives the same numbers.
+        let b = model("lambert", json!({"albedo": 0.5}));
+        let wo = from_spherical(0.4, 1.0);
+        let once = sample_histogram(b.as_ref(), wo, &opts(9)).unwrap();
+        for work in [1, 37, 1000] {
+            let mut job = HistogramJob::new(wo, &opts(9)).unwrap();
+            let mut steps = 0;
+            let h = loop {
+                steps += 1;
+                if let Some(h) = job.step(b.as_ref(), work) {
+                    break h;
+                }
+            };
+            assert!(steps > 20_000 / work, "{work}: {steps} steps");
+            assert_eq!(h, once, "work {work}");
+        }
+        assert!(
+            HistogramJob::new(
+                wo,
+                &HistogramOptions {
+                    samples: 0,
+                    ..opts(1)
+                }
+            )
+            .is_err()
+        );
     }
 
     #[test]

@@ -508,6 +508,10 @@ impl MerlTable {
     ) -> Result<Self> {
         let path = path.as_ref();
         let name = path.display().to_string();
+        if let Some(p) = fsio::provided(path) {
+            let len = p.bytes.len() as u64;
+            return Self::read_from_with_progress(&p.bytes[..], len, &name, progress);
+        }
         // A regular file no larger than the largest table: a FIFO, a device
         // or a directory is refused before it is read (see `crate::fsio`).
         let (file, len) = fsio::open_regular(path, MAX_FILE_BYTES, "a MERL .binary table")?;
@@ -866,6 +870,9 @@ pub fn read_cached(path: impl AsRef<Path>) -> Result<Arc<MerlTable>> {
 
 /// Identity of a file for the cache: canonical path, modification time, size.
 fn cache_key(path: &Path) -> Result<(PathBuf, Option<std::time::SystemTime>, u64)> {
+    if let Some(p) = fsio::provided(path) {
+        return Ok((path.to_path_buf(), Some(p.stamp()), p.bytes.len() as u64));
+    }
     let name = path.display().to_string();
     let canon = std::fs::canonicalize(path).map_err(|e| file_err(&name, e.to_string()))?;
     let meta = std::fs::metadata(&canon).map_err(|e| file_err(&name, e.to_string()))?;

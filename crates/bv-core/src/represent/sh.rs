@@ -219,68 +219,155 @@ pub fn project_fn(
     order: usize,
     n_theta: usize,
 ) -> Result<ShLobe> {
-    let n_theta = check_args(order, n_theta)?;
-    let q = Quadrature::new(domain, n_theta);
-    let nc = num_coeffs(order);
-    let sample = |w: DVec3| {
-        let v = g(w);
-        if v.is_finite() { v } else { Rgb::ZERO }
-    };
-    // Pass 1: coefficients, one partial sum per ring, in parallel.
-    let coeffs = q
-        .rings
-        .par_iter()
-        .map(|&(z, wt)| {
-            let mut acc = vec![Rgb::ZERO; nc];
-            let mut y = [0.0f64; num_coeffs(MAX_ORDER)];
-            for j in 0..q.n_phi {
-                let w = q.direction(z, j);
-                let v = sample(w) * wt;
-                eval_basis(order, w, &mut y);
-                for (a, &b) in acc.iter_mut().zip(&y[..nc]) {
-                    *a += v * b;
-                }
-            }
-            acc
+    let mut job = ProjectJob::new(domain, order, n_theta)?;
+    loop {
+        if let Some(lobe) = job.step(&g, usize::MAX) {
+            return Ok(lobe);
+        }
+    }
+}
+
+/// [`project_fn`] in steps of a bounded number of quadrature rings, for a
+/// caller that cannot block for the whole projection (a browser page
+/// without threads runs a few steps per frame). The rings of one step are
+/// summed in parallel and the steps' sums added up; the result differs from
+/// the one-shot projection only by the order of the additions.
+#[derive(Debug, Clone)]
+pub struct ProjectJob {
+    q: Quadrature,
+    order: usize,
+    domain: Domain,
+    /// Rings done: the coefficients' pass, then as many again for the error.
+    rings_done: usize,
+    coeffs: Vec<Rgb>,
+    /// The squared error and the squared norm summed so far.
+    err: (f64, f64),
+}
+
+impl ProjectJob {
+    /// A job for [`project_fn`]`(·, domain, order, n_theta)`; the order and
+    /// ring count are checked here.
+    pub fn new(domain: Domain, order: usize, n_theta: usize) -> Result<Self> {
+        let n_theta = check_args(order, n_theta)?;
+        Ok(Self {
+            q: Quadrature::new(domain, n_theta),
+            order,
+            domain,
+            rings_done: 0,
+            coeffs: vec![Rgb::ZERO; num_coeffs(order)],
+            err: (0.0, 0.0),
         })
-        .reduce(
-            || vec![Rgb::ZERO; nc],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(b) {
-                    *x += y;
-                }
-                a
-            },
-        );
-    let mut lobe = ShLobe {
-        order,
-        coeffs,
-        domain,
-        rel_l2_error: 0.0,
-        n_theta,
-    };
-    // Pass 2: error over the domain.
-    let (err2, norm2) = q
-        .rings
-        .par_iter()
-        .map(|&(z, wt)| {
-            let (mut e, mut n) = (0.0, 0.0);
-            for j in 0..q.n_phi {
-                let w = q.direction(z, j);
-                let v = mean_rgb(sample(w));
-                let r = mean_rgb(lobe.eval(w));
-                e += wt * (r - v) * (r - v);
-                n += wt * v * v;
+    }
+
+    /// The job of [`project`]`(brdf, ·, order, ·, n_theta)`: its steps take
+    /// [`lobe_fn`]`(brdf, wi, cosine)`.
+    pub fn for_brdf(brdf: &dyn Brdf, order: usize, n_theta: usize) -> Result<Self> {
+        Self::new(brdf_domain(brdf), order, n_theta)
+    }
+
+    /// The share of the work done, in `[0, 1]`.
+    pub fn progress(&self) -> f64 {
+        self.rings_done as f64 / (2 * self.q.rings.len()) as f64
+    }
+
+    /// Sums `g` over the next `rings` quadrature rings (at least one) and
+    /// returns the projection once both passes are done. `g` must be the same
+    /// function at every step.
+    pub fn step(&mut self, g: &(impl Fn(DVec3) -> Rgb + Sync), rings: usize) -> Option<ShLobe> {
+        let n = self.q.rings.len();
+        let nc = num_coeffs(self.order);
+        let order = self.order;
+        let q = &self.q;
+        let sample = |w: DVec3| {
+            let v = g(w);
+            if v.is_finite() { v } else { Rgb::ZERO }
+        };
+        if self.rings_done < n {
+            // Pass 1: coefficients, one partial sum per ring, in parallel.
+            let end = self.rings_done.saturating_add(rings.max(1)).min(n);
+            let part = q.rings[self.rings_done..end]
+                .par_iter()
+                .map(|&(z, wt)| {
+                    let mut acc = vec![Rgb::ZERO; nc];
+                    let mut y = [0.0f64; num_coeffs(MAX_ORDER)];
+                    for j in 0..q.n_phi {
+                        let w = q.direction(z, j);
+                        let v = sample(w) * wt;
+                        eval_basis(order, w, &mut y);
+                        for (a, &b) in acc.iter_mut().zip(&y[..nc]) {
+                            *a += v * b;
+                        }
+                    }
+                    acc
+                })
+                .reduce(
+                    || vec![Rgb::ZERO; nc],
+                    |mut a, b| {
+                        for (x, y) in a.iter_mut().zip(b) {
+                            *x += y;
+                        }
+                        a
+                    },
+                );
+            for (x, y) in self.coeffs.iter_mut().zip(part) {
+                *x += y;
             }
-            (e, n)
-        })
-        .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-    lobe.rel_l2_error = if norm2 > 0.0 {
-        (err2 / norm2).sqrt()
+            self.rings_done = end;
+            return None;
+        }
+        // Pass 2: error over the domain.
+        let mut lobe = ShLobe {
+            order,
+            coeffs: self.coeffs.clone(),
+            domain: self.domain,
+            rel_l2_error: 0.0,
+            n_theta: n,
+        };
+        let r0 = self.rings_done - n;
+        let end = r0.saturating_add(rings.max(1)).min(n);
+        let (e, nn) = q.rings[r0..end]
+            .par_iter()
+            .map(|&(z, wt)| {
+                let (mut e, mut n) = (0.0, 0.0);
+                for j in 0..q.n_phi {
+                    let w = q.direction(z, j);
+                    let v = mean_rgb(sample(w));
+                    let r = mean_rgb(lobe.eval(w));
+                    e += wt * (r - v) * (r - v);
+                    n += wt * v * v;
+                }
+                (e, n)
+            })
+            .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+        self.err.0 += e;
+        self.err.1 += nn;
+        self.rings_done = n + end;
+        if end < n {
+            return None;
+        }
+        let (err2, norm2) = self.err;
+        lobe.rel_l2_error = if norm2 > 0.0 {
+            (err2 / norm2).sqrt()
+        } else {
+            0.0
+        };
+        Some(lobe)
+    }
+}
+
+/// The function [`project`] projects: `f(wi, ·)`, or `f(wi, ·) cos θo` when
+/// `cosine` (for [`ProjectJob::step`]).
+pub fn lobe_fn(brdf: &dyn Brdf, wi: DVec3, cosine: bool) -> impl Fn(DVec3) -> Rgb + Sync + '_ {
+    move |wo| lobe_value(brdf, wi, wo, cosine)
+}
+
+/// The hemisphere, or the sphere for a transmitting model.
+fn brdf_domain(brdf: &dyn Brdf) -> Domain {
+    if brdf.transmits() {
+        Domain::Sphere
     } else {
-        0.0
-    };
-    Ok(lobe)
+        Domain::Hemisphere
+    }
 }
 
 /// The lobe of `brdf` at `wi` (`f`, or `f cos θo` when `cosine`), projected
@@ -293,17 +380,7 @@ pub fn project(
     cosine: bool,
     n_theta: usize,
 ) -> Result<ShLobe> {
-    let domain = if brdf.transmits() {
-        Domain::Sphere
-    } else {
-        Domain::Hemisphere
-    };
-    project_fn(
-        |wo| lobe_value(brdf, wi, wo, cosine),
-        domain,
-        order,
-        n_theta,
-    )
+    project_fn(lobe_fn(brdf, wi, cosine), brdf_domain(brdf), order, n_theta)
 }
 
 fn lobe_value(brdf: &dyn Brdf, wi: DVec3, wo: DVec3, cosine: bool) -> Rgb {
@@ -358,6 +435,41 @@ mod tests {
         let mut y = vec![0.0; num_coeffs(order)];
         eval_basis(order, w, &mut y);
         y
+    }
+
+    #[test]
+    fn a_projection_in_steps_of_one_ring_is_the_one_shot_projection() {
+        // A lobe with a peak: x³-weighted cosine power; any smooth g will do,
+        // the sums are the same ones in another order.
+        let g = |w: DVec3| Rgb::new(w.z.max(0.0).powi(8), (w.x * w.z).abs(), 0.3);
+        let once = project_fn(g, Domain::Hemisphere, 6, 24).unwrap();
+        let mut job = ProjectJob::new(Domain::Hemisphere, 6, 24).unwrap();
+        let mut steps = 0;
+        let stepped = loop {
+            steps += 1;
+            assert!(job.progress() < 1.0 || steps > 48);
+            if let Some(l) = job.step(&g, 1) {
+                break l;
+            }
+        };
+        // One ring a step: both passes over 24 rings.
+        assert_eq!(steps, 48);
+        assert_eq!((stepped.order, stepped.n_theta), (once.order, once.n_theta));
+        for (a, b) in stepped.coeffs.iter().zip(&once.coeffs) {
+            assert!((*a - *b).abs().max_element() < 1e-12, "{a:?} vs {b:?}");
+        }
+        assert!((stepped.rel_l2_error - once.rel_l2_error).abs() < 1e-12);
+        // And Lambert's ρ/π projects onto Y00 alone over the sphere: the
+        // closed form c00 = 2√π ρ/π, independent of how the work is cut.
+        let lambert = |_: DVec3| Rgb::splat(0.5 / PI);
+        let mut job = ProjectJob::new(Domain::Sphere, 2, 8).unwrap();
+        let l = loop {
+            if let Some(l) = job.step(&lambert, 3) {
+                break l;
+            }
+        };
+        assert!((l.coeffs[0].x - 2.0 * PI.sqrt() * 0.5 / PI).abs() < 1e-12);
+        assert!(l.coeffs[1..].iter().all(|c| c.abs().max_element() < 1e-12));
     }
 
     #[test]

@@ -147,87 +147,173 @@ pub fn sh_table_error(
     n_theta: usize,
     progress: Progress<'_>,
 ) -> Result<TableErrors> {
-    if max_order > MAX_ORDER {
-        return Err(BvError::Invalid(format!(
-            "SH order {max_order} is above the supported {MAX_ORDER}"
-        )));
-    }
-    if n_incident == 0 || n_incident > MAX_INCIDENT {
-        return Err(BvError::Invalid(format!(
-            "{n_incident} incident directions asked for; 1..={MAX_INCIDENT} accepted"
-        )));
-    }
-    // Stage 1 (two thirds of the work): one projection per node.
-    let mut lobes: Vec<ShLobe> = Vec::with_capacity(n_incident);
-    for n in 0..n_incident {
-        if !progress(n as f64 / n_incident as f64 * 0.67) {
+    let mut job = ShTableJob::new(max_order, n_incident, n_theta)?;
+    loop {
+        if !progress(job.progress()) {
             return Err(cancelled());
         }
-        let wi = frame::from_spherical(incident_node(n, n_incident), 0.0);
-        lobes.push(sh::project_fn(
-            |wo| {
+        if let Some(r) = job.step(brdf, table, usize::MAX, usize::MAX) {
+            if !progress(1.0) {
+                return Err(cancelled());
+            }
+            return r;
+        }
+    }
+}
+
+/// [`sh_table_error`] in steps of bounded work, for a caller that cannot
+/// block for the whole computation (a browser page without threads runs a
+/// few steps per frame). Stage 1 projects one lobe per incident node, a few
+/// quadrature rings a step ([`sh::ProjectJob`]); stage 2 compares a few θh
+/// rows of the table a step. The sums of a step are parallel and the steps'
+/// sums are added up: the result differs from the one-shot computation only
+/// by the order of the additions.
+#[derive(Debug, Clone)]
+pub struct ShTableJob {
+    max_order: usize,
+    n_incident: usize,
+    n_theta: usize,
+    lobes: Vec<ShLobe>,
+    current: Option<sh::ProjectJob>,
+    rows_done: usize,
+    /// The table's θh rows (known at the first step of stage 2).
+    rows_total: usize,
+    /// Squared errors per order (plain, cosine) and squared norms so far.
+    errors: (Vec<f64>, Vec<f64>),
+    norms: (f64, f64),
+}
+
+impl ShTableJob {
+    /// A job for [`sh_table_error`]`(·, ·, max_order, n_incident, n_theta, ·)`;
+    /// the order and node count are checked here.
+    pub fn new(max_order: usize, n_incident: usize, n_theta: usize) -> Result<Self> {
+        if max_order > MAX_ORDER {
+            return Err(BvError::Invalid(format!(
+                "SH order {max_order} is above the supported {MAX_ORDER}"
+            )));
+        }
+        if n_incident == 0 || n_incident > MAX_INCIDENT {
+            return Err(BvError::Invalid(format!(
+                "{n_incident} incident directions asked for; 1..={MAX_INCIDENT} accepted"
+            )));
+        }
+        Ok(Self {
+            max_order,
+            n_incident,
+            n_theta,
+            lobes: Vec::with_capacity(n_incident),
+            current: None,
+            rows_done: 0,
+            rows_total: 0,
+            errors: (vec![0.0; max_order + 1], vec![0.0; max_order + 1]),
+            norms: (0.0, 0.0),
+        })
+    }
+
+    /// The share of the work done, in `[0, 1]` (stage 1 counts for two
+    /// thirds), as [`sh_table_error`] reports it.
+    pub fn progress(&self) -> f64 {
+        let lobes =
+            self.lobes.len() as f64 + self.current.as_ref().map_or(0.0, sh::ProjectJob::progress);
+        if self.lobes.len() < self.n_incident {
+            return lobes / self.n_incident as f64 * 0.67;
+        }
+        0.67 + 0.33 * self.rows_done as f64 / self.rows_total.max(1) as f64
+    }
+
+    /// Does `rings` quadrature rings of the current projection (stage 1) or
+    /// `rows` θh rows of the table (stage 2; both at least one) and returns
+    /// the errors once everything is done. `brdf` and `table` must be the
+    /// same at every step.
+    pub fn step(
+        &mut self,
+        brdf: &dyn Brdf,
+        table: &MerlTable,
+        rings: usize,
+        rows: usize,
+    ) -> Option<Result<TableErrors>> {
+        if self.lobes.len() < self.n_incident {
+            let n = self.lobes.len();
+            let job = match &mut self.current {
+                Some(j) => j,
+                None => match sh::ProjectJob::new(Domain::Hemisphere, self.max_order, self.n_theta)
+                {
+                    Ok(j) => self.current.insert(j),
+                    Err(e) => return Some(Err(e)),
+                },
+            };
+            let wi = frame::from_spherical(incident_node(n, self.n_incident), 0.0);
+            let g = |wo: DVec3| {
                 if wo.z > 0.0 {
                     brdf.eval(wi, wo)
                 } else {
                     Rgb::ZERO
                 }
-            },
-            Domain::Hemisphere,
-            max_order,
-            n_theta,
-        )?);
-    }
-    if !progress(0.67) {
-        return Err(cancelled());
-    }
-    // Stage 2: every cell, every order at once (partial sums by band).
-    let d = table.dims();
-    let orders = max_order + 1;
-    let step = FRAC_PI_2 / n_incident as f64;
-    let ((ep, ec), (np, nc)) = (0..d.theta_h)
-        .into_par_iter()
-        .map(|ih| {
-            let (mut ep, mut ec) = (vec![0.0f64; orders], vec![0.0f64; orders]);
-            let (mut np, mut nc) = (0.0f64, 0.0f64);
-            let mut y = [0.0f64; num_coeffs(MAX_ORDER)];
-            let mut band = vec![Rgb::ZERO; orders];
-            for id in 0..d.theta_d {
-                for ip in 0..d.phi_d {
-                    let f = table.at(ih, id, ip);
-                    let (wi, wo) = cell_pair(d, ih, id, ip);
-                    let w2 = cosine_weight(wi, wo).powi(2);
-                    np += f.length_squared();
-                    nc += w2 * f.length_squared();
-                    band.iter_mut().for_each(|b| *b = Rgb::ZERO);
-                    if wi.z > 0.0 && wo.z > 0.0 {
-                        reconstruct_bands(&lobes, step, wi, wo, max_order, &mut y, &mut band);
-                    }
-                    let mut acc = Rgb::ZERO;
-                    for (l, b) in band.iter().enumerate() {
-                        acc += *b;
-                        let e2 = (acc.max(Rgb::ZERO) - f).length_squared();
-                        ep[l] += e2;
-                        ec[l] += w2 * e2;
+            };
+            if let Some(lobe) = job.step(&g, rings) {
+                self.lobes.push(lobe);
+                self.current = None;
+            }
+            return None;
+        }
+        // Stage 2: every cell, every order at once (partial sums by band).
+        let d = table.dims();
+        let max_order = self.max_order;
+        let orders = max_order + 1;
+        let step = FRAC_PI_2 / self.n_incident as f64;
+        let lobes = &self.lobes;
+        let end = self.rows_done.saturating_add(rows.max(1)).min(d.theta_h);
+        let ((ep, ec), (np, nc)) = (self.rows_done..end)
+            .into_par_iter()
+            .map(|ih| {
+                let (mut ep, mut ec) = (vec![0.0f64; orders], vec![0.0f64; orders]);
+                let (mut np, mut nc) = (0.0f64, 0.0f64);
+                let mut y = [0.0f64; num_coeffs(MAX_ORDER)];
+                let mut band = vec![Rgb::ZERO; orders];
+                for id in 0..d.theta_d {
+                    for ip in 0..d.phi_d {
+                        let f = table.at(ih, id, ip);
+                        let (wi, wo) = cell_pair(d, ih, id, ip);
+                        let w2 = cosine_weight(wi, wo).powi(2);
+                        np += f.length_squared();
+                        nc += w2 * f.length_squared();
+                        band.iter_mut().for_each(|b| *b = Rgb::ZERO);
+                        if wi.z > 0.0 && wo.z > 0.0 {
+                            reconstruct_bands(lobes, step, wi, wo, max_order, &mut y, &mut band);
+                        }
+                        let mut acc = Rgb::ZERO;
+                        for (l, b) in band.iter().enumerate() {
+                            acc += *b;
+                            let e2 = (acc.max(Rgb::ZERO) - f).length_squared();
+                            ep[l] += e2;
+                            ec[l] += w2 * e2;
+                        }
                     }
                 }
-            }
-            ((ep, ec), (np, nc))
-        })
-        .reduce(
-            || ((vec![0.0; orders], vec![0.0; orders]), (0.0, 0.0)),
-            |((mut a, mut b), (x, y)), ((c, e), (z, w))| {
-                a.iter_mut().zip(c).for_each(|(p, q)| *p += q);
-                b.iter_mut().zip(e).for_each(|(p, q)| *p += q);
-                ((a, b), (x + z, y + w))
-            },
-        );
-    if !progress(1.0) {
-        return Err(cancelled());
+                ((ep, ec), (np, nc))
+            })
+            .reduce(
+                || ((vec![0.0; orders], vec![0.0; orders]), (0.0, 0.0)),
+                |((mut a, mut b), (x, y)), ((c, e), (z, w))| {
+                    a.iter_mut().zip(c).for_each(|(p, q)| *p += q);
+                    b.iter_mut().zip(e).for_each(|(p, q)| *p += q);
+                    ((a, b), (x + z, y + w))
+                },
+            );
+        self.errors.0.iter_mut().zip(ep).for_each(|(p, q)| *p += q);
+        self.errors.1.iter_mut().zip(ec).for_each(|(p, q)| *p += q);
+        self.norms.0 += np;
+        self.norms.1 += nc;
+        self.rows_done = end;
+        self.rows_total = d.theta_h;
+        if end < d.theta_h {
+            return None;
+        }
+        Some(Ok(TableErrors {
+            plain: relative(std::mem::take(&mut self.errors.0), self.norms.0),
+            cosine: relative(std::mem::take(&mut self.errors.1), self.norms.1),
+        }))
     }
-    Ok(TableErrors {
-        plain: relative(ep, np),
-        cosine: relative(ec, nc),
-    })
 }
 
 /// The contribution of each band l to the interpolated reconstruction at the
