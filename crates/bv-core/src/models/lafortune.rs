@@ -16,7 +16,7 @@
 //! overflow for any exponent up to 10000 (`2^10000` would).
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{self, Dirs, Kernel, LaneKernel, Out, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -157,6 +157,8 @@ struct LafortuneLanes {
     n: [f32; MAX_LOBES],
     /// `ks · norm` per lobe and channel.
     scale: [[f32; 3]; MAX_LOBES],
+    /// Lobes in use (the first `count` slots).
+    count: usize,
 }
 
 impl LafortuneLanes {
@@ -166,6 +168,7 @@ impl LafortuneLanes {
             c: [[0.0; 3]; MAX_LOBES],
             n: [0.0; MAX_LOBES],
             scale: [[0.0; 3]; MAX_LOBES],
+            count: lobes.len().min(MAX_LOBES),
         };
         for (j, l) in lobes.iter().take(MAX_LOBES).enumerate() {
             k.c[j] = l.c.to_array();
@@ -176,16 +179,17 @@ impl LafortuneLanes {
     }
 }
 
-impl LaneKernel for LafortuneLanes {
+impl LafortuneLanes {
+    /// One lane with the first `L` lobes (the rest are unused slots).
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane_with<const L: usize>(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
         let p = [
             f64::from(wi[0]) * f64::from(wo[0]),
             f64::from(wi[1]) * f64::from(wo[1]),
             f64::from(wi[2]) * f64::from(wo[2]),
         ];
         let mut f = self.diffuse;
-        for j in 0..MAX_LOBES {
+        for j in 0..L.min(MAX_LOBES) {
             let c = self.c[j];
             let x = c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
             let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.n[j]);
@@ -195,6 +199,37 @@ impl LaneKernel for LafortuneLanes {
         }
         let above = wi[2] > 0.0 && wo[2] > 0.0;
         f.map(|v| if above { v } else { 0.0 })
+    }
+}
+
+/// [`LafortuneLanes`] compiled for exactly `L` lobes: each power costs an
+/// `exp` and a `ln` per lane, so the eight fixed slots of a one-lobe model
+/// would cost eight times its work. The lobe count is a const parameter so
+/// that the lobe loop keeps a constant trip count and the lane loop still
+/// vectorises.
+#[derive(Debug)]
+struct Lobes<'a, const L: usize>(&'a LafortuneLanes);
+
+impl<const L: usize> LaneKernel for Lobes<'_, L> {
+    #[inline(always)]
+    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+        self.0.lane_with::<L>(wi, wo)
+    }
+}
+
+impl Kernel for LafortuneLanes {
+    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        match self.count {
+            0 => batch::run(&Lobes::<0>(self), dirs, out),
+            1 => batch::run(&Lobes::<1>(self), dirs, out),
+            2 => batch::run(&Lobes::<2>(self), dirs, out),
+            3 => batch::run(&Lobes::<3>(self), dirs, out),
+            4 => batch::run(&Lobes::<4>(self), dirs, out),
+            5 => batch::run(&Lobes::<5>(self), dirs, out),
+            6 => batch::run(&Lobes::<6>(self), dirs, out),
+            7 => batch::run(&Lobes::<7>(self), dirs, out),
+            _ => batch::run(&Lobes::<MAX_LOBES>(self), dirs, out),
+        }
     }
 }
 
