@@ -129,6 +129,18 @@ fn generate(file: &BrdfFile, name: &str) -> (String, SourceMap) {
     (src, map)
 }
 
+/// The first three of naga's GLSL errors, joined: the reason shown to the
+/// user (the place is the first error's).
+pub(crate) fn glsl_reason(errors: &naga::front::glsl::ParseErrors) -> String {
+    errors
+        .errors
+        .iter()
+        .take(3)
+        .map(|e| e.kind.to_string())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 fn compile_error(map: &SourceMap, place: Option<Place>, reason: String) -> UserError {
     UserError::Compile {
         place: place.unwrap_or_else(|| map.place(0, 1)),
@@ -147,14 +159,7 @@ pub fn translate(file: &BrdfFile, name: &str) -> Result<Translated> {
             fe.parse(&options, &src).map_err(|errors| {
                 let first = errors.errors.first();
                 let place = first.and_then(|e| map.place_of_span(e.meta, &src));
-                let reason = errors
-                    .errors
-                    .iter()
-                    .take(3)
-                    .map(|e| e.kind.to_string())
-                    .collect::<Vec<_>>()
-                    .join("; ");
-                compile_error(&map, place, reason)
+                compile_error(&map, place, glsl_reason(&errors))
             })?
         }
         Language::Wgsl => naga::front::wgsl::parse_str(&src).map_err(|e| {

@@ -103,14 +103,10 @@ fn parse(src: &str, map: &SourceMap) -> Result<Module> {
             .first()
             .and_then(|e| map.place_of_span(e.meta, src))
             .unwrap_or_else(|| map.place(0, 1));
-        let reason = errors
-            .errors
-            .iter()
-            .take(3)
-            .map(|e| e.kind.to_string())
-            .collect::<Vec<_>>()
-            .join("; ");
-        UserError::Compile { place, reason }
+        UserError::Compile {
+            place,
+            reason: front::glsl_reason(&errors),
+        }
     })?;
     module.entry_points.clear();
     front::validate(&module, map, src)?;
