@@ -82,7 +82,7 @@ fn geometry(ppp: f32) -> ScreenGeometry {
 
 #[test]
 fn figures_at_1x_2x_4x_are_drawn_at_that_resolution() {
-    let v = Viewer::new(two_brdfs());
+    let mut v = Viewer::new(two_brdfs());
     let state = v.state().clone();
     let mut sizes = Vec::new();
     for scale in [1, 2, 4] {

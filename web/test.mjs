@@ -11,8 +11,8 @@
 // session persists in local storage, hostile fragments fall back to the
 // default scene with a message, long computations (albedo, sampling) run in
 // many short steps while frames keep coming, Save scene downloads the scene
-// file, and a dropped MERL table, .brdf model and environment map open. Then
-// the
+// file, Export figure (Ctrl+Shift+S, Enter) downloads a PNG of the window,
+// and a dropped MERL table, .brdf model and environment map open. Then the
 // first-frame checks again with WebGPU off (WebGL2 only). Screenshots go to
 // web/shots (or --shots DIR); timings and the renderer are printed.
 import { chromium } from "playwright-core";
@@ -537,7 +537,7 @@ async function longWorkChecks(context, gl, toml) {
   }
 }
 
-// Scenes are saved as downloads.
+// Scenes and figures are saved as downloads.
 async function downloadChecks(context, gl, toml) {
   const p = await open(context, linkOf(gl, toml), "a page that saves downloads");
   await p.page.waitForTimeout(SETTLE_MS);
@@ -554,6 +554,25 @@ async function downloadChecks(context, gl, toml) {
         `the scene downloads as a whole scene file (${text.length} characters)`);
     } catch (e) {
       check(false, `the scene downloads: ${e}`);
+    }
+  }
+  // Export figure (Ctrl+Shift+S opens the dialog, Enter saves): a PNG of
+  // the whole window, whose pixels a page can only read back between frames.
+  {
+    const download = p.page.waitForEvent("download", { timeout: 60_000 });
+    await p.page.keyboard.press("Control+Shift+S");
+    await p.page.waitForTimeout(500);
+    await p.page.keyboard.press("Enter");
+    try {
+      const d = await download;
+      const file = path.join(shots, "downloaded-figure.png");
+      await d.saveAs(file);
+      const img = decodePng(fs.readFileSync(file));
+      check(img.width >= W && img.height >= H,
+        `the window figure downloads as a PNG (${img.width}×${img.height} px, ${d.suggestedFilename()})`);
+      notBlank(img, "the downloaded window figure");
+    } catch (e) {
+      check(false, `the window figure downloads as a PNG: ${e}`);
     }
   }
   noErrors(p, "a page that saves downloads");

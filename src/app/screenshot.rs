@@ -139,6 +139,16 @@ pub struct ExportUi {
     pub toast: Option<Toast>,
     gpu: Option<eframe::egui_wgpu::RenderState>,
     svg_views: Option<Vec<&'static str>>,
+    /// PNG figures drawn and being read back (a browser page's: it maps
+    /// the pixels only between frames), saved when they are there.
+    pending: Vec<PendingPng>,
+}
+
+/// A PNG figure being read back, and where it goes.
+struct PendingPng {
+    figure: export::PendingFigure,
+    path: PathBuf,
+    what: &'static str,
 }
 
 /// Which views have a vector (SVG) form: asked of each view on an empty scene.
@@ -213,8 +223,31 @@ impl ExportUi {
                 Task::Figure(s) => Request::Figure(s, path),
             });
         }
+        self.save_pending(ctx);
         self.toast_ui(ctx);
         out
+    }
+
+    /// Saves the PNG figures whose pixels came back; asks for frames while
+    /// some have not.
+    fn save_pending(&mut self, ctx: &egui::Context) {
+        let mut done = Vec::new();
+        self.pending.retain_mut(|p| match p.figure.poll() {
+            Some(image) => {
+                done.push((image, std::mem::take(&mut p.path), p.what));
+                false
+            }
+            None => true,
+        });
+        for (image, path, what) in done {
+            match image.and_then(|img| export::save_png(&img, &path).map(|()| img)) {
+                Ok(img) => self.toast(saved_line(what, &img, &path), false),
+                Err(e) => self.toast(format!("Could not export the figure: {e:#}"), true),
+            }
+        }
+        if !self.pending.is_empty() {
+            ctx.request_repaint_after(Duration::from_millis(16));
+        }
     }
 
     fn dialog(&mut self, ctx: &egui::Context) {
@@ -312,9 +345,16 @@ impl ExportUi {
                     if ui.button("Save…").clicked() {
                         save = true;
                     }
-                    ui.weak("Ctrl+Shift+S");
+                    ui.weak("Enter saves · Ctrl+Shift+S closes");
                 });
             });
+        // Enter saves, as the button does (unless a list of the dialog is
+        // open: Enter then picks its item).
+        if !egui::Popup::is_any_open(ctx)
+            && ctx.input_mut(|i| i.consume_key(egui::Modifiers::NONE, egui::Key::Enter))
+        {
+            save = true;
+        }
         // Keep the format consistent with the target.
         let svg = matches!(&s.target, Target::View(id) if self.svg_ok(id));
         let mesh = matches!(&s.target, Target::View(id) if id == "lobe");
@@ -379,7 +419,7 @@ impl ExportUi {
     /// written. `geometry` gives the on-screen size; `view_rect` the view's
     /// size in points when one view is exported.
     pub fn export_figure(
-        &self,
+        &mut self,
         state: &AppState,
         settings: &FigureSettings,
         path: &Path,
@@ -408,23 +448,27 @@ impl ExportUi {
                     transparent: settings.transparent,
                 };
                 let mut off = self.offscreen()?;
-                let img = match entry {
+                let figure = match entry {
                     Some(e) if settings.caption => {
                         let mut captioned = state.clone();
                         captioned.display.caption = true;
-                        export::render_view(&mut off, &captioned, e, frame)?
+                        export::start_view(&mut off, &captioned, e, frame)?
                     }
-                    Some(e) => export::render_view(&mut off, state, e, frame)?,
-                    None => export::render_window(&mut off, state, frame, window)?,
+                    Some(e) => export::start_view(&mut off, state, e, frame)?,
+                    None => export::start_window(&mut off, state, frame, window)?,
                 };
+                let what = entry.map_or("the window", |e| e.title);
+                if crate::session::platform::WEB {
+                    self.pending.push(PendingPng {
+                        figure,
+                        path: path.to_path_buf(),
+                        what,
+                    });
+                    return Ok(format!("Drawing {what}…"));
+                }
+                let img = figure.wait()?;
                 export::save_png(&img, path)?;
-                Ok(format!(
-                    "Saved {} ({}×{} px) to {}",
-                    entry.map_or("the window", |e| e.title),
-                    img.width(),
-                    img.height(),
-                    path.display()
-                ))
+                Ok(saved_line(what, &img, path))
             }
             Format::Svg => {
                 let e = entry.ok_or_else(|| anyhow::anyhow!("SVG needs a 2D plot view"))?;
@@ -457,6 +501,16 @@ impl ExportUi {
             }
         }
     }
+}
+
+/// The toast line of a saved PNG figure.
+fn saved_line(what: &str, img: &image::RgbaImage, path: &Path) -> String {
+    format!(
+        "Saved {what} ({}×{} px) to {}",
+        img.width(),
+        img.height(),
+        path.display()
+    )
 }
 
 /// What the dialogs asked the viewer to do.

@@ -14,7 +14,7 @@ use crate::session::state::{AppState, Theme};
 use crate::views::ViewEntry;
 use anyhow::{Context as _, Result, bail};
 use eframe::egui;
-pub use offscreen::{Frame, Offscreen};
+pub use offscreen::{Frame, Offscreen, PendingFigure};
 use std::path::Path;
 
 /// Margin around a view in a figure, in points.
@@ -72,11 +72,22 @@ pub fn render_view(
     entry: &ViewEntry,
     frame: Frame,
 ) -> Result<image::RgbaImage> {
+    start_view(off, state, entry, frame)?.wait()
+}
+
+/// [`render_view`] without waiting for the image to be read back (a browser
+/// page takes it in a later frame).
+pub fn start_view(
+    off: &mut Offscreen,
+    state: &AppState,
+    entry: &ViewEntry,
+    frame: Frame,
+) -> Result<PendingFigure> {
     let mut runtime = Runtime::default();
     runtime.sync(state);
     check_brdfs(state, &runtime)?;
     let mut view = (entry.make)();
-    let img = off.render(frame, |ui| {
+    let img = off.start_render(frame, |ui| {
         let scene = figure_scene(state, &runtime, frame.transparent);
         let fill = if frame.transparent {
             egui::Color32::TRANSPARENT
@@ -117,14 +128,35 @@ pub fn render_window(
     render_ui(off, state, frame, make(state))
 }
 
+/// [`render_window`] without waiting for the image to be read back (a
+/// browser page takes it in a later frame).
+pub fn start_window(
+    off: &mut Offscreen,
+    state: &AppState,
+    frame: Frame,
+    make: MakeWindow,
+) -> Result<PendingFigure> {
+    start_ui(off, state, frame, make(state))
+}
+
 /// Draws `window`, a whole window's UI showing `state` (a slide of a deck,
 /// the viewer), after the checks and slow work [`render_window`] does.
 pub fn render_ui(
     off: &mut Offscreen,
     state: &AppState,
     frame: Frame,
-    mut window: Box<dyn WindowUi>,
+    window: Box<dyn WindowUi>,
 ) -> Result<image::RgbaImage> {
+    start_ui(off, state, frame, window)?.wait()
+}
+
+/// [`render_ui`] without waiting for the image to be read back.
+pub fn start_ui(
+    off: &mut Offscreen,
+    state: &AppState,
+    frame: Frame,
+    mut window: Box<dyn WindowUi>,
+) -> Result<PendingFigure> {
     // The window's albedo view computes in the background; a figure shows
     // the finished curves, so compute them first (they are cached).
     {
@@ -142,7 +174,7 @@ pub fn render_ui(
             crate::views::albedo::curve_now(&scene, b);
         }
     }
-    let img = off.render(frame, |ui| window.ui(ui))?;
+    let img = off.start_render(frame, |ui| window.ui(ui))?;
     if let Some(e) = window.error() {
         bail!("{e}");
     }

@@ -9,6 +9,7 @@
 //! never upscaled.
 
 use crate::gpu::errors::{self, ErrorLog};
+use crate::gpu::readback::PendingImage;
 use anyhow::{Context as _, Result, bail};
 use eframe::egui::{self, Vec2};
 use eframe::egui_wgpu::{self, ScreenDescriptor};
@@ -142,8 +143,20 @@ impl Offscreen {
     pub fn render(
         &mut self,
         frame: Frame,
-        mut ui: impl FnMut(&mut egui::Ui),
+        ui: impl FnMut(&mut egui::Ui),
     ) -> Result<image::RgbaImage> {
+        self.start_render(frame, ui)?.wait()
+    }
+
+    /// [`Self::render`] without waiting for the image: the drawing is
+    /// submitted and its readback started; the figure is taken with
+    /// [`PendingFigure::poll`] in a later frame (what a browser page must do:
+    /// it maps buffers only between frames).
+    pub fn start_render(
+        &mut self,
+        frame: Frame,
+        mut ui: impl FnMut(&mut egui::Ui),
+    ) -> Result<PendingFigure> {
         let [w, h] = frame.pixels();
         let max = self.max_side();
         if w > max || h > max {
@@ -167,7 +180,7 @@ impl Offscreen {
         frame: Frame,
         [w, h]: [u32; 2],
         ui: &mut impl FnMut(&mut egui::Ui),
-    ) -> Result<image::RgbaImage> {
+    ) -> Result<PendingFigure> {
         let ctx = egui::Context::default();
         ctx.set_theme(if frame.dark {
             egui::Theme::Dark
@@ -232,11 +245,13 @@ impl Offscreen {
             self.rs.renderer.write().free_texture(id);
         }
         output.textures_delta.clear();
-        let mut image = image?;
-        if frame.transparent {
-            unpremultiply(&mut image);
-        }
-        Ok(image)
+        let (texture, image) = image?;
+        Ok(PendingFigure {
+            device: self.rs.device.clone(),
+            texture,
+            image,
+            transparent: frame.transparent,
+        })
     }
 
     fn paint(
@@ -245,7 +260,7 @@ impl Offscreen {
         output: &egui::FullOutput,
         frame: Frame,
         [w, h]: [u32; 2],
-    ) -> Result<image::RgbaImage> {
+    ) -> Result<(wgpu::Texture, PendingImage)> {
         let ppp = frame.pixels_per_point;
         let screen = ScreenDescriptor {
             size_in_pixels: [w, h],
@@ -293,9 +308,55 @@ impl Offscreen {
         }
         drop(renderer);
         queue.submit(user.into_iter().chain(std::iter::once(encoder.finish())));
-        let image = crate::gpu::readback::read_rgba8(device, queue, &texture);
-        texture.destroy();
-        image
+        let image = crate::gpu::readback::start_rgba8(device, queue, &texture);
+        match image {
+            Ok(image) => Ok((texture, image)),
+            Err(e) => {
+                texture.destroy();
+                Err(e)
+            }
+        }
+    }
+}
+
+/// A figure drawn and being read back ([`Offscreen::start_render`]).
+#[derive(Debug)]
+pub struct PendingFigure {
+    device: wgpu::Device,
+    texture: wgpu::Texture,
+    image: PendingImage,
+    transparent: bool,
+}
+
+impl PendingFigure {
+    /// The figure if the GPU is done (`None` while it is not), without
+    /// blocking.
+    pub fn poll(&mut self) -> Option<Result<image::RgbaImage>> {
+        let image = self.image.poll(&self.device)?;
+        Some(image.map(|mut image| {
+            if self.transparent {
+                unpremultiply(&mut image);
+            }
+            image
+        }))
+    }
+
+    /// Blocks until the figure is there (native backends only).
+    pub fn wait(mut self) -> Result<image::RgbaImage> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| anyhow::anyhow!("waiting for the GPU: {e}"))?;
+        self.poll().unwrap_or_else(|| {
+            Err(anyhow::anyhow!(
+                "the figure was not read back after waiting"
+            ))
+        })
+    }
+}
+
+impl Drop for PendingFigure {
+    fn drop(&mut self) {
+        self.texture.destroy();
     }
 }
 

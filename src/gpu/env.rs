@@ -12,6 +12,7 @@ use super::errors;
 use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
+use super::specialised::ModelPipelines;
 use anyhow::{Context, Result, bail};
 use bv_core::ModelSpec;
 
@@ -145,14 +146,10 @@ struct Key {
 /// The progressive environment renderer.
 pub struct EnvRenderer {
     gpu: Gpu,
-    library: ShaderLibrary,
-    layout: wgpu::PipelineLayout,
     frame_layout: wgpu::BindGroupLayout,
     map_layout: wgpu::BindGroupLayout,
-    /// The generic accumulation pipeline, and those specialised for one
-    /// model (built on first use; `None` remembers a failure).
-    accumulate: wgpu::ComputePipeline,
-    specialised: std::collections::HashMap<u32, Option<wgpu::ComputePipeline>>,
+    /// The accumulation pipelines, specialised per model.
+    accumulate: ModelPipelines<wgpu::ComputePipeline>,
     show: wgpu::RenderPipeline,
     env: EnvBuffers,
     /// The accumulation, band by band (empty before the first pass).
@@ -229,6 +226,17 @@ fn compute_pipeline(
 }
 
 impl EnvRenderer {
+    /// Adopts a changed catalogue (a user's model saved): only the
+    /// pipelines whose code changed are built again, and the accumulation
+    /// restarts. `Ok(true)` when something changed.
+    pub fn follow_catalogue(&mut self) -> Result<bool> {
+        let changed = self.accumulate.follow_catalogue()?;
+        if changed {
+            self.key = None;
+        }
+        Ok(changed)
+    }
+
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
         let device = gpu.device.clone();
@@ -255,7 +263,9 @@ impl EnvRenderer {
                 bind_group_layouts: &[Some(&frame_layout), Some(&map_layout)],
                 immediate_size: 0,
             });
-        let accumulate = compute_pipeline(&gpu.device, &layout, &module);
+        let generic = compute_pipeline(&gpu.device, &layout, &module);
+        let accumulate =
+            ModelPipelines::new(&gpu.device, "env", layout, compute_pipeline, generic)?;
         let show_module = library.shader_module(&gpu.device, "env_display")?;
         let show = fullscreen::pipeline(
             &gpu.device,
@@ -267,12 +277,9 @@ impl EnvRenderer {
         let env = Self::upload(&gpu, map, 0)?;
         Ok(Self {
             gpu,
-            library: ShaderLibrary::new()?,
-            layout,
             frame_layout,
             map_layout,
             accumulate,
-            specialised: std::collections::HashMap::new(),
             show,
             env,
             accum: Vec::new(),
@@ -562,16 +569,7 @@ impl EnvRenderer {
             self.samples = 0;
         }
         let (params, refs, tables) = pack_all(models)?;
-        for r in &refs {
-            if !self.specialised.contains_key(&r.model) {
-                let built = self
-                    .library
-                    .specialised_module(&d, "env", Some(r.model))
-                    .ok()
-                    .map(|m| compute_pipeline(&d, &self.layout, &m));
-                self.specialised.insert(r.model, built);
-            }
-        }
+        self.accumulate.prepare(refs.iter().map(|r| r.model));
         if self.accum.is_empty() {
             bail!("no accumulation buffer");
         }
@@ -659,9 +657,8 @@ impl EnvRenderer {
                             entry(8, tbuf),
                         ],
                     });
-                    let p = match self.specialised.get(&r.model) {
-                        Some(Some(p)) => p,
-                        _ => &self.accumulate,
+                    let Some(p) = self.accumulate.get(r.model) else {
+                        bail!("no pipeline could be built for model {}", r.model);
                     };
                     pass.set_pipeline(p);
                     pass.set_bind_group(0, &g0, &[]);

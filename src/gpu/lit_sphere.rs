@@ -9,6 +9,7 @@ use super::errors;
 use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
+use super::specialised::ModelPipelines;
 use anyhow::{Result, bail};
 use bv_core::ModelSpec;
 use glam::DVec3;
@@ -90,11 +91,8 @@ struct ViewUniform {
 /// generic pipeline standing in while one cannot be built.
 pub struct LitSphereRenderer {
     gpu: Gpu,
-    library: ShaderLibrary,
-    layout: wgpu::PipelineLayout,
     bind_layout: wgpu::BindGroupLayout,
-    generic: wgpu::RenderPipeline,
-    specialised: std::collections::HashMap<u32, Option<wgpu::RenderPipeline>>,
+    pipelines: ModelPipelines<wgpu::RenderPipeline>,
     target: Option<Target>,
     tables: TableBuffer,
 }
@@ -102,7 +100,7 @@ pub struct LitSphereRenderer {
 impl std::fmt::Debug for LitSphereRenderer {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LitSphereRenderer")
-            .field("specialised", &self.specialised.len())
+            .field("pipelines", &self.pipelines)
             .finish_non_exhaustive()
     }
 }
@@ -183,35 +181,31 @@ impl LitSphereRenderer {
                 immediate_size: 0,
             });
         let generic = pipeline(&gpu.device, &layout, &module);
+        let pipelines = ModelPipelines::new(&gpu.device, "lit_sphere", layout, pipeline, generic)?;
         Ok(Self {
             gpu,
-            library: ShaderLibrary::new()?,
-            layout,
             bind_layout,
-            generic,
-            specialised: std::collections::HashMap::new(),
+            pipelines,
             target: None,
             tables: TableBuffer::default(),
         })
     }
 
-    /// Builds the pipeline specialised for catalogue model `model` if it is
-    /// not there yet (`None` remembers a failure: the generic one is used).
-    fn ensure_specialised(&mut self, model: u32) {
-        if self.specialised.contains_key(&model) {
-            return;
-        }
-        let built = self
-            .library
-            .specialised_module(&self.gpu.device, "lit_sphere", Some(model))
-            .ok()
-            .map(|m| pipeline(&self.gpu.device, &self.layout, &m));
-        self.specialised.insert(model, built);
+    /// Adopts a changed catalogue (a user's model saved): only the pipelines
+    /// whose code changed are built again. `Ok(true)` when something did.
+    pub fn follow_catalogue(&mut self) -> Result<bool> {
+        self.pipelines.follow_catalogue()
+    }
+
+    /// How many pipelines were compiled after the renderer was built (for
+    /// tests: what a changed catalogue cost).
+    pub fn pipelines_compiled(&self) -> u64 {
+        self.pipelines.compiled()
     }
 
     /// How many specialised pipelines exist (for tests).
     pub fn specialised_count(&self) -> usize {
-        self.specialised.values().filter(|p| p.is_some()).count()
+        self.pipelines.specialised_count()
     }
 
     /// The device it renders on.
@@ -290,9 +284,7 @@ impl LitSphereRenderer {
             bytemuck::cast_slice(&tiles),
             wgpu::BufferUsages::STORAGE,
         );
-        for r in &refs {
-            self.ensure_specialised(r.model);
-        }
+        self.pipelines.prepare(refs.iter().map(|r| r.model));
         let d = &self.gpu.device;
         let tbuf = self.tables.get(&self.gpu, &tables)?;
         let bind = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -315,9 +307,8 @@ impl LitSphereRenderer {
             if x1 <= x0 {
                 continue;
             }
-            let p = match self.specialised.get(&r.model) {
-                Some(Some(p)) => p,
-                _ => &self.generic,
+            let Some(p) = self.pipelines.get(r.model) else {
+                bail!("no pipeline could be built for model {}", r.model);
             };
             draws.push(fullscreen::Draw {
                 pipeline: p,

@@ -7,7 +7,9 @@
 //! - Shaders: [`shaders`] composes `shaders/` with naga_oil, including the
 //!   generated modules [`layout`] (parameter offsets from the declarations)
 //!   and [`colormap`] (the lobe's colour map table); [`pack`] packs models'
-//!   parameters and MERL tables into the buffers they read.
+//!   parameters and MERL tables into the buffers they read; [`specialised`]
+//!   keeps a renderer's pipelines compiled per model and follows a changed
+//!   catalogue by rebuilding only what changed.
 //! - Plumbing, one of each: [`context`] (the headless device opener, limits,
 //!   offscreen targets), [`readback`] (texture and buffer read-back),
 //!   [`fullscreen`] (full-screen triangle pipelines and passes), [`errors`]
@@ -35,6 +37,7 @@ pub mod lobe;
 pub mod pack;
 pub mod readback;
 pub mod shaders;
+pub mod specialised;
 pub mod sphere;
 
 pub use context::{Gpu, Headless, Target, gpu_for_test};

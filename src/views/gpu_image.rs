@@ -111,9 +111,12 @@ pub fn library() -> anyhow::Result<ShaderLibrary> {
 ///
 /// A renderer's shaders are composed from the catalogue as it was when it
 /// was built; when the catalogue changes (a user file opened or reloaded:
-/// [`bv_core::registry::revision`]) it is built again, and the one built
-/// before is kept and used until the new one is ready (or if it fails), so
-/// that the view keeps drawing the last working version.
+/// [`bv_core::registry::revision`]) it adopts the new one in place
+/// ([`FollowsCatalogue`]: a saved file costs the compilation of its own
+/// model's pipeline, a tenth of a second, not the whole renderer's). Only if
+/// that fails is it built again, the one built before kept and used until
+/// the new one is ready (or if it fails), so that the view keeps drawing the
+/// last working version.
 pub struct Deferred<T> {
     slot: Slot<T>,
     /// The catalogue revision the current slot was (or is being) built for.
@@ -135,6 +138,25 @@ impl<T> Default for Deferred<T> {
     }
 }
 
+/// A renderer that can adopt a changed catalogue without being built again.
+pub trait FollowsCatalogue {
+    /// Adopts the current catalogue: `Ok(true)` when what it draws changed,
+    /// an error when it cannot (it is then built again).
+    fn follow_catalogue(&mut self) -> anyhow::Result<bool>;
+}
+
+impl FollowsCatalogue for crate::gpu::LitSphereRenderer {
+    fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
+        self.follow_catalogue()
+    }
+}
+
+impl FollowsCatalogue for crate::gpu::EnvRenderer {
+    fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
+        self.follow_catalogue()
+    }
+}
+
 #[derive(Default)]
 enum Slot<T> {
     /// Not asked for yet.
@@ -148,13 +170,27 @@ enum Slot<T> {
     Failed(String),
 }
 
-impl<T: Send + 'static> Deferred<T> {
-    /// Starts a rebuild when the catalogue changed since the slot was built,
-    /// keeping a built renderer as `previous`.
+impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
+    /// Follows a catalogue that changed since the slot was built: in place
+    /// when the renderer can, else by a rebuild that keeps the built renderer
+    /// as `previous`.
     fn follow_catalogue(&mut self) {
         let now = bv_core::registry::revision();
         if self.revision == now || matches!(self.slot, Slot::Empty | Slot::Building(_)) {
             return;
+        }
+        if let Slot::Ready(t) = &mut self.slot {
+            match t.follow_catalogue() {
+                Ok(changed) => {
+                    self.revision = now;
+                    if changed {
+                        self.generation += 1;
+                    }
+                    return;
+                }
+                // The rebuild below meets the same error and shows it.
+                Err(_) => {}
+            }
         }
         if let Slot::Ready(t) = std::mem::take(&mut self.slot) {
             self.previous = Some(t);
