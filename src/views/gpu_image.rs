@@ -180,16 +180,13 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
             return;
         }
         if let Slot::Ready(t) = &mut self.slot {
-            match t.follow_catalogue() {
-                Ok(changed) => {
-                    self.revision = now;
-                    if changed {
-                        self.generation += 1;
-                    }
-                    return;
+            // On an error the rebuild below meets it too and shows it.
+            if let Ok(changed) = t.follow_catalogue() {
+                self.revision = now;
+                if changed {
+                    self.generation += 1;
                 }
-                // The rebuild below meets the same error and shows it.
-                Err(_) => {}
+                return;
             }
         }
         if let Slot::Ready(t) = std::mem::take(&mut self.slot) {
