@@ -15,6 +15,14 @@ use bv::gpu::{
 use bv_core::ModelSpec;
 use glam::DVec3;
 use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
+
+/// The catalogue is one per process: the tests here register models and
+/// watch its revision, so they take turns.
+fn serial() -> MutexGuard<'static, ()> {
+    static TURN: Mutex<()> = Mutex::new(());
+    TURN.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
 
 fn temp_file(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("bv-gpu-reload-{}-{tag}", std::process::id()));
@@ -56,6 +64,7 @@ fn centres(img: &image::RgbaImage, n: u32) -> Vec<u8> {
 
 #[test]
 fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
+    let _turn = serial();
     let Some(gpu) = gpu_for_test() else { return };
     bv::session::user_models::install();
     let path = temp_file("lit");
@@ -106,6 +115,7 @@ fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
 
 #[test]
 fn the_environment_view_restarts_its_samples_for_a_saved_model() {
+    let _turn = serial();
     let Some(gpu) = gpu_for_test() else { return };
     bv::session::user_models::install();
     let path = temp_file("env");
@@ -141,5 +151,50 @@ fn the_environment_view_restarts_its_samples_for_a_saved_model() {
         "the save changed f: {before} → {want}"
     );
     assert_eq!(after, want, "in place as from scratch");
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+}
+
+/// A model first drawn after it was saved but before the renderer followed
+/// the catalogue is drawn from the renderer's own (older) shaders; following
+/// then still compiles it again.
+#[test]
+fn a_pipeline_built_from_older_shaders_is_compiled_again_when_followed() {
+    let _turn = serial();
+    let Some(gpu) = gpu_for_test() else { return };
+    bv::session::user_models::install();
+    let path = temp_file("late");
+    std::fs::write(&path, greyish("1.0")).unwrap();
+    let models = models(&path);
+    let mut lib = ShaderLibrary::new().unwrap();
+    let mut r = LitSphereRenderer::new(gpu, &mut lib).unwrap();
+    let settings = LitSphereSettings {
+        light: DVec3::new(0.0, 0.0, 1.0),
+        ..Default::default()
+    };
+    let shown = |scale: f64| {
+        bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
+            scale * 0.5 / std::f64::consts::PI,
+        ))
+    };
+    r.render_image(&models[..1], &settings, 64, 64).unwrap();
+    std::fs::write(&path, greyish("2.0")).unwrap();
+    bv_user::load(&path).unwrap();
+    // Not followed yet: the file's sphere shows the version the renderer's
+    // shaders hold.
+    let stale = centres(
+        &r.render_image(&models[1..2], &settings, 64, 64).unwrap(),
+        1,
+    );
+    assert!(stale[0].abs_diff(shown(1.0)) <= 1, "{stale:?}");
+    assert!(r.follow_catalogue().unwrap());
+    let fresh = centres(
+        &r.render_image(&models[1..2], &settings, 64, 64).unwrap(),
+        1,
+    );
+    assert!(
+        fresh[0].abs_diff(shown(2.0)) <= 1,
+        "{fresh:?}, want {}",
+        shown(2.0)
+    );
     std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
 }

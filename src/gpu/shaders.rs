@@ -71,6 +71,8 @@ pub const ANY_MODEL: u32 = 0xffff_ffff;
 pub struct ShaderLibrary {
     composer: Composer,
     revision: u64,
+    /// The catalogue the modules were composed from.
+    catalogue: bv_core::registry::Catalogue,
 }
 
 impl std::fmt::Debug for ShaderLibrary {
@@ -84,7 +86,10 @@ impl ShaderLibrary {
     /// port of the current catalogue and the generated dispatch.
     pub fn new() -> Result<Self> {
         let mut composer = Composer::default();
+        // The revision before the snapshot: a model registered in between
+        // makes the library look older than it is, never newer.
         let revision = bv_core::registry::revision();
+        let catalogue = bv_core::catalogue();
         let mut add = |path: &str, source: &str| -> Result<()> {
             let r = composer.add_composable_module(ComposableModuleDescriptor {
                 source,
@@ -95,16 +100,23 @@ impl ShaderLibrary {
             r.map(|_| ())
                 .map_err(|e| anyhow!("{path}: {}", e.emit_to_string(&composer)))
         };
-        for (path, source) in Self::modules()? {
+        for (path, source) in Self::modules_of(&catalogue)? {
             add(&path, &source)?;
         }
-        Ok(Self { composer, revision })
+        Ok(Self {
+            composer,
+            revision,
+            catalogue,
+        })
     }
 
     /// Every composable module of the current catalogue, generated ones
     /// included, in registration order: (path, source).
     pub fn modules() -> Result<Vec<(String, String)>> {
-        let catalogue = bv_core::catalogue();
+        Self::modules_of(&bv_core::catalogue())
+    }
+
+    fn modules_of(catalogue: &[&'static bv_core::ModelInfo]) -> Result<Vec<(String, String)>> {
         let mut out = vec![
             (
                 "<generated bv::layout>".to_string(),
@@ -116,14 +128,14 @@ impl ShaderLibrary {
             ),
         ];
         out.extend(COMMON.iter().map(|(p, s)| (p.to_string(), s.to_string())));
-        for (_, m) in super::dispatch::ported(&catalogue) {
+        for (_, m) in super::dispatch::ported(catalogue) {
             if let Some(port) = &m.gpu {
                 out.push((port.path.to_string(), port.source.to_string()));
             }
         }
         out.push((
             "<generated bv::dispatch>".to_string(),
-            super::dispatch::dispatch_module(&catalogue)?,
+            super::dispatch::dispatch_module(catalogue)?,
         ));
         out.extend(
             DISPATCHERS
@@ -137,6 +149,12 @@ impl ShaderLibrary {
     /// was made for: a model registered since is not in it.
     pub fn catalogue_revision(&self) -> u64 {
         self.revision
+    }
+
+    /// The catalogue the library's modules were composed from (indices are
+    /// the models' `MODEL_*` constants).
+    pub fn catalogue(&self) -> &[&'static bv_core::ModelInfo] {
+        &self.catalogue
     }
 
     /// The composed, validated naga module of entry shader `name`.

@@ -15,7 +15,6 @@
 
 use super::shaders::ShaderLibrary;
 use anyhow::Result;
-use bv_core::ModelInfo;
 use std::collections::HashMap;
 
 /// Builds a pipeline of type `P` from a composed shader module.
@@ -78,9 +77,10 @@ impl<P> ModelPipelines<P> {
         })
     }
 
-    /// The stamp of catalogue model `model` now.
-    fn stamp(&self, catalogue: &[&'static ModelInfo], model: u32) -> Stamp {
-        match catalogue.get(model as usize) {
+    /// The stamp of catalogue model `model` in the library's catalogue (what
+    /// a pipeline built now is compiled from).
+    fn stamp(&self, model: u32) -> Stamp {
+        match self.library.catalogue().get(model as usize) {
             Some(m) if m.gpu.is_some() => Stamp::Model(std::ptr::from_ref(*m).addr()),
             _ => Stamp::Catalogue(self.library.catalogue_revision()),
         }
@@ -97,11 +97,10 @@ impl<P> ModelPipelines<P> {
         }
         self.library = ShaderLibrary::new()?;
         self.generic = None;
-        let catalogue = bv_core::catalogue();
         let now: HashMap<u32, Stamp> = self
             .specialised
             .keys()
-            .map(|&m| (m, self.stamp(&catalogue, m)))
+            .map(|&m| (m, self.stamp(m)))
             .collect();
         self.specialised
             .retain(|m, (stamp, _)| now.get(m) == Some(stamp));
@@ -111,11 +110,10 @@ impl<P> ModelPipelines<P> {
     /// Builds what drawing `models` (catalogue indices) needs: each one's
     /// specialised pipeline, and the generic one if a specialisation failed.
     pub fn prepare(&mut self, models: impl IntoIterator<Item = u32>) {
-        let catalogue = bv_core::catalogue();
         let mut need_generic = false;
         for model in models {
             if !self.specialised.contains_key(&model) {
-                let stamp = self.stamp(&catalogue, model);
+                let stamp = self.stamp(model);
                 let built = self
                     .library
                     .specialised_module(&self.device, self.entry, Some(model))
