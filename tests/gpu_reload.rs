@@ -54,6 +54,22 @@ fn models(path: &std::path::Path) -> Vec<ModelSpec> {
     vec![lambert, file, mix]
 }
 
+/// Polls `poll` (a renderer's `poll_pipelines`) until no pipeline is
+/// compiling; whether any arrived.
+fn settle(mut poll: impl FnMut() -> (bool, bool)) -> bool {
+    let t0 = std::time::Instant::now();
+    let mut any = false;
+    loop {
+        let (arrived, waiting) = poll();
+        any |= arrived;
+        if !waiting {
+            return any;
+        }
+        assert!(t0.elapsed().as_secs() < 60, "the pipelines never arrived");
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+}
+
 /// The red channel at the centre of each of `n` spheres side by side.
 fn centres(img: &image::RgbaImage, n: u32) -> Vec<u8> {
     let (w, h) = img.dimensions();
@@ -90,6 +106,11 @@ fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
     std::fs::write(&path, greyish("2.0")).unwrap();
     bv_user::load(&path).unwrap();
     assert!(r.follow_catalogue().unwrap());
+    // The draw after the change still shows the last version (the
+    // replacements compile on workers), then the new one.
+    let meanwhile = centres(&r.render_image(&models, &settings, 192, 64).unwrap(), 3);
+    assert_eq!(meanwhile, before, "the stale pipelines draw meanwhile");
+    assert!(settle(|| r.poll_pipelines()), "the replacements arrive");
     let after = centres(&r.render_image(&models, &settings, 192, 64).unwrap(), 3);
     // Lambert unchanged; the file at 2×; the mix at 1.5× (linear values,
     // so compare through the display transform).
@@ -135,6 +156,8 @@ fn the_environment_view_restarts_its_samples_for_a_saved_model() {
     std::fs::write(&path, greyish("0.25")).unwrap();
     bv_user::load(&path).unwrap();
     assert!(r.follow_catalogue().unwrap());
+    r.render_image(&models, &settings, 64, 64, 16).unwrap();
+    assert!(settle(|| r.poll_pipelines()), "the replacement arrives");
     let after = centre(&r.render_image(&models, &settings, 64, 64, 16).unwrap());
     assert_eq!(r.samples_per_pixel(), 16, "the samples restarted");
     // What a renderer built from scratch for the new catalogue draws (the
@@ -187,6 +210,8 @@ fn a_pipeline_built_from_older_shaders_is_compiled_again_when_followed() {
     );
     assert!(stale[0].abs_diff(shown(1.0)) <= 1, "{stale:?}");
     assert!(r.follow_catalogue().unwrap());
+    r.render_image(&models[1..2], &settings, 64, 64).unwrap();
+    assert!(settle(|| r.poll_pipelines()));
     let fresh = centres(
         &r.render_image(&models[1..2], &settings, 64, 64).unwrap(),
         1,

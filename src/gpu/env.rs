@@ -237,6 +237,16 @@ impl EnvRenderer {
         Ok(changed)
     }
 
+    /// Takes the pipelines that finished compiling after a catalogue change
+    /// (the accumulation restarts with them): `(arrived, waiting)`.
+    pub fn poll_pipelines(&mut self) -> (bool, bool) {
+        let (arrived, waiting) = self.accumulate.poll();
+        if arrived {
+            self.key = None;
+        }
+        (arrived, waiting)
+    }
+
     /// Builds the pipelines and uploads `map`.
     pub fn new(gpu: Gpu, library: &mut ShaderLibrary, map: &EnvironmentMap) -> Result<Self> {
         let device = gpu.device.clone();

@@ -197,6 +197,13 @@ impl LitSphereRenderer {
         self.pipelines.follow_catalogue()
     }
 
+    /// Takes the pipelines that finished compiling after a catalogue change:
+    /// `(arrived, waiting)`, whether a sphere must be drawn again, and
+    /// whether others are still compiling.
+    pub fn poll_pipelines(&mut self) -> (bool, bool) {
+        self.pipelines.poll()
+    }
+
     /// How many pipelines were compiled after the renderer was built (for
     /// tests: what a changed catalogue cost).
     pub fn pipelines_compiled(&self) -> u64 {

@@ -143,17 +143,30 @@ pub trait FollowsCatalogue {
     /// Adopts the current catalogue: `Ok(true)` when what it draws changed,
     /// an error when it cannot (it is then built again).
     fn follow_catalogue(&mut self) -> anyhow::Result<bool>;
+
+    /// Takes the pipelines compiled since for the new catalogue:
+    /// `(arrived, waiting)`, whether what it draws changed, and whether more
+    /// are still compiling.
+    fn poll_pipelines(&mut self) -> (bool, bool);
 }
 
 impl FollowsCatalogue for crate::gpu::LitSphereRenderer {
     fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
         self.follow_catalogue()
     }
+
+    fn poll_pipelines(&mut self) -> (bool, bool) {
+        self.poll_pipelines()
+    }
 }
 
 impl FollowsCatalogue for crate::gpu::EnvRenderer {
     fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
         self.follow_catalogue()
+    }
+
+    fn poll_pipelines(&mut self) -> (bool, bool) {
+        self.poll_pipelines()
     }
 }
 
@@ -173,11 +186,12 @@ enum Slot<T> {
 impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
     /// Follows a catalogue that changed since the slot was built: in place
     /// when the renderer can, else by a rebuild that keeps the built renderer
-    /// as `previous`.
-    fn follow_catalogue(&mut self) {
+    /// as `previous`. `true` when the renderer changed in place (its new
+    /// pipelines compile from its next draw on).
+    fn follow_catalogue(&mut self) -> bool {
         let now = bv_core::registry::revision();
         if self.revision == now || matches!(self.slot, Slot::Empty | Slot::Building(_)) {
-            return;
+            return false;
         }
         if let Slot::Ready(t) = &mut self.slot {
             // On an error the rebuild below meets it too and shows it.
@@ -186,12 +200,26 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
                 if changed {
                     self.generation += 1;
                 }
-                return;
+                return changed;
             }
         }
         if let Slot::Ready(t) = std::mem::take(&mut self.slot) {
             self.previous = Some(t);
         }
+        false
+    }
+
+    /// Takes the ready renderer's newly compiled pipelines (what it draws
+    /// must be drawn again when some arrived); `true` while more compile.
+    fn poll_pipelines(&mut self) -> bool {
+        let Slot::Ready(t) = &mut self.slot else {
+            return false;
+        };
+        let (arrived, waiting) = t.poll_pipelines();
+        if arrived {
+            self.generation += 1;
+        }
+        waiting
     }
 
     /// Starts `build` on a worker thread the first time (and again after the
@@ -204,7 +232,12 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
         ctx: &egui::Context,
         build: impl FnOnce() -> Result<T, String> + Send + 'static,
     ) -> Result<Option<&mut T>, String> {
-        self.follow_catalogue();
+        // The draw after a change starts compiling the new pipelines; frames
+        // keep coming until they are there.
+        let followed = self.follow_catalogue();
+        if self.poll_pipelines() || followed {
+            ctx.request_repaint_after(std::time::Duration::from_millis(15));
+        }
         if matches!(self.slot, Slot::Empty) {
             self.revision = bv_core::registry::revision();
             let (tx, rx) = std::sync::mpsc::channel();
@@ -248,6 +281,10 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
     /// building it. For figures, which are drawn in one go.
     pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
         self.follow_catalogue();
+        // A figure shows the new pipelines, not the stale ones.
+        while self.poll_pipelines() {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
         if let Slot::Building(rx) = &self.slot {
             self.generation += 1;
             self.slot = match rx.recv() {
