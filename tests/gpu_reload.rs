@@ -78,20 +78,40 @@ fn centres(img: &image::RgbaImage, n: u32) -> Vec<u8> {
         .collect()
 }
 
+/// A lit-sphere renderer, and the three models of a fresh file `tag` at
+/// scale 1 (`None` without a GPU).
+fn lit_sphere(tag: &str) -> Option<(PathBuf, Vec<ModelSpec>, LitSphereRenderer)> {
+    let gpu = gpu_for_test()?;
+    bv::session::user_models::install();
+    let path = temp_file(tag);
+    std::fs::write(&path, greyish("1.0")).unwrap();
+    let models = models(&path);
+    let r = LitSphereRenderer::new(gpu, &mut ShaderLibrary::new().unwrap()).unwrap();
+    Some((path, models, r))
+}
+
+/// A light straight above: a sphere's centre shows f · 1.
+fn head_on() -> LitSphereSettings {
+    LitSphereSettings {
+        light: DVec3::new(0.0, 0.0, 1.0),
+        ..Default::default()
+    }
+}
+
+/// The display value of a grey f = scale · 0.5 / π lit head-on.
+fn shown(scale: f64) -> u8 {
+    bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
+        scale * 0.5 / std::f64::consts::PI,
+    ))
+}
+
 #[test]
 fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
     let _turn = serial();
-    let Some(gpu) = gpu_for_test() else { return };
-    bv::session::user_models::install();
-    let path = temp_file("lit");
-    std::fs::write(&path, greyish("1.0")).unwrap();
-    let models = models(&path);
-    let mut lib = ShaderLibrary::new().unwrap();
-    let mut r = LitSphereRenderer::new(gpu, &mut lib).unwrap();
-    let settings = LitSphereSettings {
-        light: DVec3::new(0.0, 0.0, 1.0),
-        ..Default::default()
+    let Some((path, models, mut r)) = lit_sphere("lit") else {
+        return;
     };
+    let settings = head_on();
     let before = centres(&r.render_image(&models, &settings, 192, 64).unwrap(), 3);
     // The same f everywhere: three equal centres.
     assert!(
@@ -114,11 +134,6 @@ fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
     let after = centres(&r.render_image(&models, &settings, 192, 64).unwrap(), 3);
     // Lambert unchanged; the file at 2×; the mix at 1.5× (linear values,
     // so compare through the display transform).
-    let shown = |scale: f64| {
-        bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
-            scale * 0.5 / std::f64::consts::PI,
-        ))
-    };
     let want = [shown(1.0), shown(2.0), shown(1.5)];
     for (k, (got, want)) in after.iter().zip(want).enumerate() {
         assert!(
@@ -183,22 +198,10 @@ fn the_environment_view_restarts_its_samples_for_a_saved_model() {
 #[test]
 fn a_pipeline_built_from_older_shaders_is_compiled_again_when_followed() {
     let _turn = serial();
-    let Some(gpu) = gpu_for_test() else { return };
-    bv::session::user_models::install();
-    let path = temp_file("late");
-    std::fs::write(&path, greyish("1.0")).unwrap();
-    let models = models(&path);
-    let mut lib = ShaderLibrary::new().unwrap();
-    let mut r = LitSphereRenderer::new(gpu, &mut lib).unwrap();
-    let settings = LitSphereSettings {
-        light: DVec3::new(0.0, 0.0, 1.0),
-        ..Default::default()
+    let Some((path, models, mut r)) = lit_sphere("late") else {
+        return;
     };
-    let shown = |scale: f64| {
-        bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
-            scale * 0.5 / std::f64::consts::PI,
-        ))
-    };
+    let settings = head_on();
     r.render_image(&models[..1], &settings, 64, 64).unwrap();
     std::fs::write(&path, greyish("2.0")).unwrap();
     bv_user::load(&path).unwrap();
