@@ -120,14 +120,18 @@ fn a_saved_model_is_drawn_anew_by_compiling_only_what_changed() {
     );
     let compiled = r.pipelines_compiled();
     assert_eq!(compiled, 3, "one specialised pipeline per model");
-    assert!(!r.follow_catalogue().unwrap(), "nothing changed yet");
+    assert!(!r.follow_catalogue().changed(), "nothing changed yet");
 
     // Save the file with twice the value and load it as the watcher would.
     std::fs::write(&path, greyish("2.0")).unwrap();
     bv_user::load(&path).unwrap();
-    assert!(r.follow_catalogue().unwrap());
+    let followed = r.follow_catalogue();
+    assert!(
+        followed.compiling && !followed.redraw,
+        "replacements compile, the stale pipelines draw what was drawn: {followed:?}"
+    );
     // The draw after the change still shows the last version (the
-    // replacements compile on workers), then the new one.
+    // replacements compile on the compile thread), then the new one.
     let meanwhile = centres(&r.render_image(&models, &settings, 192, 64).unwrap(), 3);
     assert_eq!(meanwhile, before, "the stale pipelines draw meanwhile");
     assert!(settle(|| r.poll_pipelines()), "the replacements arrive");
@@ -165,12 +169,12 @@ fn the_environment_view_restarts_its_samples_for_a_saved_model() {
         let (w, h) = img.dimensions();
         img.get_pixel(w / 2, h / 2).0[0]
     };
-    assert!(!r.follow_catalogue().unwrap(), "nothing changed yet");
+    assert!(!r.follow_catalogue().changed(), "nothing changed yet");
     let before = centre(&r.render_image(&models, &settings, 64, 64, 16).unwrap());
     assert_eq!(r.samples_per_pixel(), 16);
     std::fs::write(&path, greyish("0.25")).unwrap();
     bv_user::load(&path).unwrap();
-    assert!(r.follow_catalogue().unwrap());
+    assert!(r.follow_catalogue().compiling);
     r.render_image(&models, &settings, 64, 64, 16).unwrap();
     assert!(settle(|| r.poll_pipelines()), "the replacement arrives");
     let after = centre(&r.render_image(&models, &settings, 64, 64, 16).unwrap());
@@ -212,7 +216,7 @@ fn a_pipeline_built_from_older_shaders_is_compiled_again_when_followed() {
         1,
     );
     assert!(stale[0].abs_diff(shown(1.0)) <= 1, "{stale:?}");
-    assert!(r.follow_catalogue().unwrap());
+    assert!(r.follow_catalogue().compiling);
     r.render_image(&models[1..2], &settings, 64, 64).unwrap();
     assert!(settle(|| r.poll_pipelines()));
     let fresh = centres(
@@ -224,5 +228,36 @@ fn a_pipeline_built_from_older_shaders_is_compiled_again_when_followed() {
         "{fresh:?}, want {}",
         shown(2.0)
     );
+    std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
+}
+
+/// Every renderer compiling for one catalogue shares one composition of the
+/// shaders; a changed catalogue gets a new one.
+#[test]
+fn one_catalogue_is_composed_once() {
+    use bv::gpu::shaders::{Snapshot, shared};
+    let _turn = serial();
+    bv::session::user_models::install();
+    let path = temp_file("shared");
+    std::fs::write(&path, greyish("1.0")).unwrap();
+    bv_user::load(&path).unwrap();
+    let snapshot = Snapshot::now();
+    let a = shared(&snapshot).unwrap();
+    let b = shared(&Snapshot::now()).unwrap();
+    assert!(std::sync::Arc::ptr_eq(&a, &b), "composed once");
+    std::fs::write(&path, greyish("2.0")).unwrap();
+    bv_user::load(&path).unwrap();
+    let c = shared(&Snapshot::now()).unwrap();
+    assert!(
+        !std::sync::Arc::ptr_eq(&a, &c),
+        "a new catalogue, a new library"
+    );
+    assert_eq!(
+        c.lock().unwrap().catalogue_revision(),
+        bv_core::registry::revision()
+    );
+    // The older snapshot still gets its own catalogue's library.
+    let old = shared(&snapshot).unwrap();
+    assert_eq!(old.lock().unwrap().catalogue_revision(), snapshot.revision);
     std::fs::remove_dir_all(path.parent().unwrap()).unwrap();
 }

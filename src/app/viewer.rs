@@ -620,8 +620,8 @@ impl Viewer {
             self.reloader.set_waker(move || c.request_repaint());
             self.reloader_woken = true;
         }
-        if self.reloader.pending() {
-            ctx.request_repaint_after(bv_user::watch::SETTLE);
+        if let Some(wait) = self.reloader.settles_in() {
+            ctx.request_repaint_after(wait);
         }
     }
 

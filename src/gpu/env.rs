@@ -12,7 +12,7 @@ use super::errors;
 use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
-use super::specialised::ModelPipelines;
+use super::specialised::{Followed, ModelPipelines};
 use anyhow::{Context, Result, bail};
 use bv_core::ModelSpec;
 
@@ -227,14 +227,17 @@ fn compute_pipeline(
 
 impl EnvRenderer {
     /// Adopts a changed catalogue (a user's model saved): only the
-    /// pipelines whose code changed are built again, and the accumulation
-    /// restarts. `Ok(true)` when something changed.
-    pub fn follow_catalogue(&mut self) -> Result<bool> {
-        let changed = self.accumulate.follow_catalogue()?;
-        if changed {
+    /// pipelines whose code changed are built again (see
+    /// [`super::specialised::ModelPipelines::follow_catalogue`]). The
+    /// accumulation restarts when the new code draws: at once, or when the
+    /// replacements arrive ([`Self::poll_pipelines`]), not for the stale
+    /// pipelines drawing the old picture meanwhile.
+    pub fn follow_catalogue(&mut self) -> Followed {
+        let followed = self.accumulate.follow_catalogue();
+        if followed.redraw {
             self.key = None;
         }
-        Ok(changed)
+        followed
     }
 
     /// Takes the pipelines that finished compiling after a catalogue change

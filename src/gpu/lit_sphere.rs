@@ -9,7 +9,7 @@ use super::errors;
 use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
-use super::specialised::ModelPipelines;
+use super::specialised::{Followed, ModelPipelines};
 use anyhow::{Result, bail};
 use bv_core::ModelSpec;
 use glam::DVec3;
@@ -192,8 +192,9 @@ impl LitSphereRenderer {
     }
 
     /// Adopts a changed catalogue (a user's model saved): only the pipelines
-    /// whose code changed are built again. `Ok(true)` when something did.
-    pub fn follow_catalogue(&mut self) -> Result<bool> {
+    /// whose code changed are built again (see
+    /// [`super::specialised::ModelPipelines::follow_catalogue`]).
+    pub fn follow_catalogue(&mut self) -> Followed {
         self.pipelines.follow_catalogue()
     }
 

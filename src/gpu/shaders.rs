@@ -67,6 +67,52 @@ pub const FIXED_MODEL_DECLARATION: &str = "const FIXED_MODEL: u32 = 0xffffffffu;
 /// `FIXED_MODEL` of a generic shader.
 pub const ANY_MODEL: u32 = 0xffff_ffff;
 
+/// The catalogue at one moment and its revision: what a library, or a
+/// pipeline, made from it holds.
+#[derive(Debug, Clone)]
+pub struct Snapshot {
+    /// [`bv_core::registry::revision`] when it was taken.
+    pub revision: u64,
+    /// The models, by catalogue index.
+    pub catalogue: bv_core::registry::Catalogue,
+}
+
+impl Snapshot {
+    /// The current catalogue.
+    pub fn now() -> Self {
+        // The revision before the catalogue: a model registered in between
+        // makes the snapshot look older than it is, never newer.
+        let revision = bv_core::registry::revision();
+        Self {
+            revision,
+            catalogue: bv_core::catalogue(),
+        }
+    }
+}
+
+/// A library shared by everything that compiles for one catalogue.
+pub type SharedLibrary = std::sync::Arc<std::sync::Mutex<ShaderLibrary>>;
+
+/// The library of `snapshot`, composed once for all who ask: composing every
+/// module takes tens of milliseconds, and after a user's file is saved each
+/// renderer compiling its replacement pipelines needs the same one. The
+/// library of the latest revision asked for is kept.
+pub fn shared(snapshot: &Snapshot) -> Result<SharedLibrary> {
+    static LATEST: std::sync::Mutex<Option<(u64, SharedLibrary)>> = std::sync::Mutex::new(None);
+    // Nothing is left half-made in the cache by a panic: it only swaps.
+    let mut latest = LATEST.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some((revision, lib)) = latest.as_ref()
+        && *revision == snapshot.revision
+    {
+        return Ok(lib.clone());
+    }
+    let lib = std::sync::Arc::new(std::sync::Mutex::new(ShaderLibrary::of(snapshot)?));
+    if latest.as_ref().is_none_or(|(r, _)| *r < snapshot.revision) {
+        *latest = Some((snapshot.revision, lib.clone()));
+    }
+    Ok(lib)
+}
+
 /// A composer holding every module of `shaders/`.
 pub struct ShaderLibrary {
     composer: Composer,
@@ -85,11 +131,13 @@ impl ShaderLibrary {
     /// Registers the generated layout, every shared module, every model's
     /// port of the current catalogue and the generated dispatch.
     pub fn new() -> Result<Self> {
+        Self::of(&Snapshot::now())
+    }
+
+    /// The library of the catalogue `snapshot` holds.
+    pub fn of(snapshot: &Snapshot) -> Result<Self> {
         let mut composer = Composer::default();
-        // The revision before the snapshot: a model registered in between
-        // makes the library look older than it is, never newer.
-        let revision = bv_core::registry::revision();
-        let catalogue = bv_core::catalogue();
+        let (revision, catalogue) = (snapshot.revision, snapshot.catalogue.clone());
         let mut add = |path: &str, source: &str| -> Result<()> {
             let r = composer.add_composable_module(ComposableModuleDescriptor {
                 source,

@@ -11,16 +11,18 @@
 //! new catalogue drops only the pipelines whose code changed: those of the
 //! changed models and those of models drawn through the generic dispatch (a
 //! mix reads its components through it), and the generic pipeline, which is
-//! built again only when a specialisation fails. Their replacements compile
-//! on worker threads while the dropped ones go on drawing (the last working
-//! version, as a user file's reload promises), so the window does not wait
-//! for a driver's compiler; [`ModelPipelines::poll`] says when they arrive.
+//! built again only when a specialisation fails. Their replacements are
+//! composed and compiled on one compile thread while the dropped ones go on
+//! drawing (the last working version, as a user file's reload promises), so
+//! the window does not wait for the composer or a driver's compiler;
+//! [`ModelPipelines::poll`] says when they arrive.
 
 use super::errors;
-use super::shaders::ShaderLibrary;
+use super::shaders::{ShaderLibrary, SharedLibrary, Snapshot};
 use anyhow::Result;
 use std::collections::HashMap;
-use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::OnceLock;
+use std::sync::mpsc::{Receiver, SendError, Sender, TryRecvError, channel};
 
 /// Builds a pipeline of type `P` from a composed shader module.
 pub type Build<P> = fn(&wgpu::Device, &wgpu::PipelineLayout, &wgpu::ShaderModule) -> P;
@@ -35,17 +37,36 @@ enum Stamp {
     Catalogue(u64),
 }
 
+/// What adopting a changed catalogue did ([`ModelPipelines::follow_catalogue`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Followed {
+    /// What is drawn changed from the next draw on: draw again now.
+    pub redraw: bool,
+    /// Replacements are compiling ([`ModelPipelines::poll`] says when they
+    /// arrive; what they replace draws meanwhile, so nothing needs drawing
+    /// again until then).
+    pub compiling: bool,
+}
+
+impl Followed {
+    /// Whether anything the pipelines draw changed or will change.
+    pub fn changed(self) -> bool {
+        self.redraw || self.compiling
+    }
+}
+
 /// The pipelines of one entry shader: one per model drawn, and the generic
 /// one for models whose specialisation failed.
 pub struct ModelPipelines<P> {
     device: wgpu::Device,
-    library: ShaderLibrary,
+    /// The catalogue the pipelines are compiled from.
+    snapshot: Snapshot,
     entry: &'static str,
     layout: wgpu::PipelineLayout,
     build: Build<P>,
     generic: Option<P>,
     specialised: HashMap<u32, (Stamp, Option<P>)>,
-    /// Replacements compiling on worker threads, by model.
+    /// Replacements compiling on the compile thread, by model.
     building: HashMap<u32, (Stamp, Receiver<Option<P>>)>,
     /// Pipelines of an earlier catalogue, drawn until their replacements
     /// arrive.
@@ -77,7 +98,7 @@ impl<P> ModelPipelines<P> {
     ) -> Result<Self> {
         Ok(Self {
             device: device.clone(),
-            library: ShaderLibrary::new()?,
+            snapshot: Snapshot::now(),
             entry,
             layout,
             build,
@@ -89,25 +110,37 @@ impl<P> ModelPipelines<P> {
         })
     }
 
-    /// The stamp of catalogue model `model` in the library's catalogue (what
+    /// The stamp of catalogue model `model` in the followed catalogue (what
     /// a pipeline built now is compiled from).
     fn stamp(&self, model: u32) -> Stamp {
-        match self.library.catalogue().get(model as usize) {
+        match self.snapshot.catalogue.get(model as usize) {
             Some(m) if m.gpu.is_some() => Stamp::Model(std::ptr::from_ref(*m).addr()),
-            _ => Stamp::Catalogue(self.library.catalogue_revision()),
+            _ => Stamp::Catalogue(self.snapshot.revision),
         }
     }
 
+    /// The composed shaders of the followed catalogue (shared, composed on
+    /// first use).
+    fn library(&self) -> Result<SharedLibrary> {
+        super::shaders::shared(&self.snapshot)
+    }
+
     /// Adopts the current catalogue ([`bv_core::registry::revision`]): the
-    /// shaders are composed again and the pipelines whose code changed are
-    /// dropped (built again on use). `Ok(false)` when the catalogue had not
-    /// changed; an error (the new catalogue's shaders do not compose) leaves
-    /// everything as it was.
-    pub fn follow_catalogue(&mut self) -> Result<bool> {
-        if self.library.catalogue_revision() == bv_core::registry::revision() {
-            return Ok(false);
+    /// pipelines whose code changed are dropped and their replacements start
+    /// compiling at once on the compile thread, the shaders composed there
+    /// too (the dropped ones draw until they arrive; [`Self::poll`]). A
+    /// model that had no pipeline of its own (drawn through the generic
+    /// dispatch) is drawn from the new code at its next draw. A replacement
+    /// that fails to compose or compile arrives as a failed specialisation
+    /// (the generic pipeline draws it, or the draw reports an error).
+    pub fn follow_catalogue(&mut self) -> Followed
+    where
+        P: Send + 'static,
+    {
+        if self.snapshot.revision == bv_core::registry::revision() {
+            return Followed::default();
         }
-        self.library = ShaderLibrary::new()?;
+        self.snapshot = Snapshot::now();
         self.generic = None;
         let now: HashMap<u32, Stamp> = self
             .specialised
@@ -119,14 +152,37 @@ impl<P> ModelPipelines<P> {
         // (its worker's result goes nowhere).
         self.building
             .retain(|m, (stamp, _)| now.get(m) == Some(stamp));
+        let mut followed = Followed::default();
         for (m, (stamp, built)) in std::mem::take(&mut self.specialised) {
             if now.get(&m) == Some(&stamp) {
                 self.specialised.insert(m, (stamp, built));
             } else if let Some(p) = built {
                 self.stale.insert(m, p);
+            } else {
+                followed.redraw = true;
             }
         }
-        Ok(true)
+        let waiting: Vec<u32> = self
+            .stale
+            .keys()
+            .filter(|m| !self.building.contains_key(m))
+            .copied()
+            .collect();
+        for m in waiting {
+            self.start_replacement(m);
+        }
+        followed.compiling = !self.building.is_empty();
+        followed
+    }
+
+    /// Starts compiling the replacement of stale model `model`'s pipeline.
+    fn start_replacement(&mut self, model: u32)
+    where
+        P: Send + 'static,
+    {
+        let stamp = self.stamp(model);
+        let rx = self.compile_elsewhere(model);
+        self.building.insert(model, (stamp, rx));
     }
 
     /// Builds what drawing `models` (catalogue indices) needs: each one's
@@ -140,16 +196,12 @@ impl<P> ModelPipelines<P> {
         let mut need_generic = false;
         for model in models {
             if !self.specialised.contains_key(&model) && !self.building.contains_key(&model) {
-                let stamp = self.stamp(model);
-                let source = self.library.specialised_wgsl(self.entry, Some(model));
-                if self.stale.contains_key(&model)
-                    && let Ok(source) = &source
-                {
-                    let rx = self.compile_elsewhere(source.clone());
-                    self.building.insert(model, (stamp, rx));
+                if self.stale.contains_key(&model) {
+                    self.start_replacement(model);
                     continue;
                 }
-                let built = source.ok().map(|source| {
+                let stamp = self.stamp(model);
+                let built = self.specialised_wgsl(model).ok().map(|source| {
                     let m = self.module(source);
                     (self.build)(&self.device, &self.layout, &m)
                 });
@@ -160,8 +212,8 @@ impl<P> ModelPipelines<P> {
         }
         if need_generic && self.generic.is_none() {
             self.generic = self
-                .library
-                .shader_module(&self.device, self.entry)
+                .library()
+                .and_then(|lib| lock(&lib)?.shader_module(&self.device, self.entry))
                 .ok()
                 .map(|m| (self.build)(&self.device, &self.layout, &m));
             self.compiled += u64::from(self.generic.is_some());
@@ -172,37 +224,39 @@ impl<P> ModelPipelines<P> {
         module(&self.device, self.entry, source)
     }
 
-    /// Compiles a specialised pipeline of `source` on a worker thread (in a
-    /// browser page, which has none, at once).
-    fn compile_elsewhere(&self, source: String) -> Receiver<Option<P>>
+    /// The entry shader specialised for `model`, from the followed catalogue.
+    fn specialised_wgsl(&self, model: u32) -> Result<String> {
+        lock(&self.library()?)?.specialised_wgsl(self.entry, Some(model))
+    }
+
+    /// Compiles the specialised pipeline of `model` on the compile thread
+    /// (see [`run_elsewhere`]), the shaders composed there too: nothing of
+    /// a replacement is done on the thread drawing the window.
+    fn compile_elsewhere(&self, model: u32) -> Receiver<Option<P>>
     where
         P: Send + 'static,
     {
-        let (tx, rx) = std::sync::mpsc::channel();
-        let (device, layout, build, entry) = (
+        let (tx, rx) = channel();
+        let (device, layout, build, entry, snapshot) = (
             self.device.clone(),
             self.layout.clone(),
             self.build,
             self.entry,
+            self.snapshot.clone(),
         );
         let work = move || {
-            let built = errors::scoped(&device, "compiling a specialised pipeline", || {
-                let m = module(&device, entry, source);
-                Ok(build(&device, &layout, &m))
+            let source = super::shaders::shared(&snapshot)
+                .and_then(|lib| lock(&lib)?.specialised_wgsl(entry, Some(model)));
+            let built = source.and_then(|source| {
+                errors::scoped(&device, "compiling a specialised pipeline", || {
+                    let m = module(&device, entry, source);
+                    Ok(build(&device, &layout, &m))
+                })
             });
             // The receiver is gone only if the catalogue moved on.
             let _ = tx.send(built.ok());
         };
-        if cfg!(target_arch = "wasm32") {
-            work();
-        } else {
-            // Without a thread the sender is dropped unsent, which
-            // [`Self::poll`] takes as a failed build (the generic pipeline
-            // draws).
-            let _ = std::thread::Builder::new()
-                .name("bv pipeline compile".into())
-                .spawn(work);
-        }
+        run_elsewhere(Box::new(work));
         rx
     }
 
@@ -256,6 +310,46 @@ impl<P> ModelPipelines<P> {
 }
 
 /// A wgpu shader module of a composed WGSL source.
+/// The library behind a shared handle (a panic while it was held is an error,
+/// not a second panic).
+fn lock(lib: &SharedLibrary) -> Result<std::sync::MutexGuard<'_, ShaderLibrary>> {
+    lib.lock()
+        .map_err(|_| anyhow::anyhow!("the shader library was left broken by a panic"))
+}
+
+/// Work for the compile thread.
+type Job = Box<dyn FnOnce() + Send>;
+
+/// Runs `job` on the one compile thread, after the jobs asked for before it.
+/// One thread, not one per pipeline: on two cores, several driver compiles
+/// at once starve the software rasteriser drawing the window, and the views
+/// are drawn (so their pipelines asked for) in the order they are seen, so
+/// the first view gets its pipeline first. Where there is no thread (a
+/// browser page, or one that could not be started) the job runs at once.
+fn run_elsewhere(job: Job) {
+    static QUEUE: OnceLock<Option<Sender<Job>>> = OnceLock::new();
+    if cfg!(target_arch = "wasm32") {
+        return job();
+    }
+    let queue = QUEUE.get_or_init(|| {
+        let (tx, rx) = channel::<Job>();
+        std::thread::Builder::new()
+            .name("bv pipeline compile".into())
+            .spawn(move || rx.into_iter().for_each(|job| job()))
+            .ok()
+            .map(|_| tx)
+    });
+    match queue {
+        // A job that panicked ended the thread: the next ones run here.
+        Some(tx) => {
+            if let Err(SendError(job)) = tx.send(job) {
+                job();
+            }
+        }
+        None => job(),
+    }
+}
+
 fn module(device: &wgpu::Device, entry: &str, source: String) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(entry),

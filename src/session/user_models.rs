@@ -175,10 +175,10 @@ impl Reloader {
         self.watcher.as_mut()
     }
 
-    /// Whether a change waits to settle (poll again after
-    /// [`bv_user::watch::SETTLE`]).
-    pub fn pending(&self) -> bool {
-        self.watcher.as_ref().is_some_and(|w| w.pending())
+    /// How long until a saved change has settled (update again then);
+    /// `None` when none waits.
+    pub fn settles_in(&self) -> Option<std::time::Duration> {
+        self.watcher.as_ref().and_then(|w| w.settles_in())
     }
 
     /// Watches the state's file models and applies the reloads that are

@@ -12,6 +12,7 @@
 use super::{Scene, SceneBrdf};
 use crate::gpu::env::Object;
 use crate::gpu::shaders::ShaderLibrary;
+use crate::gpu::specialised::Followed;
 use crate::gpu::{Background, Gpu, ToneMap};
 use crate::session::lighting::{BackgroundChoice, EnvObject, Tone};
 use bv_core::ModelSpec;
@@ -113,16 +114,12 @@ pub fn library() -> anyhow::Result<ShaderLibrary> {
 /// was built; when the catalogue changes (a user file opened or reloaded:
 /// [`bv_core::registry::revision`]) it adopts the new one in place
 /// ([`FollowsCatalogue`]: a saved file costs the compilation of its own
-/// model's pipeline, a tenth of a second, not the whole renderer's). Only if
-/// that fails is it built again, the one built before kept and used until
-/// the new one is ready (or if it fails), so that the view keeps drawing the
-/// last working version.
+/// model's pipeline, a tenth of a second, not the whole renderer's), the
+/// last working version drawn until the new pipelines arrive.
 pub struct Deferred<T> {
     slot: Slot<T>,
     /// The catalogue revision the current slot was (or is being) built for.
     revision: u64,
-    /// The renderer of an earlier revision, drawn while the slot rebuilds.
-    previous: Option<T>,
     /// Counts the renderers that became ready.
     generation: u64,
 }
@@ -132,7 +129,6 @@ impl<T> Default for Deferred<T> {
         Self {
             slot: Slot::Empty,
             revision: 0,
-            previous: None,
             generation: 0,
         }
     }
@@ -140,9 +136,8 @@ impl<T> Default for Deferred<T> {
 
 /// A renderer that can adopt a changed catalogue without being built again.
 pub trait FollowsCatalogue {
-    /// Adopts the current catalogue: `Ok(true)` when what it draws changed,
-    /// an error when it cannot (it is then built again).
-    fn follow_catalogue(&mut self) -> anyhow::Result<bool>;
+    /// Adopts the current catalogue: what changed.
+    fn follow_catalogue(&mut self) -> Followed;
 
     /// Takes the pipelines compiled since for the new catalogue:
     /// `(arrived, waiting)`, whether what it draws changed, and whether more
@@ -151,7 +146,7 @@ pub trait FollowsCatalogue {
 }
 
 impl FollowsCatalogue for crate::gpu::LitSphereRenderer {
-    fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
+    fn follow_catalogue(&mut self) -> Followed {
         self.follow_catalogue()
     }
 
@@ -161,7 +156,7 @@ impl FollowsCatalogue for crate::gpu::LitSphereRenderer {
 }
 
 impl FollowsCatalogue for crate::gpu::EnvRenderer {
-    fn follow_catalogue(&mut self) -> anyhow::Result<bool> {
+    fn follow_catalogue(&mut self) -> Followed {
         self.follow_catalogue()
     }
 
@@ -184,29 +179,25 @@ enum Slot<T> {
 }
 
 impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
-    /// Follows a catalogue that changed since the slot was built: in place
-    /// when the renderer can, else by a rebuild that keeps the built renderer
-    /// as `previous`. `true` when the renderer changed in place (its new
-    /// pipelines compile from its next draw on).
+    /// Follows a catalogue that changed since the ready renderer was built,
+    /// in place: `true` when what it draws changed, or will when its
+    /// compiling pipelines arrive.
     fn follow_catalogue(&mut self) -> bool {
         let now = bv_core::registry::revision();
-        if self.revision == now || matches!(self.slot, Slot::Empty | Slot::Building(_)) {
+        let Slot::Ready(t) = &mut self.slot else {
+            return false;
+        };
+        if self.revision == now {
             return false;
         }
-        if let Slot::Ready(t) = &mut self.slot {
-            // On an error the rebuild below meets it too and shows it.
-            if let Ok(changed) = t.follow_catalogue() {
-                self.revision = now;
-                if changed {
-                    self.generation += 1;
-                }
-                return changed;
-            }
+        self.revision = now;
+        let followed = t.follow_catalogue();
+        // Stale pipelines draw what was drawn: nothing to draw again before
+        // their replacements arrive.
+        if followed.redraw {
+            self.generation += 1;
         }
-        if let Slot::Ready(t) = std::mem::take(&mut self.slot) {
-            self.previous = Some(t);
-        }
-        false
+        followed.changed()
     }
 
     /// Takes the ready renderer's newly compiled pipelines (what it draws
@@ -222,18 +213,17 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
         waiting
     }
 
-    /// Starts `build` on a worker thread the first time (and again after the
-    /// catalogue changed), takes its result when it is there: `Ok(Some(_))`
-    /// when ready, `Ok(None)` while building (the worker asks `ctx` for a
-    /// frame when it is done). While a rebuild runs, or after it failed, the
-    /// renderer built before is returned.
+    /// Starts `build` on a worker thread the first time, takes its result
+    /// when it is there: `Ok(Some(_))` when ready (following a changed
+    /// catalogue in place), `Ok(None)` while building (the worker asks `ctx`
+    /// for a frame when it is done).
     pub fn poll(
         &mut self,
         ctx: &egui::Context,
         build: impl FnOnce() -> Result<T, String> + Send + 'static,
     ) -> Result<Option<&mut T>, String> {
-        // The draw after a change starts compiling the new pipelines; frames
-        // keep coming until they are there.
+        // Frames keep coming while new pipelines compile, to show them as
+        // soon as they are there.
         let followed = self.follow_catalogue();
         if self.poll_pipelines() || followed {
             ctx.request_repaint_after(std::time::Duration::from_millis(15));
@@ -256,7 +246,6 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
             match rx.try_recv() {
                 Ok(Ok(t)) => {
                     self.slot = Slot::Ready(t);
-                    self.previous = None;
                     self.generation += 1;
                 }
                 Ok(Err(e)) => self.slot = Slot::Failed(e),
@@ -268,17 +257,14 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
         }
         match &mut self.slot {
             Slot::Ready(t) => Ok(Some(t)),
-            Slot::Failed(e) => match &mut self.previous {
-                Some(t) => Ok(Some(t)),
-                None => Err(e.clone()),
-            },
-            Slot::Empty | Slot::Building(_) => Ok(self.previous.as_mut()),
+            Slot::Failed(e) => Err(e.clone()),
+            Slot::Empty | Slot::Building(_) => Ok(None),
         }
     }
 
     /// The value now: built on this thread if not asked for yet (or after a
-    /// failure, or for a changed catalogue), waited for if a worker is
-    /// building it. For figures, which are drawn in one go.
+    /// failure), waited for if a worker is building it, its pipelines for a
+    /// changed catalogue waited for. For figures, which are drawn in one go.
     pub fn now(&mut self, build: impl FnOnce() -> Result<T, String>) -> Result<&mut T, String> {
         self.follow_catalogue();
         // A figure shows the new pipelines, not the stale ones.
@@ -301,7 +287,6 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
                 Err(e) => Slot::Failed(e),
             };
         }
-        self.previous = None;
         match &mut self.slot {
             Slot::Ready(t) => Ok(t),
             Slot::Failed(e) => Err(e.clone()),
@@ -309,19 +294,19 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
         }
     }
 
-    /// The built value, if ready (or the one drawn while rebuilding).
+    /// The built value, if ready.
     pub fn ready(&self) -> Option<&T> {
         match &self.slot {
             Slot::Ready(t) => Some(t),
-            _ => self.previous.as_ref(),
+            _ => None,
         }
     }
 
-    /// The built value, if ready (or the one drawn while rebuilding).
+    /// The built value, if ready.
     pub fn ready_mut(&mut self) -> Option<&mut T> {
         match &mut self.slot {
             Slot::Ready(t) => Some(t),
-            _ => self.previous.as_mut(),
+            _ => None,
         }
     }
 

@@ -133,20 +133,23 @@ impl LitSphereView {
                 .and_then(|mut lib| LitSphereRenderer::new(gpu, &mut lib))
                 .map_err(|e| format!("cannot build the lit sphere renderer: {e:#}"))
         };
-        let generation = self.renderer.generation();
         let built = if figure {
-            self.renderer.now(build).map(Some)
+            self.renderer.now(build).map(|_| Some(()))
         } else {
-            self.renderer.poll(ui.ctx(), build)
+            self.renderer.poll(ui.ctx(), build).map(|r| r.map(|_| ()))
         };
-        let renderer = match built {
-            Ok(Some(r)) => r,
+        match built {
+            Ok(Some(())) => {}
             Ok(None) => return None,
             Err(e) => {
                 self.error = Some(e);
                 return None;
             }
-        };
+        }
+        // Read after polling: pipelines that arrived in this poll are drawn
+        // in this frame, not the next.
+        let generation = self.renderer.generation();
+        let renderer = self.renderer.ready_mut()?;
         let key = FrameKey {
             specs: drawables.iter().map(|d| d.spec.clone()).collect(),
             settings,

@@ -46,7 +46,10 @@ type Waker = Arc<Mutex<Option<Box<dyn Fn() + Send>>>>;
 /// Watches `.brdf` files and reloads them when they change.
 pub struct Watcher {
     inner: notify::RecommendedWatcher,
-    events: Receiver<notify::Result<notify::Event>>,
+    /// Notifications with the time each arrived (on the watcher's thread,
+    /// so a change is quiet for [`SETTLE`] counted from the save itself, not
+    /// from the frame that next looks).
+    events: Receiver<(Instant, notify::Result<notify::Event>)>,
     files: BTreeSet<PathBuf>,
     dirs: BTreeSet<PathBuf>,
     /// Files changed and when they last did.
@@ -70,7 +73,7 @@ impl Watcher {
         let wake = waker.clone();
         let inner = notify::recommended_watcher(move |e| {
             // The receiver is gone only when the watcher is dropped.
-            let _ = tx.send(e);
+            let _ = tx.send((Instant::now(), e));
             if let Ok(w) = wake.lock()
                 && let Some(w) = w.as_ref()
             {
@@ -124,24 +127,27 @@ impl Watcher {
         crate::catalogue::canonical(path).is_ok_and(|c| self.files.contains(&c))
     }
 
-    /// Whether a change is waiting to settle (call [`Watcher::poll`] again
-    /// after [`SETTLE`]).
-    pub fn pending(&self) -> bool {
-        !self.dirty.is_empty()
+    /// How long until the next changed file has been quiet for [`SETTLE`]
+    /// (call [`Watcher::poll`] then); `None` when no change waits.
+    pub fn settles_in(&self) -> Option<Duration> {
+        self.dirty
+            .values()
+            .map(|t| SETTLE.saturating_sub(t.elapsed()))
+            .min()
     }
 
     /// Takes the notifications that arrived and reloads every watched file
     /// that changed and has been quiet for [`SETTLE`]. Never blocks.
     pub fn poll(&mut self) -> Vec<Reload> {
         let now = Instant::now();
-        while let Ok(event) = self.events.try_recv() {
+        while let Ok((at, event)) = self.events.try_recv() {
             let Ok(event) = event else { continue };
             if matches!(event.kind, notify::EventKind::Access(_)) {
                 continue;
             }
             for p in event.paths {
                 if self.files.contains(&p) {
-                    self.dirty.insert(p, now);
+                    self.dirty.insert(p, at);
                 }
             }
         }
