@@ -71,6 +71,10 @@ pub struct ModelPipelines<P> {
     /// Pipelines of an earlier catalogue, drawn until their replacements
     /// arrive.
     stale: HashMap<u32, P>,
+    /// The models of the last [`Self::prepare`], in its order: those whose
+    /// replacements start compiling when the catalogue is followed (others
+    /// compile when drawn again).
+    last_drawn: Vec<u32>,
     /// Pipelines compiled since [`Self::new`], the generic one included.
     compiled: u64,
 }
@@ -106,6 +110,7 @@ impl<P> ModelPipelines<P> {
             specialised: HashMap::new(),
             building: HashMap::new(),
             stale: HashMap::new(),
+            last_drawn: Vec::new(),
             compiled: 0,
         })
     }
@@ -126,8 +131,8 @@ impl<P> ModelPipelines<P> {
     }
 
     /// Adopts the current catalogue ([`bv_core::registry::revision`]): the
-    /// pipelines whose code changed are dropped and their replacements start
-    /// compiling at once on the compile thread, the shaders composed there
+    /// pipelines whose code changed are dropped and the replacements of those
+    /// last drawn start compiling at once on the compile thread, the shaders composed there
     /// too (the dropped ones draw until they arrive; [`Self::poll`]). A
     /// model that had no pipeline of its own (drawn through the generic
     /// dispatch) is drawn from the new code at its next draw. A replacement
@@ -162,10 +167,12 @@ impl<P> ModelPipelines<P> {
                 followed.redraw = true;
             }
         }
+        // What was drawn last, in the order drawn (one compile thread takes
+        // them in turn).
         let waiting: Vec<u32> = self
-            .stale
-            .keys()
-            .filter(|m| !self.building.contains_key(m))
+            .last_drawn
+            .iter()
+            .filter(|m| self.stale.contains_key(m) && !self.building.contains_key(m))
             .copied()
             .collect();
         for m in waiting {
@@ -194,7 +201,11 @@ impl<P> ModelPipelines<P> {
         P: Send + 'static,
     {
         let mut need_generic = false;
+        self.last_drawn.clear();
         for model in models {
+            if !self.last_drawn.contains(&model) {
+                self.last_drawn.push(model);
+            }
             if !self.specialised.contains_key(&model) && !self.building.contains_key(&model) {
                 if self.stale.contains_key(&model) {
                     self.start_replacement(model);
