@@ -774,3 +774,70 @@ fn lit_view_frame_timing() {
         );
     }
 }
+
+/// A device with WebGL2's limits (no storage buffers, as a browser without
+/// WebGPU gives): the lit sphere is drawn on the CPU, the same picture.
+#[test]
+fn without_storage_buffers_the_lit_sphere_is_drawn_on_the_cpu() {
+    let mut setup = egui_kittest::wgpu::default_wgpu_setup();
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(new) = &mut setup {
+        new.device_descriptor =
+            std::sync::Arc::new(
+                |adapter: &eframe::wgpu::Adapter| eframe::wgpu::DeviceDescriptor {
+                    label: Some("webgl2-like"),
+                    required_limits: eframe::wgpu::Limits::downlevel_webgl2_defaults()
+                        .using_resolution(adapter.limits()),
+                    ..Default::default()
+                },
+            );
+    }
+    let rs = egui_kittest::wgpu::create_render_state(
+        setup,
+        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    assert_eq!(rs.device.limits().max_storage_buffers_per_shader_stage, 0);
+    let mut state = state_with(&[("lambert", serde_json::json!({"albedo": 0.8}))]);
+    state.maximised = Some("lit_sphere".into());
+    let mut h = Harness::builder()
+        .with_size([900.0, 600.0])
+        .with_max_steps(8)
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(
+            rs.clone(),
+        ))
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state));
+    bv::views::gpu_image::install(&h.ctx, &rs);
+    h.run_steps(3);
+    assert!(bv::views::gpu_image::lacks_storage_buffers(&h.ctx));
+    let rect = lit(&h).view_rect.expect("lit sphere laid out");
+    assert!(lit(&h).error().is_none(), "{:?}", lit(&h).error());
+    assert!(!lit(&h).ready(), "no GPU renderer is built for it");
+    let img = crop(&h.render().unwrap(), rect);
+    let lit_pixels = non_background(&img);
+    assert!(
+        lit_pixels > (img.width() * img.height() / 5) as usize,
+        "the sphere is missing: {lit_pixels} pixels differ from the background"
+    );
+    // The sphere's centre as on the GPU: 0.8/π · cos 30° through sRGB.
+    let c = rect.center() - rect.min;
+    let px = img.get_pixel(c.x as u32 - 2, c.y as u32 - 2).0;
+    let expected = bv::gpu::display::to_u8(bv::gpu::display::srgb_encode(
+        0.8 / std::f64::consts::PI * 30f64.to_radians().cos(),
+    ));
+    for k in 0..3 {
+        assert!(
+            px[k].abs_diff(expected) <= 2,
+            "centre pixel {px:?}, expected {expected}"
+        );
+    }
+    // A slider still changes it.
+    let brdf = h.state().state().brdfs[0].id;
+    h.state_mut().push(Command::SetParam {
+        brdf,
+        param: "albedo".into(),
+        value: ParamValue::Float(0.4),
+    });
+    h.run_steps(2);
+    let img2 = crop(&h.render().unwrap(), rect);
+    let px2 = img2.get_pixel(c.x as u32 - 2, c.y as u32 - 2).0;
+    assert!(px2[0] + 10 < px[0], "darker albedo: {px2:?} vs {px:?}");
+}

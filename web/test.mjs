@@ -129,6 +129,20 @@ function stats(img, [x0, y0, x1, y1] = [0, 0, img.width, img.height]) {
   return { colours: colours.size, std: Math.sqrt(Math.max(0, sq / n - mean * mean)), mean };
 }
 
+// The share of pixels of a region brighter than its darkest tenth by more
+// than `by` levels of luminance (a lit object against a dark background).
+function brightShare(img, [x0, y0, x1, y1], by = 40) {
+  const ls = [];
+  for (let y = y0; y < y1; y++) {
+    for (let x = x0; x < x1; x++) {
+      const i = (y * img.width + x) * 4;
+      ls.push(0.2126 * img.px[i] + 0.7152 * img.px[i + 1] + 0.0722 * img.px[i + 2]);
+    }
+  }
+  const dark = [...ls].sort((p, q) => p - q)[Math.floor(ls.length / 10)];
+  return ls.filter((l) => l > dark + by).length / ls.length;
+}
+
 // The share of pixels of a region whose colour differs by more than `tol`
 // in some channel.
 function difference(a, b, [x0, y0, x1, y1] = [0, 0, a.width, a.height], tol = 24) {
@@ -433,7 +447,14 @@ async function webgpuChecks(context, base) {
     // the dev build under software rendering) is drawn once it is done.
     if (p.log.includes("bv: background work started")) await framesDuringWork(p, 0);
     // The view's area: right of the panel, below the menu.
-    notBlank(await shot(p.page, `webgpu-view-${view}`), `view ${view}`, [320, 40, W - 10, H - 40]);
+    const img = await shot(p.page, `webgpu-view-${view}`);
+    notBlank(img, `view ${view}`, [320, 40, W - 10, H - 40]);
+    // The lit sphere is drawn (on the CPU where the page got WebGL2), not
+    // only labelled.
+    if (view === "lit_sphere") {
+      const share = brightShare(img, [370, 70, W - 20, H - 40]);
+      check(share > 0.05, `view lit_sphere: a lit sphere is drawn (${(100 * share).toFixed(1)}% of the view lit)`);
+    }
     noErrors(p, `view ${view}`);
     await p.page.close();
   }
@@ -499,6 +520,37 @@ async function webgpuChecks(context, base) {
   await longWorkChecks(context, gl, toml);
   await downloadChecks(context, gl, toml);
   await openFileChecks(context, gl, toml);
+  await fileChooserChecks(context, gl, toml);
+}
+
+// Ctrl+O (and the Open… button) open the browser's file chooser; the file
+// chosen there opens as a dropped one does.
+async function fileChooserChecks(context, gl, toml) {
+  const p = await open(context, linkOf(gl, toml), "a page a scene is chosen on");
+  await p.page.waitForTimeout(SETTLE_MS);
+  const before = await shot(p.page, "webgl-chooser-before");
+  const chooser = p.page.waitForEvent("filechooser", { timeout: 30_000 });
+  await p.page.keyboard.press("Control+O");
+  try {
+    const c = await chooser;
+    check(c.isMultiple(), "Ctrl+O opens the browser's file chooser (several files allowed)");
+    await c.setFiles({
+      name: "chosen.toml",
+      mimeType: "application/toml",
+      buffer: Buffer.from(withMaximised(toml, "polar")),
+    });
+    check(!!await waitLog(p, (l) => l === "bv: opened the scene file chosen.toml", 10_000),
+      "the scene chosen in the file chooser opens");
+    await p.page.waitForTimeout(SETTLE_MS);
+    const after = await shot(p.page, "webgl-chooser-opened");
+    notBlank(after, "the chosen scene");
+    const d = difference(before, after, [320, 40, W - 10, H - 40]);
+    check(d > 0.05, `the chosen scene (the polar view maximised) is drawn (${(100 * d).toFixed(1)}% of the pixels changed)`);
+  } catch (e) {
+    check(false, `Ctrl+O opens the browser's file chooser: ${e}`);
+  }
+  noErrors(p, "a page a scene is chosen on");
+  await p.page.close();
 }
 
 // Long computations run in steps between frames: the page keeps drawing

@@ -77,6 +77,15 @@ pub fn unavailable(ctx: &egui::Context, what: &str) -> Option<String> {
     None
 }
 
+/// Whether the device draws but has no storage buffers (a browser's WebGL2):
+/// the views whose shaders read the parameter tables from them draw on the
+/// CPU or say that they need WebGPU.
+pub fn lacks_storage_buffers(ctx: &egui::Context) -> bool {
+    device_lost(ctx).is_none()
+        && render_state(ctx)
+            .is_some_and(|rs| rs.device.limits().max_storage_buffers_per_shader_stage == 0)
+}
+
 /// Why the device of `ctx`'s render state was lost, if it was.
 pub fn device_lost(ctx: &egui::Context) -> Option<String> {
     let lost: Option<Lost> = ctx.data(|d| d.get_temp(lost_key()));

@@ -16,6 +16,10 @@
 //! pixel size, and only when something it depends on changed (BRDF specs,
 //! light, settings, size), so an idle or unrelated frame costs nothing. On a
 //! software renderer a drag renders at half the resolution ([`DRAG_SCALE`]).
+//! On a device without storage buffers (a browser's WebGL2), which the
+//! shader's parameter tables need, the same picture is drawn on the CPU by
+//! [`crate::gpu::lit_sphere::reference_image`], the twin the GPU renderer's
+//! parity test holds it to, at most [`CPU_PIXELS`] pixels scaled up.
 
 use super::gpu_image::{self, Deferred, Drawable, GpuImage, PackCheck};
 use super::{Scene, View};
@@ -60,6 +64,70 @@ pub struct LitSphereView {
     pub view_rect: Option<Rect>,
     /// How many spheres the last frame showed.
     pub tiles: usize,
+    /// The picture drawn on the CPU where the device cannot run the shader.
+    cpu: CpuSphere,
+}
+
+/// Pixels of the CPU-drawn lit sphere at most (a quarter of that while
+/// something is dragged): bv-core's f64 models at about 100 ns an evaluation
+/// in a page keep a redraw within a frame or two; egui scales the image up.
+pub const CPU_PIXELS: f32 = 360_000.0;
+
+/// The lit sphere drawn by [`crate::gpu::lit_sphere::reference_image`] (the
+/// CPU twin the GPU renderer's parity test holds it to) into an egui texture,
+/// drawn again only when the models, the settings or the size changed.
+#[derive(Default)]
+struct CpuSphere {
+    drawn: Option<(Vec<ModelSpec>, LitSphereSettings, (u32, u32))>,
+    texture: Option<egui::TextureHandle>,
+}
+
+impl CpuSphere {
+    fn draw(
+        &mut self,
+        ctx: &egui::Context,
+        scene: &Scene<'_>,
+        drawables: &[Drawable],
+        rect: Rect,
+        dark: bool,
+    ) -> Result<Option<egui::TextureId>, String> {
+        if drawables.is_empty() {
+            return Ok(None);
+        }
+        let ppp = ctx.pixels_per_point();
+        let budget = if scene.interacting && !scene.figure {
+            CPU_PIXELS / 4.0
+        } else {
+            CPU_PIXELS
+        };
+        let full = rect.width() * rect.height() * ppp * ppp;
+        let scale = if scene.figure {
+            1.0
+        } else {
+            (budget / full.max(1.0)).sqrt().min(1.0)
+        };
+        let size = gpu_image::pixel_size(rect, ppp * scale);
+        let settings = LitSphereView::settings(scene, dark, ppp * scale);
+        let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
+        let key = (specs, settings, size);
+        if self.drawn.as_ref() != Some(&key) || self.texture.is_none() {
+            let img = crate::gpu::lit_sphere::reference_image(&key.0, &settings, size.0, size.1)
+                .map_err(|e| format!("cannot draw the lit sphere on the CPU: {e}"))?;
+            let image = egui::ColorImage::from_rgba_unmultiplied(
+                [img.width() as usize, img.height() as usize],
+                img.as_raw(),
+            );
+            let options = egui::TextureOptions::LINEAR;
+            match &mut self.texture {
+                Some(t) => t.set(image, options),
+                None => {
+                    self.texture = Some(ctx.load_texture("bv lit sphere (CPU)", image, options))
+                }
+            }
+            self.drawn = Some(key);
+        }
+        Ok(self.texture.as_ref().map(egui::TextureHandle::id))
+    }
 }
 
 impl LitSphereView {
@@ -113,6 +181,28 @@ impl LitSphereView {
                 pixels_per_point,
             ),
             turn: scene.state.display.turn_deg.to_radians() + FRAME_TURN,
+        }
+    }
+
+    /// Light drag: the light goes where the pointer is on the sphere.
+    fn light_drag(
+        &self,
+        response: &egui::Response,
+        rect: Rect,
+        tiles: usize,
+        out: &mut Vec<Command>,
+    ) {
+        if (response.dragged() || response.clicked())
+            && tiles > 0
+            && let Some(p) = response.interact_pointer_pos()
+        {
+            let local = p - rect.min;
+            let dir = light_from_drag(
+                DVec2::new(local.x.into(), local.y.into()),
+                DVec2::new(rect.width().into(), rect.height().into()),
+                tiles,
+            );
+            out.push(Command::SetIncident(Incident::from_direction(to_view(dir))));
         }
     }
 
@@ -224,6 +314,32 @@ impl View for LitSphereView {
         let (drawables, mut errors) =
             gpu_image::drawables(scene, lit.side_by_side, &mut self.pack_check);
         self.tiles = drawables.len();
+        if gpu_image::lacks_storage_buffers(ui.ctx()) {
+            // WebGL2: the same picture from bv-core's f64 models on the CPU.
+            let id = self.cpu.draw(ui.ctx(), scene, &drawables, rect, dark);
+            match id {
+                Ok(Some(id)) => {
+                    painter.image(
+                        id,
+                        rect,
+                        Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                        Color32::WHITE,
+                    );
+                    painter.text(
+                        rect.left_bottom() + Vec2::new(6.0, -6.0),
+                        Align2::LEFT_BOTTOM,
+                        "drawn on the CPU (this browser gave WebGL2, not WebGPU)",
+                        egui::FontId::proportional(11.0),
+                        weak,
+                    );
+                }
+                Ok(None) => {}
+                Err(e) => errors.push(e),
+            }
+            self.messages = errors;
+            self.light_drag(&response, rect, drawables.len(), out);
+            return;
+        }
         if let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
             painter.text(
                 rect.center(),
@@ -279,19 +395,7 @@ impl View for LitSphereView {
         }
         self.messages = errors.clone();
 
-        // Light drag: the light goes where the pointer is on the sphere.
-        if (response.dragged() || response.clicked())
-            && !drawables.is_empty()
-            && let Some(p) = response.interact_pointer_pos()
-        {
-            let local = p - rect.min;
-            let dir = light_from_drag(
-                DVec2::new(local.x.into(), local.y.into()),
-                DVec2::new(rect.width().into(), rect.height().into()),
-                drawables.len(),
-            );
-            out.push(Command::SetIncident(Incident::from_direction(to_view(dir))));
-        }
+        self.light_drag(&response, rect, drawables.len(), out);
 
         if self.renderer.building() {
             painter.text(
