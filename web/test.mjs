@@ -530,9 +530,19 @@ async function fileChooserChecks(context, gl, toml) {
   await p.page.waitForTimeout(SETTLE_MS);
   const before = await shot(p.page, "webgl-chooser-before");
   const chooser = p.page.waitForEvent("filechooser", { timeout: 30_000 });
+  // The keys go to the focused element: the canvas, as after a click on it.
+  await p.page.focus("#bv_canvas");
+  const pressed = Date.now();
   await p.page.keyboard.press("Control+O");
   try {
-    const c = await chooser;
+    const c = await chooser.catch((e) => {
+      // Which half failed: bv did not take the key, or the browser did not
+      // show the chooser it asked for (a user activation expires in 5 s).
+      const asked = p.log.includes("bv: file chooser opened");
+      throw new Error(`${asked ? "bv asked for the chooser but the browser showed none" : "bv did not take Ctrl+O"} ` +
+        `(${Date.now() - pressed} ms after the key): ${e.message.split("\n")[0]}`);
+    });
+    console.log(`     the chooser opened ${Date.now() - pressed} ms after the key`);
     check(c.isMultiple(), "Ctrl+O opens the browser's file chooser (several files allowed)");
     await c.setFiles({
       name: "chosen.toml",
