@@ -319,9 +319,9 @@ impl<T: FollowsCatalogue + Send + 'static> Deferred<T> {
         }
     }
 
-    /// Changes whenever another renderer becomes the one returned (a first
-    /// build, or a rebuild for a changed catalogue): what was drawn with the
-    /// one before must be drawn again.
+    /// Changes whenever what the renderer draws changed: a first build, a
+    /// changed catalogue drawn from new code at once, or pipelines compiled
+    /// for it arriving. What was drawn before must be drawn again.
     pub fn generation(&self) -> u64 {
         self.generation
     }

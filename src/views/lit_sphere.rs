@@ -69,8 +69,9 @@ pub struct LitSphereView {
 }
 
 /// Pixels of the CPU-drawn lit sphere at most (a quarter of that while
-/// something is dragged): bv-core's f64 models at about 100 ns an evaluation
-/// in a page keep a redraw within a frame or two; egui scales the image up.
+/// something is dragged; figures are drawn at their full size): one f64
+/// evaluation a pixel, so this bounds a redraw's work whatever the view's
+/// size, and egui scales the image up.
 pub const CPU_PIXELS: f32 = 360_000.0;
 
 /// The lit sphere drawn by [`crate::gpu::lit_sphere::reference_image`] (the
