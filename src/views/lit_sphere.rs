@@ -185,6 +185,52 @@ impl LitSphereView {
         }
     }
 
+    /// The GPU renderer's image of this frame (drawn again only when
+    /// something it depends on changed).
+    fn gpu_texture(
+        &mut self,
+        ui: &Ui,
+        scene: &Scene<'_>,
+        drawables: &[Drawable],
+        rect: Rect,
+        dark: bool,
+    ) -> Option<egui::TextureId> {
+        let ppp = ui.ctx().pixels_per_point();
+        // While something is dragged on a software renderer, a quarter of the
+        // pixels keeps the drag smooth; the full image follows on release. A
+        // click that changes nothing keeps the image as it is.
+        let rs = gpu_image::render_state(ui.ctx());
+        let software = rs.as_ref().is_some_and(gpu_image::is_software);
+        let scale = if software && scene.interacting && !scene.figure {
+            let current = self.drawn.as_ref().map_or(1.0, |k| k.scale);
+            let unchanged = self.drawn.as_ref().is_some_and(|k| {
+                k.specs.len() == drawables.len()
+                    && k.specs.iter().zip(drawables).all(|(a, b)| *a == b.spec)
+                    && k.settings == Self::settings(scene, dark, ppp * current)
+                    && k.size == gpu_image::pixel_size(rect, ppp * current)
+            });
+            if unchanged { current } else { DRAG_SCALE }
+        } else {
+            1.0
+        };
+        if let Some(rs) = &rs {
+            self.image.set_filter(
+                rs,
+                if scale < 1.0 {
+                    eframe::wgpu::FilterMode::Linear
+                } else {
+                    eframe::wgpu::FilterMode::Nearest
+                },
+            );
+        }
+        let size = gpu_image::pixel_size(rect, ppp * scale);
+        let settings = Self::settings(scene, dark, ppp * scale);
+        if drawables.is_empty() {
+            return None;
+        }
+        self.render(ui, drawables, settings, size, scale, scene.figure)
+    }
+
     /// Light drag: the light goes where the pointer is on the sphere.
     fn light_drag(
         &self,
@@ -315,33 +361,10 @@ impl View for LitSphereView {
         let (drawables, mut errors) =
             gpu_image::drawables(scene, lit.side_by_side, &mut self.pack_check);
         self.tiles = drawables.len();
-        if gpu_image::lacks_storage_buffers(ui.ctx()) {
-            // WebGL2: the same picture from bv-core's f64 models on the CPU.
-            let id = self.cpu.draw(ui.ctx(), scene, &drawables, rect, dark);
-            match id {
-                Ok(Some(id)) => {
-                    painter.image(
-                        id,
-                        rect,
-                        Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
-                        Color32::WHITE,
-                    );
-                    painter.text(
-                        rect.left_bottom() + Vec2::new(6.0, -6.0),
-                        Align2::LEFT_BOTTOM,
-                        "drawn on the CPU (this browser gave WebGL2, not WebGPU)",
-                        egui::FontId::proportional(11.0),
-                        weak,
-                    );
-                }
-                Ok(None) => {}
-                Err(e) => errors.push(e),
-            }
-            self.messages = errors;
-            self.light_drag(&response, rect, drawables.len(), out);
-            return;
-        }
-        if let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
+        // WebGL2 has no storage buffers: the same picture from bv-core's f64
+        // models on the CPU.
+        let on_cpu = gpu_image::lacks_storage_buffers(ui.ctx());
+        if !on_cpu && let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
@@ -351,45 +374,32 @@ impl View for LitSphereView {
             );
             return;
         }
-        let ppp = ui.ctx().pixels_per_point();
-        // While something is dragged on a software renderer, a quarter of the
-        // pixels keeps the drag smooth; the full image follows on release. A
-        // click that changes nothing keeps the image as it is.
-        let rs = gpu_image::render_state(ui.ctx());
-        let software = rs.as_ref().is_some_and(gpu_image::is_software);
-        let scale = if software && scene.interacting && !scene.figure {
-            let current = self.drawn.as_ref().map_or(1.0, |k| k.scale);
-            let unchanged = self.drawn.as_ref().is_some_and(|k| {
-                k.specs.len() == drawables.len()
-                    && k.specs.iter().zip(&drawables).all(|(a, b)| *a == b.spec)
-                    && k.settings == Self::settings(scene, dark, ppp * current)
-                    && k.size == gpu_image::pixel_size(rect, ppp * current)
-            });
-            if unchanged { current } else { DRAG_SCALE }
+        let id = if on_cpu {
+            self.cpu
+                .draw(ui.ctx(), scene, &drawables, rect, dark)
+                .unwrap_or_else(|e| {
+                    errors.push(e);
+                    None
+                })
         } else {
-            1.0
+            self.gpu_texture(ui, scene, &drawables, rect, dark)
         };
-        if let Some(rs) = &rs {
-            self.image.set_filter(
-                rs,
-                if scale < 1.0 {
-                    eframe::wgpu::FilterMode::Linear
-                } else {
-                    eframe::wgpu::FilterMode::Nearest
-                },
-            );
-        }
-        let size = gpu_image::pixel_size(rect, ppp * scale);
-        let settings = Self::settings(scene, dark, ppp * scale);
-        if !drawables.is_empty()
-            && let Some(id) = self.render(ui, &drawables, settings, size, scale, scene.figure)
-        {
+        if let Some(id) = id {
             painter.image(
                 id,
                 rect,
                 Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
                 Color32::WHITE,
             );
+            if on_cpu {
+                painter.text(
+                    rect.right_bottom() + Vec2::new(-6.0, -6.0),
+                    Align2::RIGHT_BOTTOM,
+                    "drawn on the CPU (WebGL2, not WebGPU)",
+                    egui::FontId::proportional(11.0),
+                    weak,
+                );
+            }
         }
         if let Some(e) = &self.error {
             errors.push(e.clone());
