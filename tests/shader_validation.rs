@@ -22,6 +22,50 @@ fn every_entry_shader_validates_and_round_trips() {
 }
 
 #[test]
+fn every_entry_composes_on_a_fresh_library() {
+    // Modules are registered as shaders need them: each entry, first on its
+    // library, must find everything it imports (directly or not).
+    for (name, _) in ENTRIES {
+        let mut lib = ShaderLibrary::new().unwrap();
+        assert_eq!(lib.registered().count(), 0, "{name}: registered early");
+        let module = lib.module(name).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        validate(&module).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+    }
+}
+
+#[test]
+fn the_lobe_shaders_leave_the_model_ports_unregistered() {
+    // What the lazy registration is for: the lobe view starts without
+    // parsing every model's port.
+    let mut lib = ShaderLibrary::new().unwrap();
+    for name in ["lobe", "lines", "blit"] {
+        lib.module(name).unwrap();
+    }
+    let registered: Vec<&str> = lib.registered().collect();
+    assert!(
+        registered.iter().any(|p| p.contains("colormap")),
+        "{registered:?}"
+    );
+    for m in bv_core::catalogue().iter() {
+        if let Some(port) = &m.gpu {
+            assert!(
+                !registered.contains(&port.path),
+                "{}: registered for the lobe: {registered:?}",
+                m.id
+            );
+        }
+    }
+    // The lit sphere imports the dispatch, hence every port.
+    lib.module("lit_sphere").unwrap();
+    let registered: Vec<&str> = lib.registered().collect();
+    for m in bv_core::catalogue().iter() {
+        if let Some(port) = &m.gpu {
+            assert!(registered.contains(&port.path), "{}", m.id);
+        }
+    }
+}
+
+#[test]
 fn every_module_validates_on_its_own() {
     let mut lib = ShaderLibrary::new().unwrap();
     for (path, source) in ShaderLibrary::modules().unwrap() {

@@ -150,6 +150,16 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         dithering: false,
         ..Default::default()
     };
+    if let eframe::egui_wgpu::WgpuSetup::CreateNew(setup) = &mut options.wgpu_options.wgpu_setup {
+        // egui's device, plus the feature bv's disk pipeline cache needs where
+        // the adapter has it.
+        let base = setup.device_descriptor.clone();
+        setup.device_descriptor = Arc::new(move |adapter| {
+            let mut desc = base(adapter);
+            desc.required_features |= adapter.features() & crate::gpu::pipeline_cache::FEATURE;
+            desc
+        });
+    }
     if args.bench_frames.is_some() {
         // Measure what drawing costs, not the display's refresh rate.
         options.wgpu_options.surface.present_mode = eframe::wgpu::PresentMode::AutoNoVsync;

@@ -13,7 +13,8 @@
 //! - Plumbing, one of each: [`context`] (the headless device opener, limits,
 //!   offscreen targets), [`readback`] (texture and buffer read-back),
 //!   [`fullscreen`] (full-screen triangle pipelines and passes), [`errors`]
-//!   (error scopes, size checks, the no-adapter message).
+//!   (error scopes, size checks, the no-adapter message), [`pipeline_cache`]
+//!   (the driver's pipeline cache kept on disk between runs).
 //! - CPU data and references: [`envmap`] (environment maps and their
 //!   sampling CDFs), [`display`] (tone map and sRGB), [`sphere`] (the lit
 //!   sphere's geometry).
@@ -35,6 +36,7 @@ pub mod layout;
 pub mod lit_sphere;
 pub mod lobe;
 pub mod pack;
+pub mod pipeline_cache;
 pub mod readback;
 pub mod shaders;
 pub mod specialised;

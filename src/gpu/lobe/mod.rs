@@ -63,9 +63,15 @@ pub struct PixelSize {
 
 /// Pipelines and per-view GPU resources of every lobe view.
 pub struct LobeRenderer {
-    /// Pipelines at the full sample count, then (software renderers only) at one
-    /// sample for frames drawn while something is dragged.
-    sets: Vec<Pipelines>,
+    /// Pipelines at the full sample count.
+    at_rest: Pipelines,
+    /// Pipelines at one sample for frames drawn while something is dragged
+    /// (software renderers with multisampling only), made at the first one.
+    dragging: Option<Pipelines>,
+    /// Whether the adapter is a CPU rasteriser, which pays for every sample.
+    software: bool,
+    /// What more pipelines are made from.
+    parts: pipelines::PipelineParts,
     globals_layout: wgpu::BindGroupLayout,
     style_layout: wgpu::BindGroupLayout,
     blit_layout: wgpu::BindGroupLayout,
@@ -77,7 +83,7 @@ pub struct LobeRenderer {
 impl LobeRenderer {
     /// The offscreen sample count of frames drawn at rest.
     pub fn samples(&self) -> u32 {
-        self.sets[0].samples
+        self.at_rest.samples
     }
 
     /// Uploads what changed in `frame` and records its offscreen pass for view
@@ -95,9 +101,13 @@ impl LobeRenderer {
         let size = fit_texture(asked, device.limits().max_texture_dimension_2d);
         // Line widths follow a target made smaller than asked.
         let ppp = ppp * size[0] as f32 / asked[0].max(1) as f32;
-        let set = match self.sets.get(1) {
-            Some(fast) if frame.interacting => fast,
-            _ => &self.sets[0],
+        let fast = frame.interacting && self.software && self.at_rest.samples > 1;
+        if fast && self.dragging.is_none() {
+            self.dragging = Some(self.parts.make_set(device, 1));
+        }
+        let set = match &self.dragging {
+            Some(one) if fast => one,
+            _ => &self.at_rest,
         };
         let samples = set.samples;
         let fingerprint = frame.fingerprint(size, ppp) ^ u64::from(samples);

@@ -1,12 +1,14 @@
 //! The lobe renderer's pipelines: opaque, blended and wireframe surfaces and
 //! screen-space lines at the offscreen sample count (and, on a software
-//! renderer, at one sample for frames drawn during a drag), and the copy of
-//! the result into egui's pass.
+//! renderer, at one sample for frames drawn during a drag, made at the first
+//! such frame: `bv render` never drags), and the copy of the result into
+//! egui's pass.
 
 use super::frame::LineSeg;
 use super::mesh::Vertex;
 use super::{DEPTH_FORMAT, LobeRenderer, OFFSCREEN_FORMAT};
 use crate::gpu::fullscreen;
+use crate::gpu::pipeline_cache::DiskPipelineCache;
 use crate::gpu::shaders::ShaderLibrary;
 use anyhow::Result;
 use std::collections::HashMap;
@@ -18,6 +20,16 @@ pub(super) struct Pipelines {
     pub(super) blended: wgpu::RenderPipeline,
     pub(super) wire: wgpu::RenderPipeline,
     pub(super) lines: wgpu::RenderPipeline,
+}
+
+/// What the drawing pipelines of any sample count are made from.
+pub(super) struct PipelineParts {
+    /// The pipeline cache kept on disk, where the backend has one.
+    cache: Option<DiskPipelineCache>,
+    lobe_module: wgpu::ShaderModule,
+    lines_module: wgpu::ShaderModule,
+    mesh_layout: wgpu::PipelineLayout,
+    lines_layout: wgpu::PipelineLayout,
 }
 
 /// The sample count used offscreen: 4 where the adapter supports it for both
@@ -127,6 +139,42 @@ impl LobeRenderer {
             immediate_size: 0,
         });
 
+        let parts = PipelineParts {
+            cache: adapter.and_then(|a| DiskPipelineCache::open(device, &a.get_info())),
+            lobe_module,
+            lines_module,
+            mesh_layout,
+            lines_layout,
+        };
+        let at_rest = parts.make_set(device, samples);
+        let blit = fullscreen::pipeline(
+            device,
+            "bv lobe blit",
+            Some(&blit_pl),
+            &blit_module,
+            target_format,
+        );
+
+        Ok(Self {
+            at_rest,
+            dragging: None,
+            software,
+            parts,
+            globals_layout,
+            style_layout,
+            blit_layout,
+            sampler,
+            blit,
+            views: HashMap::new(),
+        })
+    }
+}
+
+impl PipelineParts {
+    /// The drawing pipelines at `samples` samples (the disk cache updated
+    /// with them).
+    pub(super) fn make_set(&self, device: &wgpu::Device, samples: u32) -> Pipelines {
+        let pc = self.cache.as_ref().map(DiskPipelineCache::cache);
         let alpha_blend = wgpu::BlendState::ALPHA_BLENDING;
         let vertex_layout = wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<Vertex>() as u64,
@@ -146,9 +194,9 @@ impl LobeRenderer {
             |label: &str, topology, write: bool, blend: Option<wgpu::BlendState>, multisample| {
                 device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                     label: Some(label),
-                    layout: Some(&mesh_layout),
+                    layout: Some(&self.mesh_layout),
                     vertex: wgpu::VertexState {
-                        module: &lobe_module,
+                        module: &self.lobe_module,
                         entry_point: Some("vs_main"),
                         compilation_options: Default::default(),
                         buffers: &[Some(vertex_layout.clone())],
@@ -161,7 +209,7 @@ impl LobeRenderer {
                     depth_stencil: depth(write),
                     multisample,
                     fragment: Some(wgpu::FragmentState {
-                        module: &lobe_module,
+                        module: &self.lobe_module,
                         entry_point: Some("fs_main"),
                         compilation_options: Default::default(),
                         targets: &[Some(wgpu::ColorTargetState {
@@ -171,7 +219,7 @@ impl LobeRenderer {
                         })],
                     }),
                     multiview_mask: None,
-                    cache: None,
+                    cache: pc,
                 })
             };
 
@@ -183,9 +231,9 @@ impl LobeRenderer {
         let lines_pipeline = |multisample| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("bv lobe lines"),
-                layout: Some(&lines_layout),
+                layout: Some(&self.lines_layout),
                 vertex: wgpu::VertexState {
-                    module: &lines_module,
+                    module: &self.lines_module,
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &[Some(seg_layout.clone())],
@@ -198,7 +246,7 @@ impl LobeRenderer {
                 depth_stencil: depth(false),
                 multisample,
                 fragment: Some(wgpu::FragmentState {
-                    module: &lines_module,
+                    module: &self.lines_module,
                     entry_point: Some("fs_main"),
                     compilation_options: Default::default(),
                     targets: &[Some(wgpu::ColorTargetState {
@@ -208,61 +256,44 @@ impl LobeRenderer {
                     })],
                 }),
                 multiview_mask: None,
-                cache: None,
+                cache: pc,
             })
         };
-        let make_set = |samples: u32| {
-            let ms = wgpu::MultisampleState {
-                count: samples,
-                mask: !0,
-                alpha_to_coverage_enabled: false,
-            };
-            Pipelines {
-                samples,
-                opaque: mesh_pipeline(
-                    "bv lobe opaque",
-                    wgpu::PrimitiveTopology::TriangleList,
-                    true,
-                    None,
-                    ms,
-                ),
-                blended: mesh_pipeline(
-                    "bv lobe blended",
-                    wgpu::PrimitiveTopology::TriangleList,
-                    false,
-                    Some(alpha_blend),
-                    ms,
-                ),
-                wire: mesh_pipeline(
-                    "bv lobe wire",
-                    wgpu::PrimitiveTopology::LineList,
-                    true,
-                    Some(alpha_blend),
-                    ms,
-                ),
-                lines: lines_pipeline(ms),
-            }
+        let ms = wgpu::MultisampleState {
+            count: samples,
+            mask: !0,
+            alpha_to_coverage_enabled: false,
         };
-        let mut sets = vec![make_set(samples)];
-        if software && samples > 1 {
-            sets.push(make_set(1));
+        let set = Pipelines {
+            samples,
+            opaque: mesh_pipeline(
+                "bv lobe opaque",
+                wgpu::PrimitiveTopology::TriangleList,
+                true,
+                None,
+                ms,
+            ),
+            blended: mesh_pipeline(
+                "bv lobe blended",
+                wgpu::PrimitiveTopology::TriangleList,
+                false,
+                Some(alpha_blend),
+                ms,
+            ),
+            wire: mesh_pipeline(
+                "bv lobe wire",
+                wgpu::PrimitiveTopology::LineList,
+                true,
+                Some(alpha_blend),
+                ms,
+            ),
+            lines: lines_pipeline(ms),
+        };
+        if let Some(cache) = &self.cache {
+            // A cache that cannot be written costs the next run a compile,
+            // nothing else: not worth an error.
+            let _ = cache.save();
         }
-        let blit = fullscreen::pipeline(
-            device,
-            "bv lobe blit",
-            Some(&blit_pl),
-            &blit_module,
-            target_format,
-        );
-
-        Ok(Self {
-            sets,
-            globals_layout,
-            style_layout,
-            blit_layout,
-            sampler,
-            blit,
-            views: HashMap::new(),
-        })
+        set
     }
 }
