@@ -225,6 +225,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 shot: args2.screenshot.clone().map(Shot::new),
                 outcome: outcome2,
             };
+            app.viewer.panels_on_clear = true;
             if app.bench.is_some() {
                 app.viewer.force_interacting = true;
                 if let Ok(v) = std::env::var("BV_BENCH_MAXIMISE") {
@@ -275,6 +276,13 @@ impl eframe::App for BvApp {
         let ctx = ui.ctx().clone();
         let t0 = Instant::now();
         if let Some(b) = &mut self.bench {
+            if b.settling(self.viewer.views_busy()) {
+                // Let progressive views finish (as they have when a user
+                // starts dragging) before the sweep is timed.
+                self.viewer.ui(ui);
+                ctx.request_repaint();
+                return;
+            }
             b.drive(&mut self.viewer);
         }
         self.viewer.ui(ui);
@@ -313,6 +321,12 @@ impl eframe::App for BvApp {
         self.persist
     }
 
+    /// The panels' colour: the panels are drawn without a fill of their own
+    /// on it (see `Viewer::panels_on_clear`).
+    fn clear_color(&self, visuals: &egui::Visuals) -> [f32; 4] {
+        visuals.panel_fill.to_normalized_gamma_f32()
+    }
+
     fn auto_save_interval(&self) -> Duration {
         Duration::from_secs(10)
     }
@@ -329,6 +343,12 @@ struct Bench {
     what: String,
     adapter: String,
     reported: bool,
+    /// When the first frame asked whether the views are still busy.
+    settle_start: Option<Instant>,
+    /// Frames in a row whose views were all idle.
+    idle_frames: usize,
+    /// How long the views took to settle, once they have.
+    settled_after: Option<Duration>,
 }
 
 impl Bench {
@@ -344,7 +364,34 @@ impl Bench {
             intervals: Vec::new(),
             ui_times: Vec::new(),
             what: String::new(),
+            settle_start: None,
+            idle_frames: 0,
+            settled_after: None,
         }
+    }
+
+    /// Longest wait for busy views before the sweep starts regardless.
+    const MAX_SETTLE: Duration = Duration::from_secs(60);
+    /// Frames in a row with every view idle that make the window settled (a
+    /// view starts its work, a renderer build or an accumulation, only once
+    /// it has drawn).
+    const IDLE_FRAMES: usize = 5;
+
+    /// Whether the sweep should still wait: views at work (the environment
+    /// accumulating its samples, a renderer compiling) finish first, for at
+    /// most [`Self::MAX_SETTLE`]. Without this the first frames time the
+    /// environment view converging, which is no part of a slider drag.
+    fn settling(&mut self, busy: bool) -> bool {
+        if self.settled_after.is_some() {
+            return false;
+        }
+        let start = *self.settle_start.get_or_insert_with(Instant::now);
+        self.idle_frames = if busy { 0 } else { self.idle_frames + 1 };
+        if self.idle_frames < Self::IDLE_FRAMES && start.elapsed() < Self::MAX_SETTLE {
+            return true;
+        }
+        self.settled_after = Some(start.elapsed());
+        false
     }
 
     /// Moves a float parameter of the selected BRDF one step along a
@@ -414,11 +461,12 @@ impl Bench {
 
     fn report(&self) -> String {
         format!(
-            "bench: {} frames sweeping {} on {}: frame time p50 {:.2} ms, p95 {:.2} ms ({:.1} fps median); \
-             app ui (incl. mesh rebuild) p50 {:.2} ms, p95 {:.2} ms",
+            "bench: {} frames sweeping {} on {} (after {:.1} s of views settling): frame time p50 {:.2} ms, \
+             p95 {:.2} ms ({:.1} fps median); app ui (incl. mesh rebuild) p50 {:.2} ms, p95 {:.2} ms",
             self.intervals.len(),
             self.what,
             self.adapter,
+            self.settled_after.unwrap_or_default().as_secs_f64(),
             percentile(&self.intervals, 0.5),
             percentile(&self.intervals, 0.95),
             1e3 / percentile(&self.intervals, 0.5).max(1e-9),

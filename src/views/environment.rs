@@ -661,9 +661,18 @@ impl View for EnvironmentView {
         let response = ui.allocate_rect(rect, Sense::hover());
         self.view_rect = Some(rect);
         let painter = ui.painter_at(rect);
-        if !scene.transparent {
-            painter.rect_filled(rect, 0.0, Color32::BLACK);
-        }
+        // Black where no picture covers the rectangle (the accumulated
+        // picture is opaque; a hidden fill costs a software renderer as much
+        // as a visible one).
+        let background = painter.add(egui::Shape::Noop);
+        let fill_background = || {
+            if !scene.transparent {
+                painter.set(
+                    background,
+                    egui::Shape::rect_filled(rect, 0.0, Color32::BLACK),
+                );
+            }
+        };
         let weak = ui.visuals().weak_text_color();
         let env = &scene.state.lighting.env;
 
@@ -691,6 +700,7 @@ impl View for EnvironmentView {
         });
 
         if let Some(why) = gpu_image::unavailable(ui.ctx(), "The environment view") {
+            fill_background();
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
@@ -724,6 +734,7 @@ impl View for EnvironmentView {
         }
         let size = gpu_image::pixel_size(rect, ui.ctx().pixels_per_point() * scale);
         let mut more = false;
+        let mut covered = false;
         if !drawables.is_empty() {
             let mode = Mode {
                 interacting: scene.interacting,
@@ -734,6 +745,7 @@ impl View for EnvironmentView {
             let (id, m) = self.step(ui, &drawables, env, size, mode);
             more = m;
             if let Some(id) = id {
+                covered = true;
                 painter.image(
                     id,
                     rect,
@@ -746,6 +758,9 @@ impl View for EnvironmentView {
             if self.renderer.ready().is_some() {
                 self.sync_map(ui.ctx(), &env.map);
             }
+        }
+        if !covered {
+            fill_background();
         }
         if more || self.loading.is_some() {
             ui.ctx().request_repaint();

@@ -16,6 +16,12 @@ pub(super) struct Vertex {
 pub(super) struct GpuMesh {
     pub(super) revision: u64,
     pub(super) vertices: wgpu::Buffer,
+    /// Vertices the vertex buffer holds.
+    vertex_count: usize,
+    /// The triangle list the index buffers were made from: a new revision
+    /// with the same connectivity (a slider step at the same resolution)
+    /// only rewrites the vertices.
+    triangles: Vec<u32>,
     pub(super) indices: wgpu::Buffer,
     pub(super) index_count: u32,
     pub(super) wire_indices: wgpu::Buffer,
@@ -49,15 +55,9 @@ pub fn wire_indices(mesh: &LobeMesh) -> Vec<u32> {
     out
 }
 
-pub(super) fn upload_mesh(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    style_layout: &wgpu::BindGroupLayout,
-    d: &MeshDraw,
-) -> GpuMesh {
-    let m = &d.mesh;
-    let vertices: Vec<Vertex> = m
-        .positions
+/// The vertices of a mesh as the vertex buffer holds them.
+fn vertices_of(m: &LobeMesh) -> Vec<Vertex> {
+    m.positions
         .iter()
         .zip(&m.normals)
         .zip(&m.values)
@@ -66,7 +66,35 @@ pub(super) fn upload_mesh(
             normal: *n,
             value: (v[0] + v[1] + v[2]) / 3.0,
         })
-        .collect();
+        .collect()
+}
+
+impl GpuMesh {
+    /// Takes revision `d.revision` in place when its connectivity is the one
+    /// uploaded (the vertices are rewritten into the same buffer, the index
+    /// buffers kept); `false` when a new upload is needed.
+    pub(super) fn refill(&mut self, queue: &wgpu::Queue, d: &MeshDraw) -> bool {
+        let m = &d.mesh;
+        if m.positions.is_empty()
+            || m.positions.len() != self.vertex_count
+            || m.indices != self.triangles
+        {
+            return false;
+        }
+        queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices_of(m)));
+        self.revision = d.revision;
+        true
+    }
+}
+
+pub(super) fn upload_mesh(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    style_layout: &wgpu::BindGroupLayout,
+    d: &MeshDraw,
+) -> GpuMesh {
+    let m = &d.mesh;
+    let vertices = vertices_of(m);
     // Empty buffers are not allowed; a degenerate triangle keeps things simple.
     let vertices = if vertices.is_empty() {
         vec![Vertex {
@@ -89,7 +117,7 @@ pub(super) fn upload_mesh(
         queue,
         "bv lobe vertices",
         bytemuck::cast_slice(&vertices),
-        wgpu::BufferUsages::VERTEX,
+        wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
     );
     let ib = buffer_init(
         device,
@@ -123,6 +151,8 @@ pub(super) fn upload_mesh(
     GpuMesh {
         revision: d.revision,
         vertices: vb,
+        vertex_count: m.positions.len(),
+        triangles: m.indices.clone(),
         index_count: indices.len() as u32,
         indices: ib,
         wire_count: wire.len() as u32,

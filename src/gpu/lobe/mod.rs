@@ -197,8 +197,14 @@ impl LobeRenderer {
                 .get(&d.key)
                 .is_none_or(|g| g.revision != d.revision);
             if stale {
-                vr.meshes
-                    .insert(d.key, upload_mesh(device, queue, style_layout, d));
+                let refilled = vr
+                    .meshes
+                    .get_mut(&d.key)
+                    .is_some_and(|g| g.refill(queue, d));
+                if !refilled {
+                    vr.meshes
+                        .insert(d.key, upload_mesh(device, queue, style_layout, d));
+                }
             }
             if let Some(g) = vr.meshes.get_mut(&d.key) {
                 g.used = true;
