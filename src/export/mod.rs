@@ -89,14 +89,11 @@ pub fn start_view(
     let mut view = (entry.make)();
     let img = off.start_render(frame, |ui| {
         let scene = figure_scene(state, &runtime, frame.transparent);
-        let fill = if frame.transparent {
-            egui::Color32::TRANSPARENT
-        } else {
-            ui.visuals().panel_fill
-        };
+        // No fill: the image is cleared to the panels' colour
+        // (`Offscreen::start_render`).
         if state.display.caption {
             egui::Panel::bottom("bv figure caption")
-                .frame(egui::Frame::NONE.fill(fill).inner_margin(FIGURE_MARGIN))
+                .frame(egui::Frame::NONE.inner_margin(FIGURE_MARGIN))
                 .show_separator_line(false)
                 .show(ui, |ui| {
                     ui.label(
@@ -106,7 +103,7 @@ pub fn start_view(
                 });
         }
         egui::CentralPanel::default()
-            .frame(egui::Frame::NONE.fill(fill).inner_margin(FIGURE_MARGIN))
+            .frame(egui::Frame::NONE.inner_margin(FIGURE_MARGIN))
             .show(ui, |ui| {
                 let mut ignored = Vec::new();
                 view.ui(ui, &scene, &mut ignored);

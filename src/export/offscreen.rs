@@ -267,6 +267,21 @@ impl Offscreen {
             pixels_per_point: ppp,
         };
         let jobs = ctx.tessellate(output.shapes.clone(), ppp);
+        // Cleared to the panels' colour (transparent for a transparent
+        // figure), so a figure's background needs no fill: on a software
+        // renderer a window-sized fill costs tens of milliseconds, a clear
+        // next to nothing. The value is gamma-encoded, as egui-wgpu writes.
+        let [r, g, b, a] = ctx
+            .global_style()
+            .visuals
+            .panel_fill
+            .to_normalized_gamma_f32();
+        let clear = wgpu::Color {
+            r: f64::from(r),
+            g: f64::from(g),
+            b: f64::from(b),
+            a: f64::from(a),
+        };
         let (device, queue) = (&self.rs.device, &self.rs.queue);
         let mut renderer = self.rs.renderer.write();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -296,7 +311,7 @@ impl Offscreen {
                         view: &view,
                         resolve_target: None,
                         ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                            load: wgpu::LoadOp::Clear(clear),
                             store: wgpu::StoreOp::Store,
                         },
                         depth_slice: None,
