@@ -50,32 +50,29 @@ impl Headless {
     /// for an adapter that Vulkan's would have been preferred to anyway.
     /// `WGPU_BACKEND`, when set, is obeyed as it stands.
     pub fn open() -> Result<Self> {
-        let chosen = std::env::var_os("WGPU_BACKEND").is_some();
-        let attempts: &[Option<wgpu::Backends>] = if chosen {
-            &[None]
-        } else {
-            &[Some(wgpu::Backends::PRIMARY), None]
-        };
-        let mut failure = None;
-        for only in attempts {
+        let request = |only: Option<wgpu::Backends>| {
             let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
             if let Some(only) = only {
-                desc.backends &= *only;
+                desc.backends &= only;
             }
             let instance = wgpu::Instance::new(desc);
-            let options = wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                force_fallback_adapter: false,
-                compatible_surface: None,
-                ..Default::default()
-            };
-            match pollster::block_on(instance.request_adapter(&options)) {
-                Ok(adapter) => return Self::on(instance, adapter),
-                Err(e) => failure = Some(e.to_string()),
-            }
-        }
-        let why = failure.unwrap_or_else(|| "no backend was tried".to_string());
-        Err(anyhow!(errors::no_gpu_message(&why)))
+            let adapter =
+                pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                    power_preference: wgpu::PowerPreference::HighPerformance,
+                    force_fallback_adapter: false,
+                    compatible_surface: None,
+                    ..Default::default()
+                }));
+            adapter.map(|a| (instance, a))
+        };
+        let found = if std::env::var_os("WGPU_BACKEND").is_some() {
+            request(None)
+        } else {
+            request(Some(wgpu::Backends::PRIMARY)).or_else(|_| request(None))
+        };
+        let (instance, adapter) =
+            found.map_err(|e| anyhow!(errors::no_gpu_message(&e.to_string())))?;
+        Self::on(instance, adapter)
     }
 
     /// Opens a device with [`limits`] on `adapter`.

@@ -33,7 +33,7 @@ pub struct DiskPipelineCache {
 }
 
 /// The folder caches are kept in, if the environment names one.
-pub fn cache_dir() -> Option<PathBuf> {
+fn cache_dir() -> Option<PathBuf> {
     let var = |k: &str| {
         std::env::var_os(k)
             .filter(|v| !v.is_empty())

@@ -661,18 +661,11 @@ impl View for EnvironmentView {
         let response = ui.allocate_rect(rect, Sense::hover());
         self.view_rect = Some(rect);
         let painter = ui.painter_at(rect);
-        // Black where no picture covers the rectangle (the accumulated
-        // picture is opaque; a hidden fill costs a software renderer as much
-        // as a visible one).
-        let background = painter.add(egui::Shape::Noop);
-        let fill_background = || {
-            if !scene.transparent {
-                painter.set(
-                    background,
-                    egui::Shape::rect_filled(rect, 0.0, Color32::BLACK),
-                );
-            }
-        };
+        let backdrop = gpu_image::Backdrop::reserve(
+            &painter,
+            rect,
+            (!scene.transparent).then_some(Color32::BLACK),
+        );
         let weak = ui.visuals().weak_text_color();
         let env = &scene.state.lighting.env;
 
@@ -700,7 +693,7 @@ impl View for EnvironmentView {
         });
 
         if let Some(why) = gpu_image::unavailable(ui.ctx(), "The environment view") {
-            fill_background();
+            backdrop.fill(&painter);
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
@@ -760,7 +753,7 @@ impl View for EnvironmentView {
             }
         }
         if !covered {
-            fill_background();
+            backdrop.fill(&painter);
         }
         if more || self.loading.is_some() {
             ui.ctx().request_repaint();

@@ -533,6 +533,39 @@ pub fn plate_text_within(
     plate
 }
 
+/// A view's background under its GPU picture, painted only where no opaque
+/// picture covers the rectangle (no renderer yet, the view unavailable, the
+/// CPU fallback): on a software renderer a hidden fill costs as much as a
+/// visible one. Its place is kept at the bottom of the view's shapes.
+pub struct Backdrop {
+    slot: egui::layers::ShapeIdx,
+    rect: egui::Rect,
+    /// `None` for a transparent figure.
+    color: Option<egui::Color32>,
+}
+
+impl Backdrop {
+    /// Keeps the bottom place of `painter`'s shapes for a fill of `rect`.
+    pub fn reserve(
+        painter: &egui::Painter,
+        rect: egui::Rect,
+        color: Option<egui::Color32>,
+    ) -> Self {
+        Self {
+            slot: painter.add(egui::Shape::Noop),
+            rect,
+            color,
+        }
+    }
+
+    /// Paints the background (nothing for a transparent figure).
+    pub fn fill(&self, painter: &egui::Painter) {
+        if let Some(c) = self.color {
+            painter.set(self.slot, egui::Shape::rect_filled(self.rect, 0.0, c));
+        }
+    }
+}
+
 /// The view background of the theme (sRGB 0..1), shared with the lobe view.
 pub fn theme_background(dark: bool) -> [f32; 3] {
     let b = super::lobe3d::background(dark);

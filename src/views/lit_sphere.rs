@@ -350,20 +350,12 @@ impl View for LitSphereView {
         self.view_rect = Some(rect);
         let dark = ui.visuals().dark_mode;
         let painter = ui.painter_at(rect);
-        // The background, filled in below only where no picture covers the
-        // rectangle: the renderer's picture is opaque, and on a software
-        // renderer a hidden fill costs as much as a visible one.
-        let background = painter.add(egui::Shape::Noop);
-        let fill_background = || {
-            if !scene.transparent {
-                let [r, g, b] =
-                    gpu_image::theme_background(dark).map(|c| (c * 255.0).round() as u8);
-                painter.set(
-                    background,
-                    egui::Shape::rect_filled(rect, 0.0, Color32::from_rgb(r, g, b)),
-                );
-            }
-        };
+        let [r, g, b] = gpu_image::theme_background(dark).map(|c| (c * 255.0).round() as u8);
+        let backdrop = gpu_image::Backdrop::reserve(
+            &painter,
+            rect,
+            (!scene.transparent).then_some(Color32::from_rgb(r, g, b)),
+        );
         let weak = ui.visuals().weak_text_color();
         let text = super::strong_text(ui);
 
@@ -375,7 +367,7 @@ impl View for LitSphereView {
         // models on the CPU.
         let on_cpu = gpu_image::lacks_storage_buffers(ui.ctx());
         if !on_cpu && let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
-            fill_background();
+            backdrop.fill(&painter);
             painter.text(
                 rect.center(),
                 Align2::CENTER_CENTER,
@@ -396,7 +388,7 @@ impl View for LitSphereView {
             self.gpu_texture(ui, scene, &drawables, rect, dark)
         };
         if id.is_none() || on_cpu {
-            fill_background();
+            backdrop.fill(&painter);
         }
         if let Some(id) = id {
             painter.image(

@@ -16,12 +16,10 @@ pub(super) struct Vertex {
 pub(super) struct GpuMesh {
     pub(super) revision: u64,
     pub(super) vertices: wgpu::Buffer,
-    /// Vertices the vertex buffer holds.
-    vertex_count: usize,
-    /// The triangle list the index buffers were made from: a new revision
-    /// with the same connectivity (a slider step at the same resolution)
+    /// The grid the index buffers were made for, if the mesh is one: a new
+    /// revision on the same grid (a slider step at the same resolution)
     /// only rewrites the vertices.
-    triangles: Vec<u32>,
+    grid: Option<GridKey>,
     pub(super) indices: wgpu::Buffer,
     pub(super) index_count: u32,
     pub(super) wire_indices: wgpu::Buffer,
@@ -55,6 +53,33 @@ pub fn wire_indices(mesh: &LobeMesh) -> Vec<u32> {
     out
 }
 
+/// What fixes a grid mesh's connectivity: rings, vertices per ring, whole
+/// sphere, and the vertex and index counts they imply. bv-core builds the
+/// triangle list of a grid from its resolution alone (and reuses it on the
+/// same grounds), so equal keys mean equal index buffers; comparing the
+/// lists themselves would read most of a megabyte on every slider step.
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct GridKey([usize; 5]);
+
+impl GridKey {
+    /// The key of `m`; `None` for a mesh that is not a grid (the ground disc)
+    /// or is empty.
+    fn of(m: &LobeMesh) -> Option<Self> {
+        let rows = m.n_theta.checked_add(1)?;
+        let grid = m.n_theta > 0
+            && m.n_phi > 0
+            && m.positions.len() == rows * m.n_phi
+            && m.indices.len() == m.n_theta * m.n_phi * 6;
+        grid.then_some(Self([
+            m.n_theta,
+            m.n_phi,
+            usize::from(m.full_sphere),
+            m.positions.len(),
+            m.indices.len(),
+        ]))
+    }
+}
+
 /// The vertices of a mesh as the vertex buffer holds them.
 fn vertices_of(m: &LobeMesh) -> Vec<Vertex> {
     m.positions
@@ -70,15 +95,12 @@ fn vertices_of(m: &LobeMesh) -> Vec<Vertex> {
 }
 
 impl GpuMesh {
-    /// Takes revision `d.revision` in place when its connectivity is the one
-    /// uploaded (the vertices are rewritten into the same buffer, the index
-    /// buffers kept); `false` when a new upload is needed.
+    /// Takes revision `d.revision` in place when it lies on the grid uploaded
+    /// (the vertices are rewritten into the same buffer, the index buffers
+    /// kept); `false` when a new upload is needed.
     pub(super) fn refill(&mut self, queue: &wgpu::Queue, d: &MeshDraw) -> bool {
         let m = &d.mesh;
-        if m.positions.is_empty()
-            || m.positions.len() != self.vertex_count
-            || m.indices != self.triangles
-        {
+        if self.grid.is_none() || GridKey::of(m) != self.grid {
             return false;
         }
         queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&vertices_of(m)));
@@ -151,8 +173,7 @@ pub(super) fn upload_mesh(
     GpuMesh {
         revision: d.revision,
         vertices: vb,
-        vertex_count: m.positions.len(),
-        triangles: m.indices.clone(),
+        grid: GridKey::of(m),
         index_count: indices.len() as u32,
         indices: ib,
         wire_count: wire.len() as u32,

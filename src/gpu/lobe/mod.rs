@@ -68,8 +68,9 @@ pub struct LobeRenderer {
     /// Pipelines at one sample for frames drawn while something is dragged
     /// (software renderers with multisampling only), made at the first one.
     dragging: Option<Pipelines>,
-    /// Whether the adapter is a CPU rasteriser, which pays for every sample.
-    software: bool,
+    /// Whether frames drawn during a drag use one sample: on a CPU rasteriser
+    /// (which pays for every sample) that multisamples at rest.
+    drag_at_one_sample: bool,
     /// What more pipelines are made from.
     parts: pipelines::PipelineParts,
     globals_layout: wgpu::BindGroupLayout,
@@ -101,7 +102,7 @@ impl LobeRenderer {
         let size = fit_texture(asked, device.limits().max_texture_dimension_2d);
         // Line widths follow a target made smaller than asked.
         let ppp = ppp * size[0] as f32 / asked[0].max(1) as f32;
-        let fast = frame.interacting && self.software && self.at_rest.samples > 1;
+        let fast = frame.interacting && self.drag_at_one_sample;
         if fast && self.dragging.is_none() {
             self.dragging = Some(self.parts.make_set(device, 1));
         }

@@ -158,7 +158,7 @@ impl LobeRenderer {
         Ok(Self {
             at_rest,
             dragging: None,
-            software,
+            drag_at_one_sample: software && samples > 1,
             parts,
             globals_layout,
             style_layout,
