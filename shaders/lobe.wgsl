@@ -44,7 +44,9 @@ struct VsOut {
     // once per covered pixel, which on a CPU rasteriser is most of the
     // fragment cost. Across one cell of the 128 x 256 grid the value, and so
     // the interpolated colour, differs from a per-pixel lookup by at most a
-    // few 8-bit steps.
+    // few 8-bit steps. An unlit surface (the ground disc) is written as its
+    // colour stands, so it gets the sRGB colour and skips the decode and the
+    // fragment's re-encode.
     @location(2) base: vec3<f32>,
 };
 
@@ -55,7 +57,8 @@ fn vs_main(v: VsIn) -> VsOut {
     o.clip = g.view_proj * vec4<f32>(world, 1.0);
     o.world = world;
     o.normal = v.normal;
-    o.base = srgb_to_linear(base_color(v.value));
+    let base = base_color(v.value);
+    o.base = select(srgb_to_linear(base), base, s.extra.x > 0.5);
     return o;
 }
 
@@ -92,9 +95,8 @@ fn base_color(value: f32) -> vec3<f32> {
 
 @fragment
 fn fs_main(v: VsOut) -> @location(0) vec4<f32> {
-    let base = v.base;
     if (s.extra.x > 0.5) {
-        return vec4<f32>(linear_to_srgb(base), s.color.a);
+        return vec4<f32>(v.base, s.color.a);
     }
     let to_eye = normalize(g.eye.xyz - v.world);
     var n = normalize(v.normal);
@@ -116,6 +118,6 @@ fn fs_main(v: VsOut) -> @location(0) vec4<f32> {
     let c8 = c4 * c4;
     let c16 = c8 * c8;
     let spec = c16 * c16 * c16 * 0.25;
-    let lit = base * (0.28 + 0.55 * diffuse + 0.25 * fill) + vec3<f32>(spec);
+    let lit = v.base * (0.28 + 0.55 * diffuse + 0.25 * fill) + vec3<f32>(spec);
     return vec4<f32>(linear_to_srgb(lit), s.color.a);
 }
