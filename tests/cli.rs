@@ -323,8 +323,68 @@ fn bench_json_and_threads() {
     assert!(v["m_evals_per_second"].as_f64().unwrap() > 0.0);
     // Lambert has a batch kernel; the instruction set is this CPU's.
     assert_eq!(v["kernel"], true);
-    assert!(["avx512", "avx2+fma", "scalar", "portable"].contains(&v["isa"].as_str().unwrap()));
-    assert!(v["lanes"].as_u64().unwrap() >= 1);
+    let best = bv_core::batch::Isa::best();
+    assert_eq!(v["isa"], best.name());
+    assert_eq!(v["lanes"], best.lanes());
+}
+
+/// `bv bench --json` with `BV_ISA` set to `isa`.
+fn bench_with_isa(isa: &str) -> Output {
+    Command::new(BV)
+        .args([
+            "bench",
+            "-m",
+            "phong",
+            "--pairs",
+            "1e3",
+            "--threads",
+            "1",
+            "--json",
+        ])
+        .env("BV_ISA", isa)
+        .stdin(Stdio::null())
+        .output()
+        .expect("bv starts")
+}
+
+#[test]
+fn bv_isa_forces_each_available_path_and_refuses_the_others() {
+    use bv_core::batch::Isa;
+    for isa in Isa::ALL {
+        let o = bench_with_isa(isa.name());
+        if isa.is_available() {
+            assert_eq!(o.status.code(), Some(0), "{isa}: {}", stderr(&o));
+            let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+            assert_eq!(
+                (v["kernel"].clone(), v["isa"].clone()),
+                (true.into(), isa.name().into())
+            );
+            assert_eq!(v["lanes"], isa.lanes());
+        } else {
+            // Refused before anything runs, naming what this CPU has.
+            assert_eq!(o.status.code(), Some(2), "{isa}: {}", stderr(&o));
+            let e = stderr(&o);
+            assert!(
+                e.contains(&format!("BV_ISA={isa}"))
+                    && e.contains("it has")
+                    && e.contains("scalar"),
+                "{e}"
+            );
+            assert!(stdout(&o).is_empty());
+        }
+    }
+    let o = bench_with_isa("sse9");
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(
+        e.contains("`sse9`") && e.contains("avx512, avx2, neon, simd128, scalar"),
+        "{e}"
+    );
+    // Unset or empty: the best path.
+    let o = bench_with_isa("");
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(v["isa"], Isa::best().name());
 }
 
 #[test]

@@ -388,6 +388,10 @@ async function webgpuChecks(context, base) {
   const renderers = a.log.filter((l) => l.startsWith("bv: renderer"));
   console.log(`     ${renderers.join(" | then ")}`);
   check(/BrowserWebGpu/.test(renderers[0] || ""), "WebGPU page: WebGPU adapter and device");
+  // The bundle is built with WebAssembly SIMD (.cargo/config.toml): the lobe
+  // mesh and slices run bv-core's simd128 kernels, not the scalar fallback.
+  const kernels = a.log.find((l) => l.startsWith("bv: batch kernels")) || "(no line)";
+  check(kernels === "bv: batch kernels simd128 (4 lanes)", `WebGPU page: batch kernels on WebAssembly SIMD: ${kernels}`);
   // Headless Chromium on SwiftShader destroys the WebGPU device at its first
   // canvas present (plain JavaScript does the same): the page must notice
   // and carry on with WebGL2.

@@ -94,6 +94,10 @@ async fn run() -> Result<(), String> {
         .ok_or_else(|| format!("the page has no element `{CANVAS_ID}`"))?
         .dyn_into::<web_sys::HtmlCanvasElement>()
         .map_err(|_| format!("`{CANVAS_ID}` is not a canvas"))?;
+    // The instruction set of bv-core's batch kernels (the lobe mesh, image
+    // slices): `simd128` in a bundle built with WebAssembly SIMD.
+    let isa = bv_core::batch::isa();
+    info(&format!("batch kernels {isa} ({} lanes)", isa.lanes()));
     let mut options = eframe::WebOptions {
         // As on the desktop: the UI has no gradients that band without it.
         dithering: false,

@@ -316,7 +316,7 @@ mod tests {
         assert!(r.best_rate() >= r.rate());
         // Lambert has a kernel; the ISA is whatever this CPU offers.
         assert!(r.dispatch.kernel && r.dispatch.lanes >= 1);
-        assert_eq!(r.dispatch.isa, batch::isa().0);
+        assert_eq!(r.dispatch.isa, batch::isa().name());
     }
 
     /// A model that is NaN everywhere, so that every evaluation is counted.

@@ -99,6 +99,13 @@ pub fn main(shell: &Shell) -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return clap_exit(&e),
     };
+    // A forced instruction set for the batch kernels (`BV_ISA=avx2`, to
+    // measure or test one path) that this CPU cannot run is refused before
+    // anything runs, rather than quietly measuring another path.
+    if let Err(e) = bv_core::batch::Isa::from_env() {
+        output::eprint(&format!("bv: {e}\n"));
+        return ExitCode::from(2);
+    }
     // Every model argument below (and the window's) may be a `.brdf` path.
     crate::session::user_models::install();
     let result = match &cli.command {

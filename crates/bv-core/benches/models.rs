@@ -165,26 +165,37 @@ fn batch_eval(c: &mut Criterion) {
         });
         all.push(case);
     }
+    // Every instruction set this CPU has, side by side in one run, so that
+    // the vector paths' gain over `scalar` is read off one report.
     for (name, b) in all {
-        let (isa, lanes) = batch::isa();
-        let path = if b.batch_kernel().is_some() {
-            format!("{isa}x{lanes}")
+        let paths: Vec<Option<batch::Isa>> = if b.batch_kernel().is_some() {
+            batch::Isa::available().into_iter().map(Some).collect()
         } else {
-            "fallback".to_string()
+            vec![None]
         };
-        g.bench_function(format!("{name}/{path}"), |bench| {
-            bench.iter(|| {
-                for start in (0..PAIRS).step_by(CHUNK) {
-                    let end = (start + CHUNK).min(PAIRS);
-                    let [r, gr, bl] = &mut rgb;
-                    let mut out = Out {
-                        rgb: [&mut r[..], &mut gr[..], &mut bl[..]],
-                    };
-                    batch::eval(b.as_ref(), &soa.dirs(start..end), &mut out);
-                    black_box(&rgb);
-                }
-            })
-        });
+        for isa in paths {
+            let path = match isa {
+                Some(i) => format!("{i}x{}", i.lanes()),
+                None => "fallback".to_string(),
+            };
+            g.bench_function(format!("{name}/{path}"), |bench| {
+                bench.iter(|| {
+                    for start in (0..PAIRS).step_by(CHUNK) {
+                        let end = (start + CHUNK).min(PAIRS);
+                        let [r, gr, bl] = &mut rgb;
+                        let mut out = Out {
+                            rgb: [&mut r[..], &mut gr[..], &mut bl[..]],
+                        };
+                        let dirs = soa.dirs(start..end);
+                        match isa {
+                            Some(i) => batch::eval_with(b.as_ref(), i, &dirs, &mut out),
+                            None => batch::eval(b.as_ref(), &dirs, &mut out),
+                        };
+                        black_box(&rgb);
+                    }
+                })
+            });
+        }
     }
     g.finish();
 }

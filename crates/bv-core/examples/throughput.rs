@@ -85,7 +85,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 best = best.max((passes * PAIRS) as f64 / start.elapsed().as_secs_f64());
             }
-            let (isa, width) = batch::isa();
+            let isa = batch::isa();
+            let (isa, width) = (isa.name(), isa.lanes());
             println!(
                 "{}",
                 serde_json::json!({"path": name, "threads": t, "m_evals_per_second": best / 1e6,

@@ -7,6 +7,7 @@
 //! −z side with respect to the +z side (air above glass: `eta = 1.5`). Light
 //! arriving from the −z side has `cos_i < 0` and sees the reciprocal index.
 
+use crate::batch::lanes::{LaneMask, Lanes};
 use crate::params::decl::{Applies, ColorSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
 use crate::{BvError, Result, Rgb};
@@ -373,64 +374,83 @@ impl FresnelLanes {
 
     /// F per channel at incidence cosine `cos` (signed for the dielectric).
     #[inline(always)]
-    pub fn eval<const KIND: u8>(&self, cos: f32) -> [f32; 3] {
+    pub fn eval<const KIND: u8, V: Lanes>(&self, cos: V) -> [V; 3] {
+        let zero = V::splat(0.0);
+        let one = V::splat(1.0);
         match KIND {
             Self::DIELECTRIC => {
-                let inside = cos < 0.0;
-                let c = cos.abs().min(1.0);
-                let sin2_i = (1.0 - c * c).max(0.0);
-                std::array::from_fn(|i| {
-                    let eta = if inside { self.inv_eta[i] } else { self.eta[i] };
-                    let inv_eta2 = if inside {
-                        self.eta2[i]
-                    } else {
-                        self.inv_eta2[i]
-                    };
-                    let sin2_t = sin2_i * inv_eta2;
-                    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
-                    let r_par = (eta * c - cos_t) / (eta * c + cos_t);
-                    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
-                    let f = 0.5 * (r_par * r_par + r_perp * r_perp);
-                    if sin2_t >= 1.0 { 1.0 } else { f }
-                })
+                let inside = cos.lt(zero);
+                let c = cos.abs().min(one);
+                let sin2_i = (one - c * c).max(zero);
+                [
+                    self.dielectric_channel(0, inside, c, sin2_i),
+                    self.dielectric_channel(1, inside, c, sin2_i),
+                    self.dielectric_channel(2, inside, c, sin2_i),
+                ]
             }
             Self::CONDUCTOR => {
-                let c = cos.abs().min(1.0);
-                let cos2 = c * c;
-                let sin2 = 1.0 - cos2;
-                std::array::from_fn(|i| {
-                    let t0 = self.eta2[i] - self.k2[i] - sin2;
-                    let a2b2 = (t0 * t0 + 4.0 * self.eta2k2[i]).sqrt();
-                    // a = √((a²+b² + t0)/2) cancels in f32 when t0 < 0 (k > η,
-                    // every metal); since (a²+b²)² − t0² = 4η²k² it is then
-                    // √2 ηk / r with r = √(a²+b² − t0), and otherwise r/√2
-                    // with r = √(a²+b² + t0): r never cancels. Writing
-                    // t2 = 2 cosθ a = P/Q (Q = r or 1) and clearing Q from
-                    // (Rs + Rp)/2 = Rs t3/(t3 + t4) = (t1 − t2) t3/((t1 + t2)(t3 + t4))
-                    // leaves one division per channel.
-                    let r = (a2b2 + t0.abs()).sqrt();
-                    let metal = t0 < 0.0;
-                    let p = if metal {
-                        2.0 * c * self.sqrt2_etak[i]
-                    } else {
-                        std::f32::consts::SQRT_2 * c * r
-                    };
-                    let q = if metal { r } else { 1.0 };
-                    let t1 = a2b2 + cos2;
-                    let t3 = cos2 * a2b2 + sin2 * sin2;
-                    let t1q = t1 * q;
-                    let f = (t1q - p) * t3 * q / ((t1q + p) * (t3 * q + p * sin2));
-                    if t1q + p <= 0.0 { 1.0 } else { f }
-                })
+                let c = cos.abs().min(one);
+                [
+                    self.conductor_channel(0, c),
+                    self.conductor_channel(1, c),
+                    self.conductor_channel(2, c),
+                ]
             }
             Self::SCHLICK => {
-                let m = (1.0 - cos.abs()).clamp(0.0, 1.0);
+                let m = (one - cos.abs()).clamp(0.0, 1.0);
                 let m2 = m * m;
                 let w = m2 * m2 * m;
-                std::array::from_fn(|i| self.f0[i] + (1.0 - self.f0[i]) * w)
+                [
+                    w * (1.0 - self.f0[0]) + self.f0[0],
+                    w * (1.0 - self.f0[1]) + self.f0[1],
+                    w * (1.0 - self.f0[2]) + self.f0[2],
+                ]
             }
-            _ => [1.0; 3],
+            _ => [one; 3],
         }
+    }
+
+    /// The exact dielectric F of channel `i` at `c = |cos θ|` (≤ 1) with
+    /// `sin²θ`, seen from inside where `inside`.
+    #[inline(always)]
+    fn dielectric_channel<V: Lanes>(&self, i: usize, inside: V::Mask, c: V, sin2_i: V) -> V {
+        let one = V::splat(1.0);
+        let eta = inside.select(V::splat(self.inv_eta[i]), V::splat(self.eta[i]));
+        let inv_eta2 = inside.select(V::splat(self.eta2[i]), V::splat(self.inv_eta2[i]));
+        let sin2_t = sin2_i * inv_eta2;
+        let cos_t = (one - sin2_t).max(V::splat(0.0)).sqrt();
+        let r_par = (eta * c - cos_t) / (eta * c + cos_t);
+        let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
+        let f = (r_par * r_par + r_perp * r_perp) * 0.5;
+        sin2_t.ge(one).select(one, f)
+    }
+
+    /// The exact conductor F of channel `i` at `c = |cos θ|` (≤ 1).
+    #[inline(always)]
+    fn conductor_channel<V: Lanes>(&self, i: usize, c: V) -> V {
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let cos2 = c * c;
+        let sin2 = one - cos2;
+        let t0 = -sin2 + (self.eta2[i] - self.k2[i]);
+        let a2b2 = (t0 * t0 + 4.0 * self.eta2k2[i]).sqrt();
+        // a = √((a²+b² + t0)/2) cancels in f32 when t0 < 0 (k > η, every
+        // metal); since (a²+b²)² − t0² = 4η²k² it is then √2 ηk / r with
+        // r = √(a²+b² − t0), and otherwise r/√2 with r = √(a²+b² + t0): r
+        // never cancels. Writing t2 = 2 cosθ a = P/Q (Q = r or 1) and
+        // clearing Q from (Rs + Rp)/2 = Rs t3/(t3 + t4)
+        // = (t1 − t2) t3/((t1 + t2)(t3 + t4)) leaves one division per channel.
+        let r = (a2b2 + t0.abs()).sqrt();
+        let metal = t0.lt(zero);
+        let p = metal.select(
+            c * (2.0 * self.sqrt2_etak[i]),
+            c * r * std::f32::consts::SQRT_2,
+        );
+        let q = metal.select(r, one);
+        let t1 = a2b2 + cos2;
+        let t3 = cos2 * a2b2 + sin2 * sin2;
+        let t1q = t1 * q;
+        let f = (t1q - p) * t3 * q / ((t1q + p) * (t3 * q + p * sin2));
+        (t1q + p).le(zero).select(one, f)
     }
 }
 

@@ -6,6 +6,8 @@
 //! `alpha_y` are the roughnesses along the tangent and the bitangent. Every D is
 //! normalised so that `∫ D(h) cosθh dω_h = 1` over the upper hemisphere.
 
+use crate::batch::lanes::{LaneMask, Lanes};
+use crate::batch::math;
 use crate::{BvError, Ndf, Result};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -617,26 +619,26 @@ impl ScaleLanes {
 
     /// D(h) for a unit `h`.
     #[inline(always)]
-    pub fn d<const DIST: u8>(&self, h: [f32; 3]) -> f32 {
+    pub fn d<const DIST: u8, V: Lanes>(&self, h: [V; 3]) -> V {
         let [x, y, z] = h;
         let v = if DIST == Self::GGX {
             let (u, v) = (x * self.inv_ax, y * self.inv_ay);
             let t = u * u + v * v + z * z;
-            self.norm / (t * t)
+            V::splat(self.norm) / (t * t)
         } else if DIST == Self::BLINN {
             // As `blinn_d`: θh = atan2(√(x² + y²), z), e = θh/α.
-            let theta = crate::batch::math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
+            let theta = math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
             let e = theta * self.inv_ax;
-            crate::batch::math::exp(-e * e) * self.norm
+            math::exp(-e * e) * self.norm
         } else {
             let z2 = z * z;
             let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) / z2;
             // As in `beckmann_d`: exp underflows (f32: e > 87) long before
             // the cos⁴ factor, so 0 there avoids 0/0 at the horizon.
-            let d = crate::batch::math::exp(-e) * self.norm / (z2 * z2);
-            if e > 87.0 { 0.0 } else { d }
+            let d = math::exp(-e) * self.norm / (z2 * z2);
+            e.gt(V::splat(87.0)).select(V::splat(0.0), d)
         };
-        if z > 0.0 { v } else { 0.0 }
+        z.gt(V::splat(0.0)).select(v, V::splat(0.0))
     }
 
     /// GGX's `D(h) G(wi, wo) / (4 cosθi cosθo)` with separable
@@ -649,48 +651,48 @@ impl ScaleLanes {
     /// `G/(4 zi zo) = 1/(2 (si zo + so zi))`. Both directions must be above
     /// the horizon (the caller masks the others).
     #[inline(always)]
-    pub fn ggx_dg<const CORRELATED: bool>(
+    pub fn ggx_dg<const CORRELATED: bool, V: Lanes>(
         &self,
-        wi: [f32; 3],
-        wo: [f32; 3],
-        hu: [f32; 3],
-        l2: f32,
-    ) -> f32 {
+        wi: [V; 3],
+        wo: [V; 3],
+        hu: [V; 3],
+        l2: V,
+    ) -> V {
         let (u, v) = (hu[0] * self.inv_ax, hu[1] * self.inv_ay);
         let t = u * u + v * v + hu[2] * hu[2];
-        let s =
-            |w: [f32; 3]| (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt();
-        let (si, so) = (s(wi), s(wo));
+        let (si, so) = (self.ggx_s(wi), self.ggx_s(wo));
         let g = if CORRELATED {
-            2.0 * (si * wo[2] + so * wi[2])
+            (si * wo[2] + so * wi[2]) * 2.0
         } else {
             (wi[2] + si) * (wo[2] + so)
         };
-        self.norm * (l2 * l2) / (t * t * g)
+        l2 * l2 * self.norm / (t * t * g)
+    }
+
+    /// `s = √(z² + wx²αx² + wy²αy²)` of [`ScaleLanes::ggx_dg`].
+    #[inline(always)]
+    fn ggx_s<V: Lanes>(&self, w: [V; 3]) -> V {
+        (w[2] * w[2] + w[0] * w[0] * self.ax2 + w[1] * w[1] * self.ay2).sqrt()
     }
 
     /// `1 + Λ(w)` (+∞ at and below the horizon): the form every G needs.
     /// GGX's `1 + (−1 + √(1 + t))/2` is `(1 + √(1 + t))/2`.
     #[inline(always)]
-    pub fn one_plus_lambda<const DIST: u8>(&self, w: [f32; 3]) -> f32 {
+    pub fn one_plus_lambda<const DIST: u8, V: Lanes>(&self, w: [V; 3]) -> V {
         let [x, y, z] = w;
         let t = (x * x * self.ax2 + y * y * self.ay2) / (z * z);
         let v = if DIST == Self::GGX {
-            0.5 * (1.0 + (1.0 + t).sqrt())
+            ((t + 1.0).sqrt() + 1.0) * 0.5
         } else {
             // beckmann_lambda_a with a = 1/(α tanθ) = 1/√t.
-            let a = 1.0 / t.sqrt();
-            let l = 0.5
-                * (crate::batch::math::exp(-a * a) / (a * SQRT_PI as f32)
-                    - crate::batch::math::erfc(a));
-            let l = if a > 26.0 { 0.0 } else { l.max(0.0) };
-            1.0 + if t == 0.0 { 0.0 } else { l }
+            let a = V::splat(1.0) / t.sqrt();
+            let l = (math::exp(-a * a) / (a * SQRT_PI as f32) - math::erfc(a)) * 0.5;
+            let l = a
+                .gt(V::splat(26.0))
+                .select(V::splat(0.0), l.max(V::splat(0.0)));
+            t.eq(V::splat(0.0)).select(V::splat(0.0), l) + 1.0
         };
-        if z > 0.0 && t < f32::INFINITY {
-            v
-        } else {
-            f32::INFINITY
-        }
+        (z.gt(V::splat(0.0)) & t.lt(V::splat(f32::INFINITY))).select(v, V::splat(f32::INFINITY))
     }
 }
 

@@ -10,7 +10,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
-use bv_core::batch::{self, Dirs, Kernel, LaneKernel, Out, PairBuf};
+use bv_core::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, PairBuf};
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
 use bv_core::sampling::{self, BvRng};
 use bv_core::{Brdf, Claims, ModelSpec, Rgb, catalogue};
@@ -111,19 +111,35 @@ fn pairs(seed: u64) -> PairBuf {
     PairBuf::from_pairs(&out)
 }
 
-/// The first lane where the kernel and `eval` disagree beyond the tolerance.
+/// The first lane where the kernel and `eval` disagree beyond the tolerance,
+/// on any instruction set this CPU has (each path's own compiled copy of the
+/// kernel; the vector paths also see lane counts that leave a remainder).
 fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
+    let available = Isa::available();
+    assert!(available.contains(&Isa::Scalar));
+    for isa in available {
+        if let Some(e) = first_mismatch_on(brdf, dirs, isa) {
+            return Some(format!("[{isa}] {e}"));
+        }
+    }
+    None
+}
+
+/// [`first_mismatch`] on one instruction set.
+fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String> {
     let n = dirs.len();
     let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
     let [r, g, b] = &mut rgb;
-    let d = batch::eval(
+    let d = batch::eval_with(
         brdf,
+        isa,
         &dirs.dirs(0..n),
         &mut Out {
             rgb: [&mut r[..], &mut g[..], &mut b[..]],
         },
     );
     assert!(d.kernel);
+    assert_eq!((d.isa, d.lanes), (isa.name(), isa.lanes()));
     #[allow(clippy::needless_range_loop)] // lane i of four arrays
     for i in 0..n {
         let (wi, wo) = dirs.pair(i);
@@ -191,7 +207,15 @@ fn every_kernel_matches_the_scalar_reference() {
             checked.push(format!("{} ({sets} sets)", m.id));
         }
     }
-    eprintln!("kernels checked: {}", checked.join(", "));
+    eprintln!(
+        "kernels checked on {}: {}",
+        Isa::available()
+            .iter()
+            .map(|i| i.name())
+            .collect::<Vec<_>>()
+            .join(", "),
+        checked.join(", ")
+    );
     for id in WITH_KERNEL {
         assert!(
             checked.iter().any(|c| c.starts_with(&format!("{id} ("))),
@@ -255,13 +279,10 @@ struct Wrong(Box<dyn Brdf>, WrongKernel);
 #[derive(Debug)]
 struct WrongKernel;
 impl LaneKernel for WrongKernel {
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let v = (0.5 / PI * (1.0 + 2e-4)) as f32;
-        if wi[2] > 0.0 && wo[2] > 0.0 {
-            [v; 3]
-        } else {
-            [0.0; 3]
-        }
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let v = V::splat((0.5 / PI * (1.0 + 2e-4)) as f32);
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        [above.select(v, V::splat(0.0)); 3]
     }
 }
 impl Brdf for Wrong {
@@ -288,7 +309,61 @@ fn a_wrong_kernel_is_caught() {
     let dirs = pairs(9);
     assert!(first_mismatch(lambert.as_ref(), &dirs).is_none());
     let wrong = Wrong(lambert, WrongKernel);
-    assert!(first_mismatch(&wrong, &dirs).is_some());
+    for isa in Isa::available() {
+        assert!(first_mismatch_on(&wrong, &dirs, isa).is_some(), "{isa}");
+    }
+}
+
+#[test]
+fn every_length_fills_exactly_its_lanes() {
+    // Whole vectors and every remainder (0 to 16 lanes past a multiple of the
+    // width): lanes 0..n hold the scalar path's values, lanes n.. are untouched.
+    let b = ModelSpec::from_json("cook-torrance", &serde_json::json!({}))
+        .unwrap()
+        .build()
+        .unwrap();
+    let dirs = pairs(11);
+    let m = 40;
+    let mut want = [vec![0f32; m], vec![0f32; m], vec![0f32; m]];
+    {
+        let [r, g, bl] = &mut want;
+        batch::eval_with(
+            b.as_ref(),
+            Isa::Scalar,
+            &dirs.dirs(0..m),
+            &mut Out {
+                rgb: [&mut r[..], &mut g[..], &mut bl[..]],
+            },
+        );
+    }
+    for isa in Isa::available() {
+        for n in 0..=m {
+            let mut rgb = [vec![-7f32; m], vec![-7f32; m], vec![-7f32; m]];
+            let [r, g, bl] = &mut rgb;
+            batch::eval_with(
+                b.as_ref(),
+                isa,
+                &dirs.dirs(0..n),
+                &mut Out {
+                    rgb: [&mut r[..], &mut g[..], &mut bl[..]],
+                },
+            );
+            for c in 0..3 {
+                for i in 0..m {
+                    let got = rgb[c][i];
+                    if i < n {
+                        let w = want[c][i];
+                        assert!(
+                            (got - w).abs() <= 1e-5 * w.abs().max(1e-2),
+                            "{isa} n {n} lane {i}: {got} vs {w}"
+                        );
+                    } else {
+                        assert_eq!(got, -7.0, "{isa} n {n}: lane {i} was written");
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// A model without a kernel: Lambert's `eval` alone.
@@ -344,4 +419,129 @@ fn dirs_len_is_the_shortest_array() {
         wo: [&a, &b, &a],
     };
     assert_eq!(d.len(), 3);
+}
+
+/// Which function [`MathLanes`] computes.
+#[derive(Debug, Clone, Copy)]
+enum MathFn {
+    Exp,
+    Ln,
+    Erfc,
+    Atan2,
+    Pow1m,
+}
+
+/// One of `batch::math`'s functions as a kernel: red = f(wi.x, wi.y) on
+/// every lane, so that the function runs in each instruction set's code.
+#[derive(Debug)]
+struct MathLanes(MathFn);
+
+impl LaneKernel for MathLanes {
+    fn lane<V: Lanes>(&self, wi: [V; 3], _wo: [V; 3]) -> [V; 3] {
+        use bv_core::batch::math;
+        let (x, y) = (wi[0], wi[1]);
+        let v = match self.0 {
+            MathFn::Exp => math::exp(x),
+            MathFn::Ln => math::ln(x),
+            MathFn::Erfc => math::erfc(x),
+            MathFn::Atan2 => math::atan2_first_quadrant(y, x),
+            // x^400 from x and 1 − x (the sharp Phong lobe's case).
+            MathFn::Pow1m => math::pow_1m(x, y, 400.0),
+        };
+        [v, V::splat(0.0), V::splat(0.0)]
+    }
+}
+
+#[test]
+fn lane_math_matches_f64_on_every_path() {
+    // (function, inputs (x, y), the f64 reference, relative tolerance, and
+    // an absolute floor).
+    type Case = (MathFn, Vec<(f32, f32)>, fn(f64, f64) -> f64, f64, f64);
+    let grid = |lo: f32, hi: f32, n: usize| -> Vec<(f32, f32)> {
+        (0..=n)
+            .map(|i| (lo + (hi - lo) * i as f32 / n as f32, 0.0))
+            .collect()
+    };
+    let near_one: Vec<(f32, f32)> = (0..2000)
+        .map(|i| {
+            let y = 1e-7f64 * 1.01f64.powi(i);
+            ((1.0 - y) as f32, y as f32)
+        })
+        .filter(|&(x, _)| x > 0.0)
+        .collect();
+    let angles: Vec<(f32, f32)> = (0..=4000)
+        .map(|i| {
+            let a = std::f64::consts::FRAC_PI_2 * i as f64 / 4000.0;
+            (a.cos() as f32, a.sin() as f32)
+        })
+        .collect();
+    let cases: Vec<Case> = vec![
+        (
+            MathFn::Exp,
+            grid(-87.0, 88.0, 20_000),
+            |x, _| x.exp(),
+            3e-7,
+            0.0,
+        ),
+        (
+            MathFn::Ln,
+            grid(1e-3, 4.0, 20_000),
+            |x, _| x.ln(),
+            3e-7,
+            1e-7,
+        ),
+        (
+            MathFn::Erfc,
+            grid(-5.0, 9.0, 20_000),
+            |x, _| libm::erfc(x),
+            5e-7 * 82.0,
+            4e-7,
+        ),
+        (MathFn::Atan2, angles, |x, y| y.atan2(x), 3e-7, 1e-30),
+        // From 1 − x (exact in f64 from the f32 inputs' own values).
+        (
+            MathFn::Pow1m,
+            near_one,
+            // Below y = 0.29 from y (as `ln_near_one`), above from x.
+            |x, y| {
+                if y < 0.29 {
+                    (400.0 * (-y).ln_1p()).exp()
+                } else {
+                    x.powf(400.0)
+                }
+            },
+            2e-5,
+            1e-30,
+        ),
+    ];
+    for isa in Isa::available() {
+        for (f, inputs, reference, rel, abs) in &cases {
+            let n = inputs.len();
+            let xs: Vec<f32> = inputs.iter().map(|p| p.0).collect();
+            let ys: Vec<f32> = inputs.iter().map(|p| p.1).collect();
+            let zs = vec![1f32; n];
+            let mut out = [vec![f32::NAN; n], vec![0f32; n], vec![0f32; n]];
+            let [r, g, b] = &mut out;
+            batch::run(
+                &MathLanes(*f),
+                isa,
+                &Dirs {
+                    wi: [&xs, &ys, &zs],
+                    wo: [&xs, &ys, &zs],
+                },
+                &mut Out {
+                    rgb: [&mut r[..], &mut g[..], &mut b[..]],
+                },
+            );
+            for (i, &(x, y)) in inputs.iter().enumerate() {
+                let want = reference(x as f64, y as f64);
+                let got = out[0][i] as f64;
+                let tol = (rel * want.abs()).max(*abs);
+                assert!(
+                    (got - want).abs() <= tol,
+                    "[{isa}] {f:?}({x}, {y}) = {got:e}, want {want:e}"
+                );
+            }
+        }
+    }
 }

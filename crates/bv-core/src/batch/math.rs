@@ -1,67 +1,80 @@
-//! Branch-free f32 lane math for the batch kernels.
+//! Branch-free lane math for the batch kernels, generic over [`Lanes`].
 //!
-//! Every function here is straight-line arithmetic on `f32` (bit casts,
-//! multiplies, adds, `sqrt`, `min`/`max` and selects written as `if` on
-//! values), marked `#[inline(always)]`, so that inside a kernel loop compiled
-//! for AVX-512 or AVX2 LLVM vectorises the whole evaluation; a call into libm
-//! would stop that. Accuracies are stated against the exact function and are
-//! checked in the tests below and, end to end, by the batch parity test.
+//! Every function here is straight-line vector arithmetic (multiplies,
+//! adds, `sqrt`, `min`/`max`, selects and the two bit-level steps of
+//! [`Lanes`]), marked `#[inline(always)]`, so that it compiles into the
+//! kernel's code for each instruction set; a call into libm would leave the
+//! vector registers. Accuracies are stated against the exact function and
+//! are checked in the tests below (on the scalar path, whose operations are
+//! the same IEEE operations as every vector path's) and, end to end on every
+//! path, by the batch parity test.
+
+use super::lanes::{LaneMask, Lanes, WideLanes};
 
 /// ln 2 split for Cody–Waite range reduction: `HI` has its low 12 bits zero, so
 /// `n · HI` is exact for |n| ≤ 2¹².
 const LN2_HI: f32 = 0.693_145_75;
 const LN2_LO: f32 = 1.428_606_8e-6;
 const LOG2E: f32 = std::f32::consts::LOG2_E;
-/// 1.5 · 2²³: adding it rounds a float of magnitude < 2²² to an integer, whose
-/// value then sits in the low mantissa bits.
-const ROUND_MAGIC: f32 = 12_582_912.0;
 
 /// `eˣ`, relative error ≲ 2e-7 on [−87, 88]; 0 below −87.3 (the f32 normal
 /// range ends there), +∞ above 88.7.
 #[inline(always)]
-pub fn exp(x: f32) -> f32 {
+pub fn exp<V: Lanes>(x: V) -> V {
     let xc = x.clamp(-87.0, 88.0);
     // n = round(x / ln 2), r = x − n ln 2 ∈ [−ln2/2, ln2/2].
-    let t = xc * LOG2E + ROUND_MAGIC;
-    let n = (t.to_bits() as i32).wrapping_sub(ROUND_MAGIC.to_bits() as i32);
-    let nf = t - ROUND_MAGIC;
+    let nf = (xc * LOG2E).round();
     let r = xc - nf * LN2_HI - nf * LN2_LO;
     // Taylor series to r⁷ (|r| ≤ 0.347: the r⁸/8! remainder is < 3e-9).
-    let p = 1.0
-        + r * (1.0
-            + r * (0.5
-                + r * (1.0 / 6.0
-                    + r * (1.0 / 24.0
-                        + r * (1.0 / 120.0 + r * (1.0 / 720.0 + r * (1.0 / 5040.0)))))));
-    let scale = f32::from_bits(((n + 127) as u32) << 23);
-    let v = p * scale;
-    if x < -87.3 {
-        0.0
-    } else if x > 88.7 {
-        f32::INFINITY
-    } else {
-        v
+    let p = poly(
+        r,
+        &[
+            1.0,
+            1.0,
+            0.5,
+            1.0 / 6.0,
+            1.0 / 24.0,
+            1.0 / 120.0,
+            1.0 / 720.0,
+            1.0 / 5040.0,
+        ],
+    );
+    let v = p * V::pow2i(nf);
+    let v = x.lt(V::splat(-87.3)).select(V::splat(0.0), v);
+    x.gt(V::splat(88.7)).select(V::splat(f32::INFINITY), v)
+}
+
+/// `c[0] + x (c[1] + x (c[2] + …))` by Horner's rule.
+#[inline(always)]
+fn poly<V: Lanes>(x: V, c: &[f32]) -> V {
+    let mut acc = V::splat(c[c.len() - 1]);
+    for &k in c[..c.len() - 1].iter().rev() {
+        acc = acc * x + k;
     }
+    acc
+}
+
+/// `2s (1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9)`, the series of `2 atanh s` for
+/// `|s| ≤ 0.1716`: next term < 2e-9.
+#[inline(always)]
+fn atanh2<V: Lanes>(s: V) -> V {
+    let s2 = s * s;
+    s * poly(s2, &[1.0, 1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0]) * 2.0
 }
 
 /// Natural logarithm for positive normal `x`, relative error ≲ 2e-7 (and
 /// accurate relative to `ln x` itself near `x = 1`, where it matters for
 /// `pow` with large exponents). Non-positive `x` gives −∞.
 #[inline(always)]
-pub fn ln(x: f32) -> f32 {
-    let bits = x.to_bits();
-    let mut e = ((bits >> 23) & 0xff) as i32 - 127;
-    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+pub fn ln<V: Lanes>(x: V) -> V {
+    let (e, m) = x.exponent_mantissa();
     // m ∈ [√½, √2): then s = (m − 1)/(m + 1) has |s| ≤ 0.1716.
-    let big = m > std::f32::consts::SQRT_2;
-    m = if big { m * 0.5 } else { m };
-    e = if big { e + 1 } else { e };
+    let big = m.gt(V::splat(std::f32::consts::SQRT_2));
+    let m = big.select(m * 0.5, m);
+    let e = big.select(e + 1.0, e);
     let s = (m - 1.0) / (m + 1.0);
-    let s2 = s * s;
-    // ln m = 2 atanh s = 2s (1 + s²/3 + s⁴/5 + s⁶/7 + s⁸/9); next term < 2e-9.
-    let poly = 1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0))));
-    let v = e as f32 * std::f32::consts::LN_2 + 2.0 * s * poly;
-    if x > 0.0 { v } else { f32::NEG_INFINITY }
+    let v = e * std::f32::consts::LN_2 + atanh2(s);
+    x.gt(V::splat(0.0)).select(v, V::splat(f32::NEG_INFINITY))
 }
 
 /// `ln x` given both `x` and `y = 1 − x` (each accurate to f32 rounding),
@@ -69,41 +82,44 @@ pub fn ln(x: f32) -> f32 {
 /// rounded `x` would lose every digit: `2 atanh(−y/(2 − y))` by the series of
 /// [`ln`] for `y < 0.29` (`|s| ≤ 0.17`), [`ln`]`(x)` otherwise.
 #[inline(always)]
-pub fn ln_near_one(x: f32, y: f32) -> f32 {
-    let s = -y / (2.0 - y);
-    let s2 = s * s;
-    let poly = 1.0 + s2 * (1.0 / 3.0 + s2 * (1.0 / 5.0 + s2 * (1.0 / 7.0 + s2 * (1.0 / 9.0))));
-    let small = 2.0 * s * poly;
-    if y < 0.29 { small } else { ln(x) }
+pub fn ln_near_one<V: Lanes>(x: V, y: V) -> V {
+    let s = -y / (V::splat(2.0) - y);
+    y.lt(V::splat(0.29)).select(atanh2(s), ln(x))
 }
 
 /// The Phong lobe `clamped_pow(R(wo)·wi, e)` of `phong` and
 /// `modified-phong`, with `R(wo) = (−wo.x, −wo.y, wo.z)`. The cosine is
-/// formed in f64 and the lobe taken from `1 − R(wo)·wi` ([`pow_1m`]): with
-/// exponents up to 10⁴ an f32 cosine's rounding alone would move the peak
-/// value by 10⁻³.
+/// formed in f64 lanes and the lobe taken from `1 − R(wo)·wi` ([`pow_1m`]):
+/// with exponents up to 10⁴ an f32 cosine's rounding alone would move the
+/// peak value by 10⁻³.
 #[inline(always)]
-pub fn mirror_lobe(wi: [f32; 3], wo: [f32; 3], e: f32) -> f32 {
-    let [ix, iy, iz] = wi.map(f64::from);
-    let [ox, oy, oz] = wo.map(f64::from);
-    let x = -ox * ix + -oy * iy + oz * iz;
-    pow_1m(x as f32, (1.0 - x) as f32, e)
+pub fn mirror_lobe<V: Lanes>(wi: [V; 3], wo: [V; 3], e: f32) -> V {
+    let [ix, iy, iz] = widen3(wi);
+    let [ox, oy, oz] = widen3(wo);
+    let x = -ox * ix - oy * iy + oz * iz;
+    pow_1m(V::narrow(x), V::narrow(x.one_minus()), e)
 }
 
 /// `clamped_pow(x, e)` of the Phong-type models, given `x` and `y = 1 − x`:
 /// `x^e` for `0 < x ≤ 1` (1 for `x ≥ 1`), 0 for `x ≤ 0`, with `x⁰ = 1` for
 /// `x > 0`. Passing `1 − x` keeps large exponents accurate near the peak.
 #[inline(always)]
-pub fn pow_1m(x: f32, y: f32, e: f32) -> f32 {
-    let y = y.max(0.0);
-    let v = exp(e * ln_near_one(x, y));
-    if x <= 0.0 {
-        0.0
-    } else if e == 0.0 {
-        1.0
-    } else {
-        v
+pub fn pow_1m<V: Lanes>(x: V, y: V, e: f32) -> V {
+    let y = y.max(V::splat(0.0));
+    if e == 0.0 {
+        return x.gt(V::splat(0.0)).select(V::splat(1.0), V::splat(0.0));
     }
+    let v = exp(ln_near_one(x, y) * e);
+    x.le(V::splat(0.0)).select(V::splat(0.0), v)
+}
+
+/// [`pow_1m`] with an exponent that varies per lane.
+#[inline(always)]
+pub fn pow_1m_lanes<V: Lanes>(x: V, y: V, e: V) -> V {
+    let y = y.max(V::splat(0.0));
+    let v = exp(ln_near_one(x, y) * e);
+    let v = e.eq(V::splat(0.0)).select(V::splat(1.0), v);
+    x.le(V::splat(0.0)).select(V::splat(0.0), v)
 }
 
 /// An RGB triple in f32.
@@ -114,40 +130,42 @@ pub fn rgb(v: crate::Rgb) -> [f32; 3] {
 
 /// `xʸ` for `x ≥ 0`, as `exp(y ln x)`; `0ʸ = 0` for `y > 0` and `x⁰ = 1`.
 #[inline(always)]
-pub fn pow(x: f32, y: f32) -> f32 {
+pub fn pow<V: Lanes>(x: V, y: V) -> V {
     let v = exp(y * ln(x));
-    if y == 0.0 {
-        1.0
-    } else if x > 0.0 {
-        v
-    } else {
-        0.0
-    }
+    let v = x.gt(V::splat(0.0)).select(v, V::splat(0.0));
+    y.eq(V::splat(0.0)).select(V::splat(1.0), v)
 }
 
 /// `erfc x` (Numerical Recipes' `erfcc`, a Chebyshev fit with fractional
 /// error < 1.2e-7 for every x; Press et al., *Numerical Recipes* 2nd ed.
 /// §6.2), with the exponential from [`exp`].
 #[inline(always)]
-pub fn erfc(x: f32) -> f32 {
+pub fn erfc<V: Lanes>(x: V) -> V {
     let z = x.abs();
-    let t = 1.0 / (1.0 + 0.5 * z);
-    let poly = -z * z - 1.265_512_2
-        + t * (1.000_023_7
-            + t * (0.374_091_96
-                + t * (0.096_784_18
-                    + t * (-0.186_288_06
-                        + t * (0.278_868_07
-                            + t * (-1.135_204
-                                + t * (1.488_515_9 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
-    let ans = t * exp(poly);
-    if x >= 0.0 { ans } else { 2.0 - ans }
+    let t = V::splat(1.0) / (z * 0.5 + 1.0);
+    let c = poly(
+        t,
+        &[
+            -1.265_512_2,
+            1.000_023_7,
+            0.374_091_96,
+            0.096_784_18,
+            -0.186_288_06,
+            0.278_868_07,
+            -1.135_204,
+            1.488_515_9,
+            -0.822_152_23,
+            0.170_872_77,
+        ],
+    );
+    let ans = t * exp(c - z * z);
+    x.ge(V::splat(0.0)).select(ans, V::splat(2.0) - ans)
 }
 
 /// `erf x = 1 − erfc x` (absolute error < 1.2e-7).
 #[inline(always)]
-pub fn erf(x: f32) -> f32 {
-    1.0 - erfc(x)
+pub fn erf<V: Lanes>(x: V) -> V {
+    V::splat(1.0) - erfc(x)
 }
 
 /// `atan2(y, x)` for `y ≥ 0`, `x ≥ 0` (the first quadrant: the polar angle
@@ -157,34 +175,116 @@ pub fn erf(x: f32) -> f32 {
 /// or `π/2 − atan(1/t)`, written here so that the whole reduction costs one
 /// division; then an odd degree-9 minimax polynomial. `(0, 0)` gives 0.
 #[inline(always)]
-pub fn atan2_first_quadrant(y: f32, x: f32) -> f32 {
+pub fn atan2_first_quadrant<V: Lanes>(y: V, x: V) -> V {
     // tan(3π/8) = 1 + √2 and tan(π/8) = √2 − 1.
-    let big = y > 2.414_213_5 * x;
-    let mid = y > 0.414_213_57 * x;
-    let (num, den, base) = if big {
-        (-x, y, std::f32::consts::FRAC_PI_2)
-    } else if mid {
-        (y - x, y + x, std::f32::consts::FRAC_PI_4)
-    } else {
-        (y, x, 0.0)
-    };
-    let t = num / den;
-    let t = if den > 0.0 { t } else { 0.0 };
+    let big = y.gt(x * 2.414_213_5);
+    let mid = y.gt(x * 0.414_213_57);
+    let num = big.select(-x, mid.select(y - x, y));
+    let den = big.select(y, mid.select(y + x, x));
+    let base = big.select(
+        V::splat(std::f32::consts::FRAC_PI_2),
+        mid.select(V::splat(std::f32::consts::FRAC_PI_4), V::splat(0.0)),
+    );
+    let t = den.gt(V::splat(0.0)).select(num / den, V::splat(0.0));
     let z = t * t;
     let p =
-        (((8.053_744_5e-2 * z - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_295e-1) * z * t
+        (((z * 8.053_744_5e-2 - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_295e-1) * z * t
             + t;
     base + p
 }
 
 /// A 3-vector of lanes' worth of one direction.
-pub type V3 = [f32; 3];
+pub type V3<V = f32> = [V; 3];
 
 /// Dot product.
 #[inline(always)]
-pub fn dot(a: V3, b: V3) -> f32 {
+pub fn dot<V: Lanes>(a: [V; 3], b: [V; 3]) -> V {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
+
+/// `a + b` per component.
+#[inline(always)]
+pub fn add3<V: Lanes>(a: [V; 3], b: [V; 3]) -> [V; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// `a − b` per component.
+#[inline(always)]
+pub fn sub3<V: Lanes>(a: [V; 3], b: [V; 3]) -> [V; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// `a × b`.
+#[inline(always)]
+pub fn cross<V: Lanes>(a: [V; 3], b: [V; 3]) -> [V; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Per-channel constants as lanes.
+#[inline(always)]
+pub fn splat3<V: Lanes>(c: [f32; 3]) -> [V; 3] {
+    [V::splat(c[0]), V::splat(c[1]), V::splat(c[2])]
+}
+
+/// `a · s` per component.
+#[inline(always)]
+pub fn scale3<V: Lanes>(a: [V; 3], s: V) -> [V; 3] {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+/// The components widened to f64 lanes.
+#[inline(always)]
+pub fn widen3<V: Lanes>(a: [V; 3]) -> [V::Wide; 3] {
+    [a[0].widen(), a[1].widen(), a[2].widen()]
+}
+
+/// `(1 − c)⁵` with `1 − c` clamped to [0, 1]: Schlick's Fresnel weight.
+#[inline(always)]
+pub fn schlick_weight<V: Lanes>(c: V) -> V {
+    pow5((V::splat(1.0) - c).clamp(0.0, 1.0))
+}
+
+/// `x⁵`.
+#[inline(always)]
+pub fn pow5<V: Lanes>(x: V) -> V {
+    let x2 = x * x;
+    x2 * x2 * x
+}
+
+/// `a + (b − a) t`.
+#[inline(always)]
+pub fn lerp<V: Lanes>(a: V, b: V, t: V) -> V {
+    a + (b - a) * t
+}
+
+/// `[e(0), e(1), e(2)]` for an expression `e` of the channel index: the
+/// three channels written out. Lane code uses this instead of std's array
+/// `map` and `from_fn` or a closure: those are not always inlined, and lane
+/// code left out of line is compiled without the vector instruction set
+/// (each vector operation then becomes a call).
+macro_rules! channels {
+    (|$c:ident| $e:expr) => {
+        [
+            {
+                let $c = 0usize;
+                $e
+            },
+            {
+                let $c = 1usize;
+                $e
+            },
+            {
+                let $c = 2usize;
+                $e
+            },
+        ]
+    };
+}
+pub(crate) use channels;
 
 #[cfg(test)]
 mod tests {

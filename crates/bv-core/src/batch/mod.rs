@@ -5,31 +5,51 @@
 //!
 //! A model opts in by giving [`crate::Brdf::batch_kernel`] a [`Kernel`], which
 //! it defines in its own module next to its f64 `eval` (one model, one unit).
-//! Most kernels implement [`LaneKernel`] instead, one lane's evaluation as
-//! straight-line f32 code, and get [`Kernel`] through [`run`]. A model without a
-//! kernel is evaluated by [`eval`] through its scalar f64 `eval`, one lane at a
-//! time, so every caller can use the batch path for every model. The f64 `eval`
-//! stays the reference: the parity test (`tests/batch_parity.rs`) holds each
-//! kernel within 1e-4 relative or 1e-6 absolute of it.
+//! Most kernels implement [`LaneKernel`]: one generic function, `lane<V:
+//! Lanes>`, that evaluates a vector of lanes with the operators and methods
+//! of [`Lanes`] and reads like the f64 formulas it ports. [`run`] compiles
+//! it once per instruction set ([`Isa`]: AVX-512 with 16 lanes, AVX2 + FMA
+//! with 8, NEON and wasm `simd128` with 4, and `f32` itself as the scalar
+//! fallback) and calls the copy for the instruction set chosen at run time
+//! ([`isa`]: the widest this CPU has, or `BV_ISA`'s). A model without a
+//! kernel is evaluated by [`eval`] through its scalar f64 `eval`, one lane at
+//! a time, so every caller can use the batch path for every model. The f64
+//! `eval` stays the reference: the parity test (`tests/batch_parity.rs`)
+//! holds each kernel, on every instruction set this machine has, within
+//! 1e-4 relative or 1e-6 absolute of it.
 //!
-//! # Why `pulp`'s dispatch with auto-vectorised lane loops
+//! # Why explicit vectors, and why our own
 //!
-//! [`run`] hands the lane loop to `pulp::Arch::dispatch`, which detects the
-//! CPU once (AVX-512 "x86-64-v4", AVX2 + FMA "x86-64-v3", or none) and calls
-//! the loop inside a function compiled with those target features; the loop
-//! body is inlined there and LLVM vectorises it to 16 (AVX-512) or 8 (AVX2)
-//! f32 lanes. `pulp` is maintained (it is the SIMD layer of `faer`), was
-//! already in the dependency tree, and its dispatch is safe code. Writing the
-//! kernels against `pulp`'s explicit `Simd` vector API, or `wide`'s fixed-width
-//! types, would fix one width and make every model's kernel a second,
-//! unreadable copy of its formulas; with plain f32 loops the kernel reads like
-//! the f64 code it ports, and the same source compiles to every width.
-//! (`multiversion` would do the dispatch equally well but is not yet a
-//! dependency.) The rule that makes this work: kernel code must be
-//! branch-free (selects written as `if` on values) and call only the inline
-//! math of [`math`], never libm.
+//! The kernels used to be scalar f32 loops left to LLVM's auto-vectoriser
+//! inside `pulp`'s dispatch. On AVX-512 it vectorised most of them; on an
+//! AVX2-only CPU it gave up on all but the simplest (Lambert, Oren-Nayar,
+//! Hapke), and most models ran at scalar speed or below, with nothing to
+//! say so. Written against [`Lanes`], a kernel is vector code by
+//! construction: there is no loop for the compiler to give up on.
+//!
+//! The vector type is this module's own ([`lanes`], with one file per
+//! architecture) rather than a crate's, because each candidate lacked
+//! something the kernels need: `pulp` 0.22's generic `Simd` trait has no
+//! float-to-integer conversion or rounding (`exp` and `ln` need both) and
+//! no NEON implementation; `fearless_simd` 0.4 has no AVX-512 (an AVX-512
+//! machine would drop to 8 lanes, half of what the auto-vectorised kernels
+//! had there); `wide` fixes the instruction set at compile time, so one
+//! binary cannot dispatch at run time. The whole surface is about thirty
+//! operations, each one intrinsic per architecture, with the same
+//! semantics everywhere (see [`lanes`]); the parity test runs every path.
 
+pub mod isa;
+pub mod lanes;
 pub mod math;
+#[cfg(target_arch = "aarch64")]
+mod neon;
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+mod wasm;
+#[cfg(target_arch = "x86_64")]
+mod x86;
+
+pub use isa::{Isa, IsaError};
+pub use lanes::{LaneMask, Lanes, WideLanes};
 
 use crate::Brdf;
 use glam::DVec3;
@@ -156,20 +176,23 @@ impl PairBuf {
 /// A model's batch evaluator: fills `out` with `f` at every lane of `dirs`
 /// (the first `min(dirs.len(), out.len())` lanes).
 pub trait Kernel: Send + Sync + std::fmt::Debug {
-    /// Evaluates the batch.
-    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>);
+    /// Evaluates the batch with the instruction set `isa` (an instruction
+    /// set this CPU lacks is replaced by [`Isa::best`]).
+    fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>);
 }
 
-/// One lane of a kernel, as straight-line f32 code (see the module doc for
-/// the rules that let it vectorise). Implementors get [`Kernel`] for free.
+/// A kernel's lanes: `f(wi, wo)` per channel for a vector of lanes, as
+/// straight-line code on [`Lanes`] (selects instead of branches on lane
+/// values; branches on the kernel's own constants are fine).
+/// Implementors get [`Kernel`] for free, compiled for every instruction set.
 pub trait LaneKernel: Send + Sync + std::fmt::Debug {
-    /// `f(wi, wo)` per channel for one lane.
-    fn lane(&self, wi: math::V3, wo: math::V3) -> [f32; 3];
+    /// `f(wi, wo)` per channel for each lane of `wi` and `wo`.
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3];
 }
 
 impl<K: LaneKernel> Kernel for K {
-    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-        run(self, dirs, out);
+    fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        run(self, isa, dirs, out);
     }
 }
 
@@ -180,43 +203,78 @@ pub struct Zero;
 
 impl LaneKernel for Zero {
     #[inline(always)]
-    fn lane(&self, _wi: math::V3, _wo: math::V3) -> [f32; 3] {
-        [0.0; 3]
+    fn lane<V: Lanes>(&self, _wi: [V; 3], _wo: [V; 3]) -> [V; 3] {
+        [V::splat(0.0); 3]
     }
 }
 
-/// Runs `k` over every lane, compiled for the best instruction set this CPU
-/// has (see the module doc).
+/// Runs `k` over every lane with the instruction set `isa` (or
+/// [`Isa::best`] if this CPU lacks it).
 #[inline]
-pub fn run<K: LaneKernel + ?Sized>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    struct Op<'k, 'd, 'o, 'p, K: ?Sized> {
-        k: &'k K,
-        dirs: &'d Dirs<'d>,
-        out: &'o mut Out<'p>,
+pub fn run<K: LaneKernel>(k: &K, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    let isa = if isa.is_available() { isa } else { Isa::best() };
+    match isa {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `is_available` saw AVX-512F, AVX2 and FMA on this CPU.
+        Isa::Avx512 => unsafe { x86::run_avx512(k, dirs, out) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `is_available` saw AVX2 and FMA on this CPU.
+        Isa::Avx2 => unsafe { x86::run_avx2(k, dirs, out) },
+        #[cfg(target_arch = "aarch64")]
+        Isa::Neon => neon::run_neon(k, dirs, out),
+        #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+        Isa::Simd128 => wasm::run_simd128(k, dirs, out),
+        _ => lanes_loop::<f32, K>(k, dirs, out),
     }
-    impl<K: LaneKernel + ?Sized> pulp::WithSimd for Op<'_, '_, '_, '_, K> {
-        type Output = ();
-        #[inline(always)]
-        fn with_simd<S: pulp::Simd>(self, _simd: S) -> Self::Output {
-            lanes(self.k, self.dirs, self.out);
-        }
-    }
-    pulp::Arch::new().dispatch(Op { k, dirs, out });
 }
 
-/// The lane loop itself, inlined into each instruction set's copy.
+/// The lane loop, inlined into each instruction set's copy: whole vectors of
+/// `V::LANES`, then the remainder through one vector padded with the normal
+/// direction (its lanes are computed and dropped).
 #[inline(always)]
-fn lanes<K: LaneKernel + ?Sized>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+fn lanes_loop<V: Lanes, K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     let n = dirs.len().min(out.len());
     let [ix, iy, iz] = dirs.wi.map(|a| &a[..n]);
     let [ox, oy, oz] = dirs.wo.map(|a| &a[..n]);
     let [r, g, b] = &mut out.rgb;
     let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
-    for i in 0..n {
-        let f = k.lane([ix[i], iy[i], iz[i]], [ox[i], oy[i], oz[i]]);
-        r[i] = f[0];
-        g[i] = f[1];
-        b[i] = f[2];
+    let whole = n - n % V::LANES;
+    let mut i = 0;
+    while i < whole {
+        let wi = [V::load(&ix[i..]), V::load(&iy[i..]), V::load(&iz[i..])];
+        let wo = [V::load(&ox[i..]), V::load(&oy[i..]), V::load(&oz[i..])];
+        let f = k.lane(wi, wo);
+        f[0].store(&mut r[i..]);
+        f[1].store(&mut g[i..]);
+        f[2].store(&mut b[i..]);
+        i += V::LANES;
+    }
+    let rest = n - whole;
+    if rest > 0 {
+        // The widest vector has 16 lanes.
+        let pad = |src: &[f32], fill: f32| {
+            let mut a = [fill; 16];
+            a[..rest].copy_from_slice(&src[whole..]);
+            a
+        };
+        let wi = [
+            V::load(&pad(ix, 0.0)),
+            V::load(&pad(iy, 0.0)),
+            V::load(&pad(iz, 1.0)),
+        ];
+        let wo = [
+            V::load(&pad(ox, 0.0)),
+            V::load(&pad(oy, 0.0)),
+            V::load(&pad(oz, 1.0)),
+        ];
+        let f = k.lane(wi, wo);
+        let mut a = [[0f32; 16]; 3];
+        f[0].store(&mut a[0]);
+        f[1].store(&mut a[1]);
+        f[2].store(&mut a[2]);
+        r[whole..].copy_from_slice(&a[0][..rest]);
+        g[whole..].copy_from_slice(&a[1][..rest]);
+        b[whole..].copy_from_slice(&a[2][..rest]);
     }
 }
 
@@ -225,40 +283,37 @@ fn lanes<K: LaneKernel + ?Sized>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
 pub struct Dispatch {
     /// Whether the model's own kernel ran (`false`: the scalar f64 fallback).
     pub kernel: bool,
-    /// The instruction set the kernel ran with (`"scalar"` for the fallback).
+    /// The instruction set the kernel ran with ([`Isa::name`]; `"scalar"`
+    /// for the fallback).
     pub isa: &'static str,
     /// f32 lanes per vector of that instruction set.
     pub lanes: usize,
 }
 
-/// The instruction set [`run`] dispatches to on this CPU and its f32 lanes:
-/// `("avx512", 16)`, `("avx2+fma", 8)` or `("scalar", 1)`.
-pub fn isa() -> (&'static str, usize) {
-    #[cfg(any(target_arch = "x86_64", target_arch = "x86"))]
-    {
-        match pulp::Arch::new() {
-            pulp::Arch::V4(_) => ("avx512", 16),
-            pulp::Arch::V3(_) => ("avx2+fma", 8),
-            _ => ("scalar", 1),
-        }
-    }
-    #[cfg(not(any(target_arch = "x86_64", target_arch = "x86")))]
-    {
-        ("portable", 1)
-    }
+/// The instruction set batches run with in this process ([`Isa::selected`]:
+/// `BV_ISA`'s, or the widest this CPU has).
+pub fn isa() -> Isa {
+    Isa::selected()
 }
 
-/// Evaluates `brdf` on every lane of `dirs` into `out`: through its kernel if
-/// it has one, otherwise through its f64 `eval`, lane by lane. Lanes beyond
+/// Evaluates `brdf` on every lane of `dirs` into `out` with the process's
+/// instruction set ([`isa`]): through its kernel if it has one, otherwise
+/// through its f64 `eval`, lane by lane. Lanes beyond
 /// `min(dirs.len(), out.len())` are left untouched.
 pub fn eval(brdf: &dyn Brdf, dirs: &Dirs<'_>, out: &mut Out<'_>) -> Dispatch {
+    eval_with(brdf, isa(), dirs, out)
+}
+
+/// [`eval`] with the instruction set `isa` (replaced by [`Isa::best`] where
+/// this CPU lacks it), for tests and benchmarks that compare the paths.
+pub fn eval_with(brdf: &dyn Brdf, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) -> Dispatch {
     if let Some(k) = brdf.batch_kernel() {
-        k.eval(dirs, out);
-        let (isa, lanes) = isa();
+        let isa = if isa.is_available() { isa } else { Isa::best() };
+        k.eval(isa, dirs, out);
         return Dispatch {
             kernel: true,
-            isa,
-            lanes,
+            isa: isa.name(),
+            lanes: isa.lanes(),
         };
     }
     scalar(brdf, dirs, out);

@@ -3,7 +3,7 @@
 //! value and eqs. 9–10 for importance sampling. bv fixes the seed's typos
 //! (`cos²φ` written twice in D, the missing `/2` in the diffuse term).
 
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::frame::half_vector;
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
@@ -93,36 +93,28 @@ struct AsLanes {
 
 impl LaneKernel for AsLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let v = math::add3(wi, wo);
         let (x2, y2) = (v[0] * v[0], v[1] * v[1]);
         let t2 = x2 + y2;
         let l = (t2 + v[2] * v[2]).sqrt();
         let hz = v[2] / l;
         let one_minus = t2 / (l * (l + v[2]));
-        let e = if t2 > 0.0 {
-            (self.nu * x2 + self.nv * y2) / t2
-        } else {
-            0.5 * (self.nu + self.nv)
-        };
-        let lobe = math::pow_1m(hz, one_minus, e);
-        let c = (0.5 * l).min(1.0);
-        let spec = self.spec_scale * lobe / (c * wi[2].max(wo[2]));
+        let e = t2.gt(zero).select(
+            (x2 * self.nu + y2 * self.nv) / t2,
+            V::splat(0.5 * (self.nu + self.nv)),
+        );
+        let lobe = math::pow_1m_lanes(hz, one_minus, e);
+        let c = (l * 0.5).min(one);
+        let spec = lobe * self.spec_scale / (c * wi[2].max(wo[2]));
         // Schlick's (1 − c)⁵ and the diffuse factors 1 − (1 − cos/2)⁵.
-        let p5 = |x: f32| {
-            let x2 = x * x;
-            x2 * x2 * x
-        };
-        let fw = p5(1.0 - c);
-        let d = (1.0 - p5(1.0 - 0.5 * wi[2])) * (1.0 - p5(1.0 - 0.5 * wo[2]));
-        let above = wi[2] > 0.0 && wo[2] > 0.0 && l > 0.0;
-        std::array::from_fn(|k| {
-            let f = self.rs[k] + (1.0 - self.rs[k]) * fw;
-            if above {
-                self.diffuse_scale[k] * d + f * spec
-            } else {
-                0.0
-            }
+        let fw = math::pow5(one - c);
+        let d = (one - math::pow5(one - wi[2] * 0.5)) * (one - math::pow5(one - wo[2] * 0.5));
+        let above = wi[2].gt(zero) & wo[2].gt(zero) & l.gt(zero);
+        math::channels!(|k| {
+            let f = fw * (1.0 - self.rs[k]) + self.rs[k];
+            above.select(d * self.diffuse_scale[k] + f * spec, zero)
         })
     }
 }

@@ -14,7 +14,7 @@
 //! reciprocal: the diffuse part depends on `wi` only.
 
 use super::lobes::clamped_pow;
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, WideLanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -85,22 +85,17 @@ struct BanksLanes {
 
 impl LaneKernel for BanksLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let [ix, iy, iz] = wi.map(f64::from);
-        let [ox, oy, oz] = wo.map(f64::from);
-        let si = (iy * iy + iz * iz).sqrt().min(1.0);
-        let so = (oy * oy + oz * oz).sqrt().min(1.0);
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let [ix, iy, iz] = math::widen3(wi);
+        let [ox, oy, oz] = math::widen3(wo);
+        let one = V::Wide::splat(1.0);
+        let si = (iy * iy + iz * iz).sqrt().min(one);
+        let so = (oy * oy + oz * oz).sqrt().min(one);
         let x = si * so - ix * ox;
-        let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.e);
-        let si = si as f32;
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        std::array::from_fn(|c| {
-            if above {
-                self.kd[c] * si + self.ks[c] * lobe
-            } else {
-                0.0
-            }
-        })
+        let lobe = math::pow_1m(V::narrow(x), V::narrow(x.one_minus()), self.e);
+        let si = V::narrow(si);
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(si * self.kd[c] + lobe * self.ks[c], V::splat(0.0)))
     }
 }
 

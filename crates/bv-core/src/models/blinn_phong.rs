@@ -9,7 +9,7 @@
 //! the directional albedo is unbounded at grazing incidence.
 
 use super::lobes::{COS_FLOOR, clamped_pow, half_vector};
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -82,21 +82,15 @@ struct BlinnPhongLanes {
 
 impl LaneKernel for BlinnPhongLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let v = math::add3(wi, wo);
         let t2 = v[0] * v[0] + v[1] * v[1];
         let l = (t2 + v[2] * v[2]).sqrt();
         let y = t2 / (l * (l + v[2]));
         let lobe = math::pow_1m(v[2] / l, y, self.e);
         let spec = lobe / wi[2];
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        std::array::from_fn(|c| {
-            if above {
-                self.kd[c] + self.ks[c] * spec
-            } else {
-                0.0
-            }
-        })
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(spec * self.ks[c] + self.kd[c], V::splat(0.0)))
     }
 }
 

@@ -3,7 +3,7 @@
 //! 1982, eq. in §"The reflectance model"; Walter et al. 2007, eq. 20), with the
 //! choices of D, G and F of `crate::microfacet` and `crate::fresnel`.
 
-use crate::batch::{self, Dirs, Kernel, LaneKernel, Out, math};
+use crate::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, math};
 use crate::fresnel::{self, Fresnel, FresnelLanes};
 use crate::microfacet::{
     self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
@@ -365,71 +365,75 @@ impl CtKernel {
 #[derive(Debug)]
 struct CtLane<'a, const D: u8, const G: u8, const F: u8, const MIX: bool>(&'a CtKernel);
 
+impl<const D: u8, const G: u8, const F: u8, const MIX: bool> CtLane<'_, D, G, F, MIX> {
+    /// `1 + Λ(w)` of the distribution, or of the mixture of two scales.
+    #[inline(always)]
+    fn one_plus_lambda<V: Lanes>(&self, w: [V; 3]) -> V {
+        let k = self.0;
+        if MIX {
+            k.first.one_plus_lambda::<D, V>(w) * (1.0 - k.w2)
+                + k.second.one_plus_lambda::<D, V>(w) * k.w2
+        } else {
+            k.first.one_plus_lambda::<D, V>(w)
+        }
+    }
+}
+
 impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
     for CtLane<'_, D, G, F, MIX>
 {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
         let k = self.0;
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let above = wi[2].gt(zero) & wo[2].gt(zero);
         // frame::half_vector: one square root and one division.
-        let hu = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let hu = math::add3(wi, wo);
         let l2 = math::dot(hu, hu);
-        let inv = 1.0 / l2.sqrt();
-        let h = hu.map(|c| c * inv);
-        if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
+        let inv = one / l2.sqrt();
+        let h = math::scale3(hu, inv);
+        let finite_h = l2.gt(V::splat(1e-24)) & l2.lt(V::splat(f32::INFINITY));
+        let scalar = if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
             // The common GGX-Smith case with one division for D G/(4 cos cos).
-            let scalar = if G == CORRELATED {
-                k.first.ggx_dg::<true>(wi, wo, hu, l2)
+            if G == CORRELATED {
+                k.first.ggx_dg::<true, V>(wi, wo, hu, l2)
             } else {
-                k.first.ggx_dg::<false>(wi, wo, hu, l2)
-            };
-            let ok = above && l2 > 1e-24 && l2 < f32::INFINITY && scalar.is_finite();
-            let scalar = if ok { scalar * k.ks } else { 0.0 };
-            let fr = k.fresnel.eval::<F>(math::dot(wi, h));
-            let f: [f32; 3] = std::array::from_fn(|c| k.diffuse[c] + fr[c] * scalar);
-            return if above { f } else { [0.0; 3] };
-        }
-        let w1 = 1.0 - k.w2;
-        let d = if MIX {
-            w1 * k.first.d::<D>(h) + k.w2 * k.second.d::<D>(h)
+                k.first.ggx_dg::<false, V>(wi, wo, hu, l2)
+            }
         } else {
-            k.first.d::<D>(h)
-        };
-        let opl = |w: [f32; 3]| {
-            if MIX {
-                w1 * k.first.one_plus_lambda::<D>(w) + k.w2 * k.second.one_plus_lambda::<D>(w)
+            let w1 = 1.0 - k.w2;
+            let d = if MIX {
+                k.first.d::<D, V>(h) * w1 + k.second.d::<D, V>(h) * k.w2
             } else {
-                k.first.one_plus_lambda::<D>(w)
-            }
+                k.first.d::<D, V>(h)
+            };
+            let g = match G {
+                VGROOVE => {
+                    let oh = math::dot(wo, h);
+                    let kk = h[2] * 2.0 / oh;
+                    let g = one.min(kk * wo[2]).min(kk * wi[2]);
+                    (oh.gt(zero) & h[2].gt(zero)).select(g, zero)
+                }
+                SMITH => one / (self.one_plus_lambda(wi) * self.one_plus_lambda(wo)),
+                _ => one / (self.one_plus_lambda(wi) + self.one_plus_lambda(wo) - 1.0),
+            };
+            d * g / (wi[2] * wo[2] * 4.0)
         };
-        let g = match G {
-            VGROOVE => {
-                let oh = math::dot(wo, h);
-                let kk = 2.0 * h[2] / oh;
-                let g = 1f32.min(kk * wo[2]).min(kk * wi[2]);
-                if oh > 0.0 && h[2] > 0.0 { g } else { 0.0 }
-            }
-            SMITH => 1.0 / (opl(wi) * opl(wo)),
-            _ => 1.0 / (opl(wi) + opl(wo) - 1.0),
-        };
-        let scalar = d * g / (4.0 * wi[2] * wo[2]);
-        let ok = above && l2 > 1e-24 && l2 < f32::INFINITY && scalar.is_finite();
-        let scalar = if ok { scalar * k.ks } else { 0.0 };
-        let fr = k.fresnel.eval::<F>(math::dot(wi, h));
-        let f: [f32; 3] = std::array::from_fn(|c| k.diffuse[c] + fr[c] * scalar);
-        if above { f } else { [0.0; 3] }
+        let ok = above & finite_h & scalar.is_finite();
+        let scalar = ok.select(scalar * k.ks, zero);
+        let fr = k.fresnel.eval::<F, V>(math::dot(wi, h));
+        math::channels!(|c| above.select(fr[c] * scalar + k.diffuse[c], zero))
     }
 }
 
 impl Kernel for CtKernel {
-    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
         macro_rules! go {
             ($d:expr, $g:expr, $f:expr) => {
                 if self.mix {
-                    batch::run(&CtLane::<$d, $g, $f, true>(self), dirs, out)
+                    batch::run(&CtLane::<$d, $g, $f, true>(self), isa, dirs, out)
                 } else {
-                    batch::run(&CtLane::<$d, $g, $f, false>(self), dirs, out)
+                    batch::run(&CtLane::<$d, $g, $f, false>(self), isa, dirs, out)
                 }
             };
             ($d:expr, $g:expr) => {

@@ -3,7 +3,7 @@
 //! BRDF Explorer), with these fixed choices: linear `base_color`,
 //! `Cdlum = 0.3R + 0.6G + 0.1B`, specular G = separable Smith GGX with (αx, αy).
 
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::fresnel::schlick_weight;
 use crate::microfacet::{self, Distribution, Microfacet, Scale, ScaleLanes};
 use crate::model::{Build, GpuPort, ModelInfo};
@@ -204,41 +204,40 @@ struct DisneyLanes {
 
 impl LaneKernel for DisneyLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let (nl, nv) = (wi[2], wo[2]);
-        let hu = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+        let hu = math::add3(wi, wo);
         let l2 = math::dot(hu, hu);
-        let inv = 1.0 / l2.sqrt();
-        let h = [hu[0] * inv, hu[1] * inv, hu[2] * inv];
+        let inv = one / l2.sqrt();
+        let h = math::scale3(hu, inv);
         let lh = math::dot(wi, h).clamp(0.0, 1.0);
-        let weight = |c: f32| {
-            let m = (1.0 - c).clamp(0.0, 1.0);
-            let m2 = m * m;
-            m2 * m2 * m
-        };
+        let weight = math::schlick_weight::<V>;
         let (fl, fv, fh) = (weight(nl), weight(nv), weight(lh));
-        let mix = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let fd90 = 0.5 + 2.0 * lh * lh * self.roughness;
-        let fd = mix(1.0, fd90, fl) * mix(1.0, fd90, fv);
+        let mix = math::lerp::<V>;
+        let fd90 = lh * lh * (2.0 * self.roughness) + 0.5;
+        let fd = mix(one, fd90, fl) * mix(one, fd90, fv);
         let fss90 = lh * lh * self.roughness;
-        let fss = mix(1.0, fss90, fl) * mix(1.0, fss90, fv);
-        let ss = 1.25 * (fss * (1.0 / (nl + nv) - 0.5) + 0.5);
-        let diffuse = mix(fd, ss, self.subsurface);
-        let dg = self.spec.ggx_dg::<false>(wi, wo, hu, l2);
+        let fss = mix(one, fss90, fl) * mix(one, fss90, fv);
+        let ss = (fss * (one / (nl + nv) - 0.5) + 0.5) * 1.25;
+        let diffuse = mix(fd, ss, V::splat(self.subsurface));
+        let dg = self.spec.ggx_dg::<false, V>(wi, wo, hu, l2);
+        // A branch on the model's constant, not on a lane.
         let coat = if self.coat > 0.0 {
-            let dr = self.coat_num / (self.coat_a2 * h[2] * h[2] + h[0] * h[0] + h[1] * h[1]);
-            let fr = 0.04 + 0.96 * fh;
-            let g = self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }>(wi)
-                * self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }>(wo);
-            self.coat * dr * fr / (g * 4.0 * nl * nv)
+            let dr =
+                V::splat(self.coat_num) / (h[2] * h[2] * self.coat_a2 + h[0] * h[0] + h[1] * h[1]);
+            let fr = fh * 0.96 + 0.04;
+            let g = self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }, V>(wi)
+                * self.coat_g.one_plus_lambda::<{ ScaleLanes::GGX }, V>(wo);
+            dr * self.coat * fr / (g * 4.0 * nl * nv)
         } else {
-            0.0
+            zero
         };
-        let valid = nl > 0.0 && nv > 0.0 && l2 > 1e-24;
-        std::array::from_fn(|c| {
-            let fs = self.cspec0[c] + (1.0 - self.cspec0[c]) * fh;
-            let f = self.diffuse[c] * diffuse + self.sheen[c] * fh + fs * dg + coat;
-            if valid && f.is_finite() { f } else { 0.0 }
+        let valid = nl.gt(zero) & nv.gt(zero) & l2.gt(V::splat(1e-24));
+        math::channels!(|c| {
+            let fs = fh * (1.0 - self.cspec0[c]) + self.cspec0[c];
+            let f = diffuse * self.diffuse[c] + fh * self.sheen[c] + fs * dg + coat;
+            (valid & f.is_finite()).select(f, zero)
         })
     }
 }

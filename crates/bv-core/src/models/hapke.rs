@@ -5,7 +5,7 @@
 //! Hapke's closed-form approximation of Chandrasekhar's H function. The lecture
 //! uses it for the Moon's flat, retro-reflective look.
 
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -92,43 +92,48 @@ struct HapkeLanes {
     one_minus_gamma: f32,
 }
 
+impl HapkeLanes {
+    /// `H(x) − 1 = 2x (1 − γ)/(1 + 2xγ)`.
+    #[inline(always)]
+    fn h_minus_1<V: Lanes>(&self, x: V) -> V {
+        x * (2.0 * self.one_minus_gamma) / (x * (2.0 * self.gamma) + 1.0)
+    }
+}
+
 impl LaneKernel for HapkeLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let s = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
-        let d = [wi[0] - wo[0], wi[1] - wo[1], wi[2] - wo[2]];
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let zero = V::splat(0.0);
+        let s = math::add3(wi, wo);
+        let d = math::sub3(wi, wo);
         let (s2, d2) = (math::dot(s, s), math::dot(d, d));
-        let hs = self.width * s2.sqrt();
+        let hs = s2.sqrt() * self.width;
         let bd = hs + d2.sqrt();
-        let surge = if bd > 0.0 { self.b0 * hs / bd } else { 0.0 };
+        let surge = bd.gt(zero).select(hs * self.b0 / bd, zero);
         let g = self.asym;
         let num = (1.0 - g) * (1.0 + g);
+        // A branch on the model's constant, not on a lane.
         let a = if g <= 0.0 {
-            (1.0 + g) - g * 0.5 * d2
+            -(d2 * (g * 0.5)) + (1.0 + g)
         } else {
-            (1.0 - g) + g * 0.5 * s2
+            s2 * (g * 0.5) + (1.0 - g)
         };
-        let c = [
-            wi[1] * wo[2] - wi[2] * wo[1],
-            wi[2] * wo[0] - wi[0] * wo[2],
-            wi[0] * wo[1] - wi[1] * wo[0],
-        ];
-        let dd = a * a + g * g * math::dot(c, c);
-        let phase = if num > 0.0 && dd > 0.0 {
-            num / (dd * dd.sqrt())
+        let c = math::cross(wi, wo);
+        let dd = a * a + math::dot(c, c) * (g * g);
+        let phase = if num > 0.0 {
+            dd.gt(zero).select(V::splat(num) / (dd * dd.sqrt()), zero)
         } else {
-            0.0
+            zero
         };
         // H(μi) H(μo) − 1 as (Hi − 1)(Ho − 1) + (Hi − 1) + (Ho − 1) with
         // H(x) − 1 = 2x (1 − γ)/(1 + 2xγ): near the horizon both H are close
         // to 1 and the direct product minus 1 loses f32's digits, while f
         // divides it by the small cos θi + cos θo.
-        let hm1 = |x: f32| 2.0 * x * self.one_minus_gamma / (1.0 + 2.0 * x * self.gamma);
-        let (hi, ho) = (hm1(wi[2]), hm1(wo[2]));
+        let (hi, ho) = (self.h_minus_1(wi[2]), self.h_minus_1(wo[2]));
         let multiple = hi * ho + hi + ho;
-        let multiple = if multiple > 0.0 { multiple } else { 0.0 };
-        let f = self.w4pi / (wi[2] + wo[2]) * ((1.0 + surge) * phase + multiple);
-        let v = if wi[2] > 0.0 && wo[2] > 0.0 { f } else { 0.0 };
+        let multiple = multiple.gt(zero).select(multiple, zero);
+        let f = V::splat(self.w4pi) / (wi[2] + wo[2]) * ((surge + 1.0) * phase + multiple);
+        let v = (wi[2].gt(zero) & wo[2].gt(zero)).select(f, zero);
         [v; 3]
     }
 }

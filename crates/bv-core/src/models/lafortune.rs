@@ -16,7 +16,7 @@
 //! overflow for any exponent up to 10000 (`2^10000` would).
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
-use crate::batch::{self, Dirs, Kernel, LaneKernel, Out, math};
+use crate::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, WideLanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -146,9 +146,8 @@ pub struct Lafortune {
 }
 
 /// [`Lafortune`]'s f32 batch kernel: `kd/π + Σ ks norm clamped_pow(C wi · wo,
-/// n)` over a fixed [`MAX_LOBES`] slots (unused ones have `ks = 0`), so the
-/// lobe loop has a constant trip count and the lane loop vectorises. Each
-/// base is formed in f64 and its power taken from `1 − base`
+/// n)` over the first `count` of [`MAX_LOBES`] slots (see [`Lobes`]). Each
+/// base is formed in f64 lanes and its power taken from `1 − base`
 /// ([`math::pow_1m`]), which keeps large exponents accurate near the peak.
 #[derive(Debug, Clone, Copy)]
 struct LafortuneLanes {
@@ -182,56 +181,48 @@ impl LafortuneLanes {
 impl LafortuneLanes {
     /// One lane with the first `L` lobes (the rest are unused slots).
     #[inline(always)]
-    fn lane_with<const L: usize>(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let p = [
-            f64::from(wi[0]) * f64::from(wo[0]),
-            f64::from(wi[1]) * f64::from(wo[1]),
-            f64::from(wi[2]) * f64::from(wo[2]),
-        ];
-        let mut f = self.diffuse;
+    fn lane_with<const L: usize, V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let p: [V::Wide; 3] = math::channels!(|c| wi[c].widen() * wo[c].widen());
+        let mut f = math::splat3::<V>(self.diffuse);
         for j in 0..L.min(MAX_LOBES) {
             let c = self.c[j];
-            let x = c[0] * p[0] + c[1] * p[1] + c[2] * p[2];
-            let lobe = math::pow_1m(x as f32, (1.0 - x) as f32, self.n[j]);
+            let x = p[0] * c[0] + p[1] * c[1] + p[2] * c[2];
+            let lobe = math::pow_1m(V::narrow(x), V::narrow(x.one_minus()), self.n[j]);
             for (k, fk) in f.iter_mut().enumerate() {
-                *fk += self.scale[j][k] * lobe;
+                *fk += lobe * self.scale[j][k];
             }
         }
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        f.map(|v| if above { v } else { 0.0 })
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(f[c], V::splat(0.0)))
     }
 }
 
 /// [`LafortuneLanes`] compiled for exactly `L` lobes: each power costs an
 /// `exp` and a `ln` per lane, so the eight fixed slots of a one-lobe model
 /// would cost eight times its work. The lobe count is a const parameter so
-/// that the lobe loop keeps a constant trip count and the lane loop still
-/// vectorises. It holds its own copy of the coefficients, not a reference:
-/// behind a second reference LLVM could not prove that the lane loop's
-/// stores leave them unchanged and kept the loop scalar (42 M evals/s on
-/// one core against 181 M with the copy, `bv bench --model lafortune`).
+/// that the lobe loop has a constant trip count and is unrolled.
 #[derive(Debug)]
 struct Lobes<const L: usize>(LafortuneLanes);
 
 impl<const L: usize> LaneKernel for Lobes<L> {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        self.0.lane_with::<L>(wi, wo)
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        self.0.lane_with::<L, V>(wi, wo)
     }
 }
 
 impl Kernel for LafortuneLanes {
-    fn eval(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
         match self.count {
-            0 => batch::run(&Lobes::<0>(*self), dirs, out),
-            1 => batch::run(&Lobes::<1>(*self), dirs, out),
-            2 => batch::run(&Lobes::<2>(*self), dirs, out),
-            3 => batch::run(&Lobes::<3>(*self), dirs, out),
-            4 => batch::run(&Lobes::<4>(*self), dirs, out),
-            5 => batch::run(&Lobes::<5>(*self), dirs, out),
-            6 => batch::run(&Lobes::<6>(*self), dirs, out),
-            7 => batch::run(&Lobes::<7>(*self), dirs, out),
-            _ => batch::run(&Lobes::<MAX_LOBES>(*self), dirs, out),
+            0 => batch::run(&Lobes::<0>(*self), isa, dirs, out),
+            1 => batch::run(&Lobes::<1>(*self), isa, dirs, out),
+            2 => batch::run(&Lobes::<2>(*self), isa, dirs, out),
+            3 => batch::run(&Lobes::<3>(*self), isa, dirs, out),
+            4 => batch::run(&Lobes::<4>(*self), isa, dirs, out),
+            5 => batch::run(&Lobes::<5>(*self), isa, dirs, out),
+            6 => batch::run(&Lobes::<6>(*self), isa, dirs, out),
+            7 => batch::run(&Lobes::<7>(*self), isa, dirs, out),
+            _ => batch::run(&Lobes::<MAX_LOBES>(*self), isa, dirs, out),
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Lambert: the ideal diffuse reflector, `f = albedo / π`.
 
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -50,12 +50,9 @@ struct LambertLanes {
 
 impl LaneKernel for LambertLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        if wi[2] > 0.0 && wo[2] > 0.0 {
-            self.f
-        } else {
-            [0.0; 3]
-        }
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(V::splat(self.f[c]), V::splat(0.0)))
     }
 }
 

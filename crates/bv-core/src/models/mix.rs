@@ -86,7 +86,12 @@ struct Part {
 /// A mix's batch kernel is the weighted sum of its parts' batches (each
 /// through its own kernel, or its scalar fallback), accumulated in f32.
 impl crate::batch::Kernel for Mix {
-    fn eval(&self, dirs: &crate::batch::Dirs<'_>, out: &mut crate::batch::Out<'_>) {
+    fn eval(
+        &self,
+        isa: crate::batch::Isa,
+        dirs: &crate::batch::Dirs<'_>,
+        out: &mut crate::batch::Out<'_>,
+    ) {
         let n = dirs.len().min(out.len());
         for ch in out.rgb.iter_mut() {
             ch[..n].fill(0.0);
@@ -98,7 +103,7 @@ impl crate::batch::Kernel for Mix {
                 let mut tmp = crate::batch::Out {
                     rgb: [r.as_mut_slice(), g.as_mut_slice(), b.as_mut_slice()],
                 };
-                crate::batch::eval(p.brdf.as_ref(), dirs, &mut tmp);
+                crate::batch::eval_with(p.brdf.as_ref(), isa, dirs, &mut tmp);
             }
             let w = p.weight as f32;
             for (dst, src) in out.rgb.iter_mut().zip(&part) {

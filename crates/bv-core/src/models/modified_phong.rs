@@ -7,7 +7,7 @@
 //! `(e+2)/(2π)` so that the specular albedo at normal incidence is exactly `ks`.
 
 use super::lobes::{Mixture, PowerLobe, clamped_pow};
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -82,16 +82,10 @@ struct ModifiedPhongLanes {
 
 impl LaneKernel for ModifiedPhongLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
         let lobe = math::mirror_lobe(wi, wo, self.e);
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        std::array::from_fn(|c| {
-            if above {
-                self.diffuse[c] + self.spec[c] * lobe
-            } else {
-                0.0
-            }
-        })
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(lobe * self.spec[c] + self.diffuse[c], V::splat(0.0)))
     }
 }
 

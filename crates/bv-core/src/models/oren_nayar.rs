@@ -2,7 +2,7 @@
 //! distribution of standard deviation σ, in the "qualitative model" of Oren &
 //! Nayar 1994, "Generalization of Lambert's reflectance model" (SIGGRAPH), eq. 30.
 
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -68,12 +68,13 @@ struct OrenNayarLanes {
 
 impl LaneKernel for OrenNayarLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let zero = V::splat(0.0);
         let tangential = wi[0] * wo[0] + wi[1] * wo[1];
-        let t = tangential.max(0.0) / wi[2].max(wo[2]);
-        let s = self.a + self.b * t;
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        self.albedo_over_pi.map(|c| if above { c * s } else { 0.0 })
+        let t = tangential.max(zero) / wi[2].max(wo[2]);
+        let s = t * self.b + self.a;
+        let above = wi[2].gt(zero) & wo[2].gt(zero);
+        math::channels!(|c| above.select(s * self.albedo_over_pi[c], zero))
     }
 }
 

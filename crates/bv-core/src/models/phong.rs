@@ -12,7 +12,7 @@
 //!   (Lewis 1994, "Making shaders more physically plausible", §2).
 
 use super::lobes::{COS_FLOOR, Mixture, PowerLobe, clamped_pow};
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -85,17 +85,11 @@ struct PhongLanes {
 
 impl LaneKernel for PhongLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
         let lobe = math::mirror_lobe(wi, wo, self.e);
         let spec = lobe / wi[2];
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        std::array::from_fn(|c| {
-            if above {
-                self.kd[c] + self.ks[c] * spec
-            } else {
-                0.0
-            }
-        })
+        let above = wi[2].gt(V::splat(0.0)) & wo[2].gt(V::splat(0.0));
+        math::channels!(|c| above.select(spec * self.ks[c] + self.kd[c], V::splat(0.0)))
     }
 }
 

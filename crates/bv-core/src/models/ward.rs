@@ -7,7 +7,7 @@
 //! (Cornell PCG-05-06), eqs. 6–9.
 
 use super::lobes::{COS_FLOOR, half_unnormalised};
-use crate::batch::{Kernel, LaneKernel, math};
+use crate::batch::{Kernel, LaneKernel, LaneMask, Lanes, math};
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, ModelInfo};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::Params;
@@ -92,20 +92,15 @@ struct WardLanes {
 
 impl LaneKernel for WardLanes {
     #[inline(always)]
-    fn lane(&self, wi: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
-        let v = [wi[0] + wo[0], wi[1] + wo[1], wi[2] + wo[2]];
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let zero = V::splat(0.0);
+        let v = math::add3(wi, wo);
         let s = v[0] * v[0] * self.inv_ax2 + v[1] * v[1] * self.inv_ay2;
         let e = s / (v[2] * v[2]);
-        let g = math::exp(-(if s > 0.0 { e } else { 0.0 }));
+        let g = math::exp(-s.gt(zero).select(e, zero));
         let spec = g * self.norm / (wi[2].sqrt() * wo[2].sqrt());
-        let above = wi[2] > 0.0 && wo[2] > 0.0;
-        std::array::from_fn(|c| {
-            if above {
-                self.diffuse[c] + self.ks[c] * spec
-            } else {
-                0.0
-            }
-        })
+        let above = wi[2].gt(zero) & wo[2].gt(zero);
+        math::channels!(|c| above.select(spec * self.ks[c] + self.diffuse[c], zero))
     }
 }
 

@@ -1,0 +1,482 @@
+//! [`Lanes`] on x86-64: AVX2 + FMA (8 lanes) and AVX-512F (16 lanes), and
+//! the lane loops compiled for each.
+//!
+//! Soundness: every type here wraps a register whose instructions need the
+//! CPU feature named in its doc. A value of the type is made only inside
+//! [`run_avx2`] or [`run_avx512`], which the dispatcher
+//! ([`super::run`]) calls only after [`super::Isa::is_available`] saw the
+//! feature; the types are private to the batch module, so no other code can
+//! make one.
+
+use super::lanes::{Lanes, WideLanes, mask_ops, vector_ops};
+use super::{Dirs, LaneKernel, Out};
+use std::arch::x86_64::*;
+
+/// Builds a `WideLanes` pair type: two f64 registers holding the lanes of
+/// one f32 register, each operation applied to both halves.
+macro_rules! wide_pair {
+    ($t:ident, $narrow:ident, $reg:ty, $add:path, $sub:path, $mul:path, $set1:path,
+     $sqrt:path, $min:path, $xor:path) => {
+        impl std::ops::Add for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, o: Self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe { Self([$add(self.0[0], o.0[0]), $add(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Sub for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(self, o: Self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe { Self([$sub(self.0[0], o.0[0]), $sub(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Mul for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, o: Self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe { Self([$mul(self.0[0], o.0[0]), $mul(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Neg for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe {
+                    let s = $set1(-0.0);
+                    Self([$xor(self.0[0], s), $xor(self.0[1], s)])
+                }
+            }
+        }
+        impl std::ops::Mul<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, o: f64) -> Self {
+                self * <Self as WideLanes>::splat(o)
+            }
+        }
+        impl std::ops::Add<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, o: f64) -> Self {
+                self + <Self as WideLanes>::splat(o)
+            }
+        }
+        impl WideLanes for $t {
+            type Narrow = $narrow;
+            #[inline(always)]
+            fn splat(x: f64) -> Self {
+                // SAFETY: see the module doc.
+                unsafe {
+                    let v: $reg = $set1(x);
+                    Self([v, v])
+                }
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe { Self([$sqrt(self.0[0]), $sqrt(self.0[1])]) }
+            }
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                // SAFETY: see the module doc.
+                unsafe { Self([$min(self.0[0], o.0[0]), $min(self.0[1], o.0[1])]) }
+            }
+        }
+    };
+}
+
+// ---------------------------------------------------------------------------
+// AVX2 + FMA.
+
+/// Eight f32 lanes in a 256-bit register (AVX2 + FMA; see the module doc).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx2(__m256);
+/// A comparison result of [`Avx2`]: all-ones or all-zeros per lane.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx2Mask(__m256);
+/// The lanes of [`Avx2`] in f64: lanes 0–3, then 4–7.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx2Wide([__m256d; 2]);
+
+vector_ops!(
+    Avx2,
+    f32,
+    _mm256_add_ps,
+    _mm256_sub_ps,
+    _mm256_mul_ps,
+    _mm256_div_ps,
+    |x| Avx2(unsafe { _mm256_xor_ps(x.0, _mm256_set1_ps(-0.0)) })
+);
+mask_ops!(Avx2Mask, _mm256_and_ps, _mm256_or_ps, |x| Avx2Mask(
+    unsafe { _mm256_xor_ps(x.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) }
+));
+wide_pair!(
+    Avx2Wide,
+    Avx2,
+    __m256d,
+    _mm256_add_pd,
+    _mm256_sub_pd,
+    _mm256_mul_pd,
+    _mm256_set1_pd,
+    _mm256_sqrt_pd,
+    _mm256_min_pd,
+    _mm256_xor_pd
+);
+
+impl From<f32> for Avx2 {
+    #[inline(always)]
+    fn from(x: f32) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_set1_ps(x) })
+    }
+}
+
+/// An ordered comparison of two [`Avx2`] as a mask.
+macro_rules! avx2_cmp {
+    ($a:expr, $b:expr, $op:ident) => {
+        // SAFETY: see the module doc.
+        Avx2Mask(unsafe { _mm256_cmp_ps::<$op>($a.0, $b.0) })
+    };
+}
+
+impl Lanes for Avx2 {
+    type Mask = Avx2Mask;
+    type Wide = Avx2Wide;
+    const LANES: usize = 8;
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Self::from(x)
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        let s = &s[..8];
+        // SAFETY: `s` holds 8 floats; unaligned load; see the module doc.
+        Self(unsafe { _mm256_loadu_ps(s.as_ptr()) })
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [f32]) {
+        let s = &mut s[..8];
+        // SAFETY: `s` has room for 8 floats; see the module doc.
+        unsafe { _mm256_storeu_ps(s.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        // minps returns its second operand when either is NaN.
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_min_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_max_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn round(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe {
+            _mm256_round_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0)
+        })
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> Avx2Mask {
+        avx2_cmp!(self, o, _CMP_LT_OQ)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> Avx2Mask {
+        avx2_cmp!(self, o, _CMP_LE_OQ)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> Avx2Mask {
+        avx2_cmp!(self, o, _CMP_GT_OQ)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> Avx2Mask {
+        avx2_cmp!(self, o, _CMP_GE_OQ)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> Avx2Mask {
+        avx2_cmp!(self, o, _CMP_EQ_OQ)
+    }
+    #[inline(always)]
+    fn select(m: Avx2Mask, a: Self, b: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm256_blendv_ps(b.0, a.0, m.0) })
+    }
+    #[inline(always)]
+    fn pow2i(n: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe {
+            let i = _mm256_add_epi32(_mm256_cvtps_epi32(n.0), _mm256_set1_epi32(127));
+            _mm256_castsi256_ps(_mm256_slli_epi32::<23>(i))
+        })
+    }
+    #[inline(always)]
+    fn exponent_mantissa(self) -> (Self, Self) {
+        // SAFETY: see the module doc.
+        unsafe {
+            let bits = _mm256_castps_si256(self.0);
+            let e = _mm256_sub_epi32(
+                _mm256_and_si256(_mm256_srli_epi32::<23>(bits), _mm256_set1_epi32(0xff)),
+                _mm256_set1_epi32(127),
+            );
+            let m = _mm256_or_si256(
+                _mm256_and_si256(bits, _mm256_set1_epi32(0x007f_ffff)),
+                _mm256_set1_epi32(0x3f80_0000),
+            );
+            (Self(_mm256_cvtepi32_ps(e)), Self(_mm256_castsi256_ps(m)))
+        }
+    }
+    #[inline(always)]
+    fn widen(self) -> Avx2Wide {
+        // SAFETY: see the module doc.
+        unsafe {
+            let lo = _mm256_castps256_ps128(self.0);
+            let hi = _mm256_extractf128_ps::<1>(self.0);
+            Avx2Wide([_mm256_cvtps_pd(lo), _mm256_cvtps_pd(hi)])
+        }
+    }
+    #[inline(always)]
+    fn narrow(w: Avx2Wide) -> Self {
+        // SAFETY: see the module doc.
+        unsafe {
+            let lo = _mm256_cvtpd_ps(w.0[0]);
+            let hi = _mm256_cvtpd_ps(w.0[1]);
+            Self(_mm256_set_m128(hi, lo))
+        }
+    }
+}
+
+/// The lane loop of `k` in AVX2 + FMA code.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    super::lanes_loop::<Avx2, K>(k, dirs, out);
+}
+
+// ---------------------------------------------------------------------------
+// AVX-512F.
+
+/// Sixteen f32 lanes in a 512-bit register (AVX-512F; see the module doc).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx512(__m512);
+/// A comparison result of [`Avx512`]: one bit per lane.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx512Mask(__mmask16);
+/// The lanes of [`Avx512`] in f64: lanes 0–7, then 8–15.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Avx512Wide([__m512d; 2]);
+
+/// `&` and `|` of two bit masks (plain integer operations; the `unsafe` of
+/// [`mask_ops`] has nothing to guard here).
+#[inline(always)]
+unsafe fn and16(a: __mmask16, b: __mmask16) -> __mmask16 {
+    a & b
+}
+#[inline(always)]
+unsafe fn or16(a: __mmask16, b: __mmask16) -> __mmask16 {
+    a | b
+}
+
+vector_ops!(
+    Avx512,
+    f32,
+    _mm512_add_ps,
+    _mm512_sub_ps,
+    _mm512_mul_ps,
+    _mm512_div_ps,
+    |x| Avx512(unsafe {
+        _mm512_castsi512_ps(_mm512_xor_si512(
+            _mm512_castps_si512(x.0),
+            _mm512_set1_epi32(i32::MIN),
+        ))
+    })
+);
+mask_ops!(Avx512Mask, and16, or16, |x| Avx512Mask(!x.0));
+wide_pair!(
+    Avx512Wide,
+    Avx512,
+    __m512d,
+    _mm512_add_pd,
+    _mm512_sub_pd,
+    _mm512_mul_pd,
+    _mm512_set1_pd,
+    _mm512_sqrt_pd,
+    _mm512_min_pd,
+    xor512_pd
+);
+
+/// `a ^ b` of two f64 registers (AVX-512F has the integer form only).
+#[inline(always)]
+unsafe fn xor512_pd(a: __m512d, b: __m512d) -> __m512d {
+    // SAFETY: the caller is in AVX-512F code (see the module doc).
+    unsafe {
+        _mm512_castsi512_pd(_mm512_xor_si512(
+            _mm512_castpd_si512(a),
+            _mm512_castpd_si512(b),
+        ))
+    }
+}
+
+impl From<f32> for Avx512 {
+    #[inline(always)]
+    fn from(x: f32) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_set1_ps(x) })
+    }
+}
+
+/// An ordered comparison of two [`Avx512`] as a bit mask.
+macro_rules! avx512_cmp {
+    ($a:expr, $b:expr, $op:ident) => {
+        // SAFETY: see the module doc.
+        Avx512Mask(unsafe { _mm512_cmp_ps_mask::<$op>($a.0, $b.0) })
+    };
+}
+
+impl Lanes for Avx512 {
+    type Mask = Avx512Mask;
+    type Wide = Avx512Wide;
+    const LANES: usize = 16;
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Self::from(x)
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        let s = &s[..16];
+        // SAFETY: `s` holds 16 floats; unaligned load; see the module doc.
+        Self(unsafe { _mm512_loadu_ps(s.as_ptr()) })
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [f32]) {
+        let s = &mut s[..16];
+        // SAFETY: `s` has room for 16 floats; see the module doc.
+        unsafe { _mm512_storeu_ps(s.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_abs_ps(self.0) })
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        // vminps returns its second operand when either is NaN.
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_min_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_max_ps(self.0, o.0) })
+    }
+    #[inline(always)]
+    fn round(self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe {
+            _mm512_roundscale_ps::<{ _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC }>(self.0)
+        })
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> Avx512Mask {
+        avx512_cmp!(self, o, _CMP_LT_OQ)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> Avx512Mask {
+        avx512_cmp!(self, o, _CMP_LE_OQ)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> Avx512Mask {
+        avx512_cmp!(self, o, _CMP_GT_OQ)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> Avx512Mask {
+        avx512_cmp!(self, o, _CMP_GE_OQ)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> Avx512Mask {
+        avx512_cmp!(self, o, _CMP_EQ_OQ)
+    }
+    #[inline(always)]
+    fn select(m: Avx512Mask, a: Self, b: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
+    }
+    #[inline(always)]
+    fn pow2i(n: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe {
+            let i = _mm512_add_epi32(_mm512_cvtps_epi32(n.0), _mm512_set1_epi32(127));
+            _mm512_castsi512_ps(_mm512_slli_epi32::<23>(i))
+        })
+    }
+    #[inline(always)]
+    fn exponent_mantissa(self) -> (Self, Self) {
+        // SAFETY: see the module doc.
+        unsafe {
+            let bits = _mm512_castps_si512(self.0);
+            let e = _mm512_sub_epi32(
+                _mm512_and_si512(_mm512_srli_epi32::<23>(bits), _mm512_set1_epi32(0xff)),
+                _mm512_set1_epi32(127),
+            );
+            let m = _mm512_or_si512(
+                _mm512_and_si512(bits, _mm512_set1_epi32(0x007f_ffff)),
+                _mm512_set1_epi32(0x3f80_0000),
+            );
+            (Self(_mm512_cvtepi32_ps(e)), Self(_mm512_castsi512_ps(m)))
+        }
+    }
+    #[inline(always)]
+    fn widen(self) -> Avx512Wide {
+        // SAFETY: see the module doc.
+        unsafe {
+            let lo = _mm512_castps512_ps256(self.0);
+            let hi = _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(self.0)));
+            Avx512Wide([_mm512_cvtps_pd(lo), _mm512_cvtps_pd(hi)])
+        }
+    }
+    #[inline(always)]
+    fn narrow(w: Avx512Wide) -> Self {
+        // SAFETY: see the module doc.
+        unsafe {
+            let lo = _mm512_castps256_ps512(_mm512_cvtpd_ps(w.0[0]));
+            let hi = _mm256_castps_pd(_mm512_cvtpd_ps(w.0[1]));
+            Self(_mm512_castpd_ps(_mm512_insertf64x4::<1>(
+                _mm512_castps_pd(lo),
+                hi,
+            )))
+        }
+    }
+}
+
+/// The lane loop of `k` in AVX-512F code.
+///
+/// # Safety
+/// The CPU must have AVX-512F, AVX2 and FMA.
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    super::lanes_loop::<Avx512, K>(k, dirs, out);
+}
