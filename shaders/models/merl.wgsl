@@ -95,13 +95,28 @@ fn clamped_lerp(u: f32, n: u32) -> vec3<f32> {
     return vec3<f32>(f32(i0), f32(i1), t - f32(i0));
 }
 
-// The same along the periodic φd axis.
+// The same along the periodic φd axis, for u in [0, n): the cell below is
+// −1 (wrapped to n − 1) up to n − 1. The wrap is a comparison, not `%` of a
+// negative number: with `((i % n) + n) % n`, lavapipe (LLVM 15) on an
+// AVX2-only AMD EPYC read the wrong cells for in-plane pairs (φd near 0,
+// t < 0; tests/gpu_parity.rs, up to 885× the tolerance), while the same
+// shader passed on an AVX-512 Intel machine. The comparison form passes on
+// the AVX2 machine.
 fn periodic_lerp(u: f32, n: u32) -> vec3<f32> {
     let t = u - 0.5;
     let fl = floor(t);
     let ni = i32(n);
-    let i0 = ((i32(fl) % ni) + ni) % ni;
-    let i1 = (i0 + 1) % ni;
+    var i0 = i32(fl);
+    if (i0 < 0) {
+        i0 = i0 + ni;
+    }
+    if (i0 >= ni) {
+        i0 = i0 - ni;
+    }
+    var i1 = i0 + 1;
+    if (i1 >= ni) {
+        i1 = 0;
+    }
     return vec3<f32>(f32(i0), f32(i1), t - fl);
 }
 
