@@ -374,3 +374,80 @@ macro_rules! mask_ops {
     };
 }
 pub(crate) use mask_ops;
+
+/// Builds a `WideLanes` pair type: two f64 registers holding the lanes of
+/// one f32 register, each operation applied to both halves.
+macro_rules! wide_pair {
+    ($t:ident, $narrow:ident, $reg:ty, $add:path, $sub:path, $mul:path, $set1:path,
+     $sqrt:path, $min:path, |$x:ident| $neg:expr) => {
+        impl std::ops::Add for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, o: Self) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe { Self([$add(self.0[0], o.0[0]), $add(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Sub for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(self, o: Self) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe { Self([$sub(self.0[0], o.0[0]), $sub(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Mul for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, o: Self) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe { Self([$mul(self.0[0], o.0[0]), $mul(self.0[1], o.0[1])]) }
+            }
+        }
+        impl std::ops::Neg for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                let $x = self;
+                $neg
+            }
+        }
+        impl std::ops::Mul<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, o: f64) -> Self {
+                self * <Self as $crate::batch::lanes::WideLanes>::splat(o)
+            }
+        }
+        impl std::ops::Add<f64> for $t {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, o: f64) -> Self {
+                self + <Self as $crate::batch::lanes::WideLanes>::splat(o)
+            }
+        }
+        impl $crate::batch::lanes::WideLanes for $t {
+            type Narrow = $narrow;
+            #[inline(always)]
+            fn splat(x: f64) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe {
+                    let v: $reg = $set1(x);
+                    Self([v, v])
+                }
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe { Self([$sqrt(self.0[0]), $sqrt(self.0[1])]) }
+            }
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                // SAFETY: see the type's invariant.
+                unsafe { Self([$min(self.0[0], o.0[0]), $min(self.0[1], o.0[1])]) }
+            }
+        }
+    };
+}
+
+pub(crate) use wide_pair;

@@ -105,12 +105,7 @@ pub fn mirror_lobe<V: Lanes>(wi: [V; 3], wo: [V; 3], e: f32) -> V {
 /// `x > 0`. Passing `1 − x` keeps large exponents accurate near the peak.
 #[inline(always)]
 pub fn pow_1m<V: Lanes>(x: V, y: V, e: f32) -> V {
-    let y = y.max(V::splat(0.0));
-    if e == 0.0 {
-        return x.gt(V::splat(0.0)).select(V::splat(1.0), V::splat(0.0));
-    }
-    let v = exp(ln_near_one(x, y) * e);
-    x.le(V::splat(0.0)).select(V::splat(0.0), v)
+    pow_1m_lanes(x, y, V::splat(e))
 }
 
 /// [`pow_1m`] with an exponent that varies per lane.

@@ -2,7 +2,7 @@
 //! architecture's baseline, so its types need no run-time check: every
 //! AArch64 CPU that runs Rust's `aarch64-*` targets has it.
 
-use super::lanes::{Lanes, WideLanes, mask_ops, vector_ops};
+use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
 use super::{Dirs, LaneKernel, Out};
 use std::arch::aarch64::*;
 
@@ -31,75 +31,18 @@ impl From<f32> for Neon {
     }
 }
 
-impl std::ops::Add for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vaddq_f64(self.0[0], o.0[0]), vaddq_f64(self.0[1], o.0[1])]) }
-    }
-}
-impl std::ops::Sub for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vsubq_f64(self.0[0], o.0[0]), vsubq_f64(self.0[1], o.0[1])]) }
-    }
-}
-impl std::ops::Mul for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vmulq_f64(self.0[0], o.0[0]), vmulq_f64(self.0[1], o.0[1])]) }
-    }
-}
-impl std::ops::Neg for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vnegq_f64(self.0[0]), vnegq_f64(self.0[1])]) }
-    }
-}
-impl std::ops::Mul<f64> for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: f64) -> Self {
-        self * <Self as WideLanes>::splat(o)
-    }
-}
-impl std::ops::Add<f64> for NeonWide {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: f64) -> Self {
-        self + <Self as WideLanes>::splat(o)
-    }
-}
-impl WideLanes for NeonWide {
-    type Narrow = Neon;
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vdupq_n_f64(x), vdupq_n_f64(x)]) }
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe { Self([vsqrtq_f64(self.0[0]), vsqrtq_f64(self.0[1])]) }
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        // SAFETY: NEON is baseline on AArch64.
-        unsafe {
-            Self([
-                vminnmq_f64(self.0[0], o.0[0]),
-                vminnmq_f64(self.0[1], o.0[1]),
-            ])
-        }
-    }
-}
+wide_pair!(
+    NeonWide,
+    Neon,
+    float64x2_t,
+    vaddq_f64,
+    vsubq_f64,
+    vmulq_f64,
+    vdupq_n_f64,
+    vsqrtq_f64,
+    vminnmq_f64,
+    |x| NeonWide(unsafe { [vnegq_f64(x.0[0]), vnegq_f64(x.0[1])] })
+);
 
 impl Lanes for Neon {
     type Mask = NeonMask;

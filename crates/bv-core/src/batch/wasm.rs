@@ -5,7 +5,7 @@
 //! `.cargo/config.toml` sets it; every current browser with WebGPU has
 //! SIMD).
 
-use super::lanes::{Lanes, WideLanes, mask_ops, vector_ops};
+use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
 use super::{Dirs, LaneKernel, Out};
 use std::arch::wasm32::*;
 
@@ -36,71 +36,30 @@ mod ops {
     mask_ops!(Simd128Mask, v128_and, v128_or, |x| Simd128Mask(v128_not(
         x.0
     )));
+    wide_pair!(
+        Simd128Wide,
+        Simd128,
+        v128,
+        f64x2_add,
+        f64x2_sub,
+        f64x2_mul,
+        f64x2_splat,
+        f64x2_sqrt,
+        min_f64x2,
+        |x| Simd128Wide([f64x2_neg(x.0[0]), f64x2_neg(x.0[1])])
+    );
+}
+
+/// The smaller per lane, `b` where `a` is NaN (pmin(b, a) = a < b ? a : b).
+#[inline(always)]
+fn min_f64x2(a: v128, b: v128) -> v128 {
+    f64x2_pmin(b, a)
 }
 
 impl From<f32> for Simd128 {
     #[inline(always)]
     fn from(x: f32) -> Self {
         Self(f32x4_splat(x))
-    }
-}
-
-impl std::ops::Add for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        Self([f64x2_add(self.0[0], o.0[0]), f64x2_add(self.0[1], o.0[1])])
-    }
-}
-impl std::ops::Sub for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        Self([f64x2_sub(self.0[0], o.0[0]), f64x2_sub(self.0[1], o.0[1])])
-    }
-}
-impl std::ops::Mul for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: Self) -> Self {
-        Self([f64x2_mul(self.0[0], o.0[0]), f64x2_mul(self.0[1], o.0[1])])
-    }
-}
-impl std::ops::Neg for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Self([f64x2_neg(self.0[0]), f64x2_neg(self.0[1])])
-    }
-}
-impl std::ops::Mul<f64> for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(self, o: f64) -> Self {
-        self * <Self as WideLanes>::splat(o)
-    }
-}
-impl std::ops::Add<f64> for Simd128Wide {
-    type Output = Self;
-    #[inline(always)]
-    fn add(self, o: f64) -> Self {
-        self + <Self as WideLanes>::splat(o)
-    }
-}
-impl WideLanes for Simd128Wide {
-    type Narrow = Simd128;
-    #[inline(always)]
-    fn splat(x: f64) -> Self {
-        Self([f64x2_splat(x), f64x2_splat(x)])
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Self([f64x2_sqrt(self.0[0]), f64x2_sqrt(self.0[1])])
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        // pmin(b, a) = a < b ? a : b.
-        Self([f64x2_pmin(o.0[0], self.0[0]), f64x2_pmin(o.0[1], self.0[1])])
     }
 }
 

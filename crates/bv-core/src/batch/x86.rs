@@ -8,87 +8,9 @@
 //! feature; the types are private to the batch module, so no other code can
 //! make one.
 
-use super::lanes::{Lanes, WideLanes, mask_ops, vector_ops};
+use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
 use super::{Dirs, LaneKernel, Out};
 use std::arch::x86_64::*;
-
-/// Builds a `WideLanes` pair type: two f64 registers holding the lanes of
-/// one f32 register, each operation applied to both halves.
-macro_rules! wide_pair {
-    ($t:ident, $narrow:ident, $reg:ty, $add:path, $sub:path, $mul:path, $set1:path,
-     $sqrt:path, $min:path, $xor:path) => {
-        impl std::ops::Add for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn add(self, o: Self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe { Self([$add(self.0[0], o.0[0]), $add(self.0[1], o.0[1])]) }
-            }
-        }
-        impl std::ops::Sub for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn sub(self, o: Self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe { Self([$sub(self.0[0], o.0[0]), $sub(self.0[1], o.0[1])]) }
-            }
-        }
-        impl std::ops::Mul for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn mul(self, o: Self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe { Self([$mul(self.0[0], o.0[0]), $mul(self.0[1], o.0[1])]) }
-            }
-        }
-        impl std::ops::Neg for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn neg(self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe {
-                    let s = $set1(-0.0);
-                    Self([$xor(self.0[0], s), $xor(self.0[1], s)])
-                }
-            }
-        }
-        impl std::ops::Mul<f64> for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn mul(self, o: f64) -> Self {
-                self * <Self as WideLanes>::splat(o)
-            }
-        }
-        impl std::ops::Add<f64> for $t {
-            type Output = Self;
-            #[inline(always)]
-            fn add(self, o: f64) -> Self {
-                self + <Self as WideLanes>::splat(o)
-            }
-        }
-        impl WideLanes for $t {
-            type Narrow = $narrow;
-            #[inline(always)]
-            fn splat(x: f64) -> Self {
-                // SAFETY: see the module doc.
-                unsafe {
-                    let v: $reg = $set1(x);
-                    Self([v, v])
-                }
-            }
-            #[inline(always)]
-            fn sqrt(self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe { Self([$sqrt(self.0[0]), $sqrt(self.0[1])]) }
-            }
-            #[inline(always)]
-            fn min(self, o: Self) -> Self {
-                // SAFETY: see the module doc.
-                unsafe { Self([$min(self.0[0], o.0[0]), $min(self.0[1], o.0[1])]) }
-            }
-        }
-    };
-}
 
 // ---------------------------------------------------------------------------
 // AVX2 + FMA.
@@ -125,7 +47,10 @@ wide_pair!(
     _mm256_set1_pd,
     _mm256_sqrt_pd,
     _mm256_min_pd,
-    _mm256_xor_pd
+    |x| Avx2Wide(unsafe {
+        let s = _mm256_set1_pd(-0.0);
+        [_mm256_xor_pd(x.0[0], s), _mm256_xor_pd(x.0[1], s)]
+    })
 );
 
 impl From<f32> for Avx2 {
@@ -320,7 +245,10 @@ wide_pair!(
     _mm512_set1_pd,
     _mm512_sqrt_pd,
     _mm512_min_pd,
-    xor512_pd
+    |x| Avx512Wide(unsafe {
+        let s = _mm512_set1_pd(-0.0);
+        [xor512_pd(x.0[0], s), xor512_pd(x.0[1], s)]
+    })
 );
 
 /// `a ^ b` of two f64 registers (AVX-512F has the integer form only).
