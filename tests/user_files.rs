@@ -235,6 +235,7 @@ fn cpu_and_gpu_agree_on_file_models() {
         ("features.brdf", serde_json::json!({})),
         ("native.brdf", serde_json::json!({})),
         ("retro.brdf", serde_json::json!({"shine": 30.0})),
+        ("polyfills.brdf", serde_json::json!({})),
     ];
     let specs: Vec<(&str, ModelSpec)> = names
         .iter()

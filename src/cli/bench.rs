@@ -222,7 +222,15 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     let pairs = PairBuf::from_pairs(&random_pairs(args.pairs.min(POOL)));
+    // A warm-up pass and at least one timed one.
+    let work = super::budget::Work {
+        serial: 0,
+        parallel: 2 * args.pairs as u64,
+        threads,
+    };
+    super::budget::start(brdf.as_ref(), "bv bench", work, super::budget::LONG)?;
     let r = measure(brdf.as_ref(), &pairs, args.pairs, threads, MIN_TIMED)?;
+    super::budget::finish(brdf.as_ref(), "bench")?;
     if r.non_finite > 0 {
         super::output::eprint(&format!(
             "bv bench: warning: {} of {} results were not finite (a bug in model `{}`)\n",

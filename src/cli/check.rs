@@ -53,7 +53,15 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<()> {
         },
         ..CheckOptions::default()
     };
+    let (serial, parallel) = opts.evaluations(brdf.as_ref());
+    let work = super::budget::Work {
+        serial,
+        parallel,
+        threads: rayon::current_num_threads(),
+    };
+    super::budget::start(brdf.as_ref(), "bv check", work, super::budget::CHECK)?;
     let report = analysis::check(brdf.as_ref(), &opts);
+    super::budget::finish(brdf.as_ref(), "check")?;
     if args.json {
         let mut v = serde_json::to_value(&report).context("encoding the report as JSON")?;
         // The report names the model; the parameters make it reproducible.

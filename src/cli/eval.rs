@@ -229,11 +229,12 @@ impl Evaluator {
         let wi = direction(&obj, "wi")?;
         let wo = direction(&obj, "wo")?;
         let brdf = self.model(model, params)?;
-        let f = brdf.eval(wi, wo);
+        // A failed evaluation (a user's shader past its step budget) is this
+        // query's error, not a 0.
+        let f = brdf.try_eval(wi, wo).map_err(|e| e.to_string())?;
         if !f.is_finite() {
             return Err(format!(
-                "model `{model}` gave a non-finite value {f} at wi = {wi}, wo = {wo} \
-                 (a bug in bv; please report it)"
+                "model `{model}` gave a non-finite value {f} at wi = {wi}, wo = {wo}"
             ));
         }
         Ok(f)

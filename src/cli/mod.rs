@@ -16,6 +16,7 @@
 //! status; nothing a user types makes the program panic.
 
 pub mod bench;
+pub mod budget;
 pub mod check;
 pub mod eval;
 pub mod info;

@@ -114,7 +114,21 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
         ]
     };
     let f_cols = |first| vec![first, "f_r", "f_g", "f_b", "f_mean", "f_cos_mean"];
-    Ok(match a.curve {
+    let work = match a.curve {
+        // The albedo view's Monte Carlo: 90 angles of 4096 samples.
+        Curve::Albedo => super::budget::Work {
+            serial: 0,
+            parallel: 90 * 4096,
+            threads: rayon::current_num_threads(),
+        },
+        _ => super::budget::Work {
+            serial: a.samples as u64,
+            parallel: 0,
+            threads: 1,
+        },
+    };
+    super::budget::start(brdf.as_ref(), "bv slice", work, super::budget::LONG)?;
+    let table = match a.curve {
         Curve::ThetaO => {
             let s = curves::plane_of_incidence(
                 brdf.as_ref(),
@@ -193,7 +207,9 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
                 rows,
             )
         }
-    })
+    };
+    super::budget::finish(brdf.as_ref(), "slice")?;
+    Ok(table)
 }
 
 /// A unit direction with the `z` of signed in-plane angle `x` (for the cosine

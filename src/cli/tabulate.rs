@@ -50,8 +50,15 @@ pub fn run(args: &TabulateArgs) -> Result<()> {
             args.model
         ));
     }
+    let work = super::budget::Work {
+        serial: 0,
+        parallel: dims.cells() as u64,
+        threads: rayon::current_num_threads(),
+    };
+    super::budget::start(brdf.as_ref(), "bv tabulate", work, super::budget::LONG)?;
     let start = Instant::now();
     let table = merl::tabulate(brdf.as_ref(), dims)?;
+    super::budget::finish(brdf.as_ref(), "tabulate")?;
     let tab_s = start.elapsed().as_secs_f64();
     for w in table.warnings().messages() {
         warn(&w);

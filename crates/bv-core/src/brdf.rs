@@ -141,6 +141,62 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         None
     }
+
+    /// `f(wi, wo)`, or why it cannot be computed. The built-in models always
+    /// succeed (the default is [`Brdf::eval`]); a user's shader can fail (its
+    /// step budget, its memory limit), and that is an error here, where
+    /// [`Brdf::eval`] reads it as 0 and counts it in [`Brdf::health`].
+    fn try_eval(&self, wi: DVec3, wo: DVec3) -> crate::Result<Rgb> {
+        Ok(self.eval(wi, wo))
+    }
+
+    /// How [`Brdf::eval`] has gone since the model was built: failed and
+    /// non-finite evaluations, which it read as 0. Every analysis reads this
+    /// after computing, so that a result built on failures is an error, not
+    /// a silent 0. Default: nothing can fail.
+    fn health(&self) -> EvalHealth {
+        EvalHealth::default()
+    }
+
+    /// About how long one evaluation takes, where that can be far more than a
+    /// built-in model's fraction of a microsecond (an interpreted shader,
+    /// timed when it was built), so that an analysis can refuse a model too
+    /// slow for it before it starts. Default: `None` (cheap).
+    fn eval_cost(&self) -> Option<std::time::Duration> {
+        None
+    }
+
+    /// Limits the wall-clock time evaluation may take from now on: past it,
+    /// each [`Brdf::eval`] fails at once (counted in [`Brdf::health`]), so an
+    /// analysis of a model that turned out too slow ends in bounded time and
+    /// reports why. `None` lifts the limit. Default: nothing to limit.
+    fn limit_time(&self, _budget: Option<std::time::Duration>) {}
+}
+
+/// Failed and non-finite evaluations of a model (see [`Brdf::health`]).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct EvalHealth {
+    /// Evaluations that failed (each read as 0).
+    pub failed: u64,
+    /// Evaluations whose value had a NaN or infinite channel (read as 0).
+    pub non_finite: u64,
+    /// Why the first failed evaluation failed, with its directions.
+    pub first_failure: Option<String>,
+}
+
+impl EvalHealth {
+    /// The error for a result computed with failed evaluations of model
+    /// `id`, if any failed.
+    pub fn failure(&self, id: &str) -> Option<crate::BvError> {
+        (self.failed > 0).then(|| {
+            crate::BvError::Invalid(format!(
+                "{} evaluation{} of model `{id}` failed, so the result would be wrong; the first: {}",
+                self.failed,
+                if self.failed == 1 { "" } else { "s" },
+                self.first_failure.as_deref().unwrap_or("no reason recorded")
+            ))
+        })
+    }
 }
 
 /// The microfacet terms of a model, as functions a plot can sample: the

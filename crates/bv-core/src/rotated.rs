@@ -131,6 +131,22 @@ impl Brdf for Rotated {
         self.inner.is_analytic()
     }
 
+    fn try_eval(&self, wi: DVec3, wo: DVec3) -> crate::Result<Rgb> {
+        self.inner.try_eval(self.to_inner(wi), self.to_inner(wo))
+    }
+
+    fn health(&self) -> crate::EvalHealth {
+        self.inner.health()
+    }
+
+    fn eval_cost(&self) -> Option<std::time::Duration> {
+        self.inner.eval_cost()
+    }
+
+    fn limit_time(&self, budget: Option<std::time::Duration>) {
+        self.inner.limit_time(budget);
+    }
+
     fn ndf(&self) -> Option<&dyn Ndf> {
         self.ndf.as_ref().map(|n| n as &dyn Ndf)
     }

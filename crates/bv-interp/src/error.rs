@@ -27,10 +27,15 @@ pub enum InterpError {
         depth: u32,
     },
     /// The call's variables need more memory than the limit allows.
-    #[error("the shader needs {bytes} bytes of variables, more than the memory limit")]
+    #[error(
+        "the shader needs {bytes} bytes for its variables and intermediate values in one \
+         evaluation; the limit is {limit} bytes"
+    )]
     Memory {
         /// The bytes the call would have needed at that point.
         bytes: usize,
+        /// The limit it ran into.
+        limit: usize,
     },
     /// A value given to the interpreter does not have the type the shader
     /// declares.

@@ -57,12 +57,16 @@ impl<'p> Machine<'p, '_> {
             Err(bytes) => {
                 return Err(InterpError::Memory {
                     bytes: bytes.saturating_add(fb * 8),
+                    limit: self.limits.max_memory_bytes,
                 });
             }
         };
         let top = fb + cells;
         if top.saturating_mul(8) > self.limits.max_memory_bytes {
-            return Err(InterpError::Memory { bytes: top * 8 });
+            return Err(InterpError::Memory {
+                bytes: top * 8,
+                limit: self.limits.max_memory_bytes,
+            });
         }
         if self.mem.len() < top {
             self.mem.resize(top, 0.0);

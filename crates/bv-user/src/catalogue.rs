@@ -30,8 +30,14 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 /// The catalogue id of the file at canonical `path`: its stem (lower case,
 /// every other character `-`) and 8 hex digits of the path's hash, so that
 /// two `phong.brdf` in different folders are two models and one path is
-/// always the same one.
+/// always the same one. Two paths can share this id (32 bits collide after
+/// some 77,000 paths, or on purpose); [`unique_id`] is what a load uses.
 pub fn model_id(path: &Path) -> String {
+    id_with_hash(path, false)
+}
+
+/// The stem part and the hash of a path: 8 hex digits, or all 16 (`long`).
+fn id_with_hash(path: &Path, long: bool) -> String {
     let stem: String = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -53,20 +59,60 @@ pub fn model_id(path: &Path) -> String {
         .filter(|w| !w.is_empty())
         .collect::<Vec<_>>()
         .join("-");
-    let hash = fnv1a(path.to_string_lossy().as_bytes()) as u32;
-    format!(
-        "{}-{hash:08x}",
-        if stem.is_empty() { "brdf" } else { &stem }
-    )
+    let hash = fnv1a(path.to_string_lossy().as_bytes());
+    let stem = if stem.is_empty() { "brdf" } else { &stem };
+    if long {
+        format!("{stem}-{hash:016x}")
+    } else {
+        format!("{stem}-{:08x}", hash as u32)
+    }
+}
+
+/// The ids given out in this process, and the canonical path each belongs
+/// to: an id is never handed to a second path.
+static IDS: LazyLock<Mutex<HashMap<String, PathBuf>>> =
+    LazyLock::new(|| Mutex::new(HashMap::new()));
+
+/// The id of the file at canonical `path`, unique in this process: its
+/// [`model_id`], or, if another path already has that, the stem with the
+/// whole 64-bit hash; if even that is taken (a collision built on purpose),
+/// the file is refused rather than confused with the other.
+pub fn unique_id(path: &Path) -> Result<String> {
+    let mut ids = IDS.lock().map_err(|_| UserError::Model {
+        file: path.display().to_string(),
+        reason: "internal: the id registry is poisoned".into(),
+    })?;
+    for long in [false, true] {
+        let id = id_with_hash(path, long);
+        match ids.get(&id) {
+            Some(owner) if owner != path => continue,
+            Some(_) => return Ok(id),
+            None => {
+                ids.insert(id.clone(), path.to_path_buf());
+                return Ok(id);
+            }
+        }
+    }
+    let other = ids
+        .get(&id_with_hash(path, true))
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    Err(UserError::Model {
+        file: path.display().to_string(),
+        reason: format!(
+            "its path has the same 64-bit hash as `{other}`, loaded before it; rename or move \
+             one of them"
+        ),
+    })
 }
 
 fn leak(s: String) -> &'static str {
     Box::leak(s.into_boxed_str())
 }
 
-/// The catalogue entry of a compiled file.
-pub fn model_info(c: &Compiled, path: &Path) -> Result<ModelInfo> {
-    let id = model_id(path);
+/// The catalogue entry of a compiled file, under `id` (its
+/// [`unique_id`]).
+pub fn model_info(c: &Compiled, path: &Path, id: String) -> Result<ModelInfo> {
     let file_name = path
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
@@ -170,7 +216,8 @@ pub fn load(path: &Path) -> Result<&'static ModelInfo> {
     let stamp = stamp_of(&canon);
     let text = read(&canon)?;
     let c = compile::compile(&text, &path.display().to_string())?;
-    let info = model_info(&c, &canon)?;
+    let id = unique_id(&canon)?;
+    let info = model_info(&c, &canon, id)?;
     let info = bv_core::register(info).map_err(|e| UserError::Model {
         file: path.display().to_string(),
         reason: e.to_string(),
@@ -248,5 +295,33 @@ mod tests {
         assert!(is_file_name("x/y.BRDF"));
         assert!(!is_file_name("lambert"));
         assert!(model_id(Path::new("/x/_a__b-.brdf")).starts_with("a-b-"));
+    }
+
+    /// Two paths whose 32-bit ids collide (found by a birthday search)
+    /// get two ids, each path always the same one.
+    #[test]
+    fn colliding_short_ids_are_told_apart() {
+        let mut seen: HashMap<String, PathBuf> = HashMap::new();
+        let (a, b) = (0..2_000_000u32)
+            .find_map(|k| {
+                let p = PathBuf::from(format!("/collide/{k:x}/phong.brdf"));
+                let id = model_id(&p);
+                match seen.get(&id) {
+                    Some(q) => Some((q.clone(), p)),
+                    None => {
+                        seen.insert(id, p);
+                        None
+                    }
+                }
+            })
+            .expect("a 32-bit collision among 2 million paths");
+        assert_eq!(model_id(&a), model_id(&b));
+        let ia = unique_id(&a).unwrap();
+        let ib = unique_id(&b).unwrap();
+        assert_ne!(ia, ib);
+        assert_eq!(ia, model_id(&a));
+        assert_eq!(ib.len(), "phong-".len() + 16, "{ib}");
+        assert_eq!(unique_id(&a).unwrap(), ia);
+        assert_eq!(unique_id(&b).unwrap(), ib);
     }
 }

@@ -53,6 +53,11 @@ fn container_error(message: &str, name: &str) -> UserError {
 /// carry.
 pub fn compile(text: &str, name: &str) -> Result<Compiled> {
     let file = brdf_file::parse(text).map_err(|e| container_error(&e.to_string(), name))?;
+    front::check_param_names(&file, name)?;
+    // Bounded before any compiler sees the text (see `bounds`).
+    let mut sections = vec![&file.source];
+    sections.extend(file.is_func.as_ref());
+    crate::bounds::check(file.language, &sections, name)?;
     let t: Translated = front::translate(&file, name)?;
     front::check_signature(&t, &file, name)?;
     safety::check(&t.module, name)?;

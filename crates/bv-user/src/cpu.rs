@@ -7,13 +7,23 @@
 //!
 //! Every call is bounded by the interpreter's [`Limits`] (steps, call depth,
 //! memory): an endless loop ends with an error, never a hang. An evaluator is
-//! probed once when it is built (at normal incidence), so that a shader that
-//! never finishes, or one the interpreter cannot run, is a clear build error;
-//! a later evaluation that fails reads as 0.
+//! probed when it is built, at the normal and at 32 pairs spread over the
+//! hemisphere, so that a shader that does not finish (or that the
+//! interpreter cannot run) somewhere is a clear build error, and the probe
+//! times it ([`Brdf::eval_cost`]) so that an analysis can refuse a model too
+//! slow for it before it starts.
+//!
+//! A later evaluation that fails anyway reads as 0 in [`Brdf::eval`] and is
+//! counted, with the first reason, in [`Brdf::health`], which every analysis
+//! reads after computing: an error, never a silent 0. [`Brdf::try_eval`]
+//! returns the error itself. Under [`Brdf::limit_time`], evaluations past
+//! the deadline (or after a failure) fail at once, so that an analysis of a
+//! model that is too slow ends in bounded time.
 //!
 //! Values are handled as the built-in models and the GPU port handle them:
 //! 0 below the horizon (the Explorer draws only the upper hemisphere), and
-//! a NaN or infinite channel (a division by a vanishing cosine) reads as 0.
+//! a NaN or infinite channel (a division by a vanishing cosine) reads as 0
+//! and is counted in [`Brdf::health`], so that `bv check` reports it.
 //! Negative values are kept, so that `bv check` reports them.
 //!
 //! A file with a usable `isFunc` section ([`crate::sampler`]) samples with
@@ -30,7 +40,10 @@ use bv_core::params::ParamKind;
 use bv_core::{Brdf, Claims, ParamDecl, Params, Rgb};
 use bv_interp::{InterpError, Limits, Program, Value};
 use glam::{DVec2, DVec3};
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, OnceLock};
+use std::time::Duration;
+use web_time::Instant;
 
 /// A file's module and declaration, ready to be given parameter values.
 #[derive(Debug, Clone)]
@@ -42,12 +55,42 @@ pub struct FileProgram {
     file: String,
 }
 
+/// An interpreter's message in the user's terms: bv's internal names for
+/// the model's function and parameters become the user's.
+fn user_terms(message: &str) -> String {
+    message
+        .replace(&format!("`{}`", port::BRDF_FN), "the BRDF function")
+        .replace(&format!("`{SAMPLE_FN}`"), "the isFunc section")
+}
+
 fn interp_error(file: &str, e: &InterpError) -> UserError {
+    model_error(file, user_terms(&e.to_string()))
+}
+
+fn model_error(file: &str, reason: String) -> UserError {
     UserError::Model {
         file: file.to_string(),
-        reason: format!("on the CPU: {e}"),
+        reason: format!("on the CPU: {reason}"),
     }
 }
+
+/// An evaluation error in the user's terms, with the directions it
+/// happened at.
+fn at_pair(e: &InterpError, wi: DVec3, wo: DVec3) -> String {
+    format!(
+        "{} (at L = {}, V = {})",
+        user_terms(&e.to_string()),
+        fmt_dir(wi),
+        fmt_dir(wo)
+    )
+}
+
+fn fmt_dir(w: DVec3) -> String {
+    format!("({:.4}, {:.4}, {:.4})", w.x, w.y, w.z)
+}
+
+/// [`FileBrdf::deadline_ns`] when no deadline is set.
+const NO_DEADLINE: u64 = u64::MAX;
 
 impl FileProgram {
     /// The program of a compiled file; fails if the interpreter cannot run
@@ -78,6 +121,7 @@ impl FileProgram {
             Some(m) => Some(Arc::new(self.program(m, &values, true)?)),
             None => None,
         };
+        let born = Instant::now();
         let mut b = FileBrdf {
             id,
             program: Arc::new(program),
@@ -88,16 +132,34 @@ impl FileProgram {
                 energy_conserving: false,
                 isotropic: false,
             },
+            cost: Duration::ZERO,
+            born,
+            deadline_ns: AtomicU64::new(NO_DEADLINE),
+            failed: AtomicU64::new(0),
+            non_finite: AtomicU64::new(0),
+            first_failure: OnceLock::new(),
         };
-        b.try_eval(DVec3::Z, DVec3::Z)
-            .map_err(|e| interp_error(&self.file, &e))?;
+        // The probe: the normal, then pairs over the hemisphere (a shader
+        // that loops only away from the normal fails here, not in an
+        // analysis hours later).
+        let pairs: Vec<(DVec3, DVec3)> = std::iter::once((DVec3::Z, DVec3::Z))
+            .chain(probe_pairs())
+            .collect();
+        let start = Instant::now();
+        for &(wi, wo) in &pairs {
+            b.call_brdf(wi, wo)
+                .map_err(|e| model_error(&self.file, at_pair(&e, wi, wo)))?;
+        }
+        b.cost = start.elapsed() / pairs.len() as u32;
         if b.sampler.is_some() {
-            // The sampler and its density run once too, so that one the
+            // The sampler and its density run too, so that one the
             // interpreter cannot finish is a build error, not silence.
-            b.try_sample(DVec3::Z, DVec2::splat(0.5))
-                .map_err(|e| interp_error(&self.file, &e))?;
-            b.try_pdf(DVec3::Z, DVec3::Z)
-                .map_err(|e| interp_error(&self.file, &e))?;
+            for &(wi, wo) in &pairs {
+                b.try_sample(wi, DVec2::new(wo.x.abs(), wo.y.abs()))
+                    .map_err(|e| model_error(&self.file, at_pair(&e, wi, wo)))?;
+                b.try_pdf(wi, wo)
+                    .map_err(|e| model_error(&self.file, at_pair(&e, wi, wo)))?;
+            }
         }
         b.claims = b.observed_claims();
         Ok(b)
@@ -154,6 +216,19 @@ pub struct FileBrdf {
     sampler: Option<Arc<Program>>,
     limits: Limits,
     claims: Claims,
+    /// Mean time of one evaluation in the build's probe.
+    cost: Duration,
+    /// When the evaluator was built: the origin of `deadline_ns`.
+    born: Instant,
+    /// The deadline of [`Brdf::limit_time`], in nanoseconds after `born`
+    /// ([`NO_DEADLINE`]: none). An atomic, read on every evaluation by
+    /// every thread of an analysis without a lock.
+    deadline_ns: AtomicU64,
+    /// Evaluations that failed, and that returned a non-finite channel.
+    failed: AtomicU64,
+    non_finite: AtomicU64,
+    /// Why the first failed evaluation failed.
+    first_failure: OnceLock<String>,
 }
 
 impl std::fmt::Debug for FileBrdf {
@@ -167,8 +242,32 @@ fn v3(w: DVec3) -> Value {
 }
 
 impl FileBrdf {
+    /// The value at a pair above the horizon (0 below it), or why there is
+    /// none: the interpreter's error at these directions, or the time limit.
+    fn checked(&self, wi: DVec3, wo: DVec3) -> Result<Rgb, String> {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Ok(Rgb::ZERO);
+        }
+        let deadline = self.deadline_ns.load(Ordering::Relaxed);
+        if deadline != NO_DEADLINE {
+            // Under a time limit, a failure ends the analysis: the rest fail
+            // at once instead of each running to the step budget.
+            if self.failed.load(Ordering::Acquire) > 0 {
+                return Err("an earlier evaluation failed".into());
+            }
+            if u64::try_from(self.born.elapsed().as_nanos()).unwrap_or(u64::MAX) > deadline {
+                return Err(format!(
+                    "the model is too slow to analyse: it ran past the analysis's time \
+                     budget ({} per evaluation when it was built)",
+                    bv_core::text::fmt_duration(self.cost)
+                ));
+            }
+        }
+        self.call_brdf(wi, wo).map_err(|e| at_pair(&e, wi, wo))
+    }
+
     /// f(wi, wo) as the shader returns it (no horizon test, no clamping).
-    pub fn try_eval(&self, wi: DVec3, wo: DVec3) -> Result<Rgb, InterpError> {
+    pub fn call_brdf(&self, wi: DVec3, wo: DVec3) -> Result<Rgb, InterpError> {
         let args = [v3(wi), v3(wo), v3(DVec3::Z), v3(DVec3::X), v3(DVec3::Y)];
         let out = self.program.call(port::BRDF_FN, &args, &self.limits)?;
         let [r, g, b] = out
@@ -246,10 +345,11 @@ impl FileBrdf {
         let mut reciprocal = true;
         let mut isotropic = true;
         for (wi, wo) in probe_pairs() {
-            let f = self.eval(wi, wo);
-            reciprocal &= same(f, self.eval(wo, wi));
+            let value = |a: DVec3, b: DVec3| self.checked(a, b).unwrap_or(Rgb::ZERO);
+            let f = value(wi, wo);
+            reciprocal &= same(f, value(wo, wi));
             let turn = glam::DQuat::from_rotation_z(0.7);
-            isotropic &= same(f, self.eval(turn * wi, turn * wo));
+            isotropic &= same(f, value(turn * wi, turn * wo));
         }
         Claims {
             reciprocal,
@@ -265,13 +365,46 @@ impl Brdf for FileBrdf {
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return Rgb::ZERO;
+        match self.checked(wi, wo) {
+            Ok(f) => {
+                if !f.is_finite() {
+                    self.non_finite.fetch_add(1, Ordering::Relaxed);
+                }
+                Rgb::from_array(f.to_array().map(|x| if x.is_finite() { x } else { 0.0 }))
+            }
+            Err(why) => {
+                // The reason first: a thread that sees the count sees it.
+                let _ = self.first_failure.set(why);
+                self.failed.fetch_add(1, Ordering::Release);
+                Rgb::ZERO
+            }
         }
-        match self.try_eval(wi, wo) {
-            Ok(f) => Rgb::from_array(f.to_array().map(|x| if x.is_finite() { x } else { 0.0 })),
-            Err(_) => Rgb::ZERO,
+    }
+
+    /// The shader's value, non-finite channels as they are; an error names
+    /// the directions.
+    fn try_eval(&self, wi: DVec3, wo: DVec3) -> bv_core::Result<Rgb> {
+        self.checked(wi, wo).map_err(bv_core::BvError::Invalid)
+    }
+
+    fn health(&self) -> bv_core::EvalHealth {
+        bv_core::EvalHealth {
+            failed: self.failed.load(Ordering::Relaxed),
+            non_finite: self.non_finite.load(Ordering::Relaxed),
+            first_failure: self.first_failure.get().cloned(),
         }
+    }
+
+    fn eval_cost(&self) -> Option<Duration> {
+        Some(self.cost)
+    }
+
+    fn limit_time(&self, budget: Option<Duration>) {
+        let ns = budget.map_or(NO_DEADLINE, |b| {
+            let at = self.born.elapsed().saturating_add(b);
+            u64::try_from(at.as_nanos()).unwrap_or(NO_DEADLINE - 1)
+        });
+        self.deadline_ns.store(ns, Ordering::Relaxed);
     }
 
     /// A user's shader is not a closed form a quadrature may trust to its

@@ -73,6 +73,316 @@ fn wgsl_type(kind: &FileParamKind) -> &'static str {
     }
 }
 
+/// GLSL 4.50's keywords, reserved words and type names (§3.6), and the
+/// names bv's generated code uses: none can name a parameter, which bv
+/// declares as a global of that name.
+const GLSL_RESERVED: &[&str] = &[
+    "attribute",
+    "const",
+    "uniform",
+    "varying",
+    "buffer",
+    "shared",
+    "coherent",
+    "volatile",
+    "restrict",
+    "readonly",
+    "writeonly",
+    "atomic_uint",
+    "layout",
+    "centroid",
+    "flat",
+    "smooth",
+    "noperspective",
+    "patch",
+    "sample",
+    "break",
+    "continue",
+    "do",
+    "for",
+    "while",
+    "switch",
+    "case",
+    "default",
+    "if",
+    "else",
+    "subroutine",
+    "in",
+    "out",
+    "inout",
+    "float",
+    "double",
+    "int",
+    "void",
+    "bool",
+    "true",
+    "false",
+    "invariant",
+    "precise",
+    "discard",
+    "return",
+    "mat2",
+    "mat3",
+    "mat4",
+    "dmat2",
+    "dmat3",
+    "dmat4",
+    "mat2x2",
+    "mat2x3",
+    "mat2x4",
+    "dmat2x2",
+    "dmat2x3",
+    "dmat2x4",
+    "mat3x2",
+    "mat3x3",
+    "mat3x4",
+    "dmat3x2",
+    "dmat3x3",
+    "dmat3x4",
+    "mat4x2",
+    "mat4x3",
+    "mat4x4",
+    "dmat4x2",
+    "dmat4x3",
+    "dmat4x4",
+    "vec2",
+    "vec3",
+    "vec4",
+    "ivec2",
+    "ivec3",
+    "ivec4",
+    "bvec2",
+    "bvec3",
+    "bvec4",
+    "dvec2",
+    "dvec3",
+    "dvec4",
+    "uint",
+    "uvec2",
+    "uvec3",
+    "uvec4",
+    "lowp",
+    "mediump",
+    "highp",
+    "precision",
+    "sampler1D",
+    "sampler2D",
+    "sampler3D",
+    "samplerCube",
+    "struct",
+    "common",
+    "partition",
+    "active",
+    "asm",
+    "class",
+    "union",
+    "enum",
+    "typedef",
+    "template",
+    "this",
+    "resource",
+    "goto",
+    "inline",
+    "noinline",
+    "public",
+    "static",
+    "extern",
+    "external",
+    "interface",
+    "long",
+    "short",
+    "half",
+    "fixed",
+    "unsigned",
+    "superp",
+    "input",
+    "output",
+    "hvec2",
+    "hvec3",
+    "hvec4",
+    "fvec2",
+    "fvec3",
+    "fvec4",
+    "filter",
+    "sizeof",
+    "cast",
+    "namespace",
+    "using",
+    "main",
+    "BRDF",
+];
+
+/// WGSL's keywords, reserved words and predeclared types that a `var`
+/// cannot be named (WGSL §15.1, §15.2), and bv's own names.
+const WGSL_RESERVED: &[&str] = &[
+    "alias",
+    "break",
+    "case",
+    "const",
+    "const_assert",
+    "continue",
+    "continuing",
+    "default",
+    "diagnostic",
+    "discard",
+    "else",
+    "enable",
+    "false",
+    "fn",
+    "for",
+    "if",
+    "let",
+    "loop",
+    "override",
+    "requires",
+    "return",
+    "struct",
+    "switch",
+    "true",
+    "var",
+    "while",
+    "f32",
+    "f16",
+    "i32",
+    "u32",
+    "bool",
+    "vec2",
+    "vec3",
+    "vec4",
+    "mat2x2",
+    "mat3x3",
+    "mat4x4",
+    "array",
+    "ptr",
+    "atomic",
+    "sampler",
+    "texture_2d",
+    "NULL",
+    "Self",
+    "abstract",
+    "active",
+    "as",
+    "asm",
+    "async",
+    "await",
+    "become",
+    "cast",
+    "catch",
+    "class",
+    "co_await",
+    "co_return",
+    "co_yield",
+    "coherent",
+    "const_cast",
+    "do",
+    "dynamic_cast",
+    "enum",
+    "export",
+    "extends",
+    "extern",
+    "external",
+    "final",
+    "finally",
+    "friend",
+    "from",
+    "fxgroup",
+    "get",
+    "goto",
+    "impl",
+    "implements",
+    "import",
+    "inline",
+    "instanceof",
+    "interface",
+    "layout",
+    "macro",
+    "match",
+    "mod",
+    "module",
+    "move",
+    "mut",
+    "mutable",
+    "namespace",
+    "new",
+    "nil",
+    "noexcept",
+    "noinline",
+    "null",
+    "package",
+    "private",
+    "protected",
+    "public",
+    "pub",
+    "readonly",
+    "ref",
+    "reinterpret_cast",
+    "resource",
+    "restrict",
+    "self",
+    "shared",
+    "sizeof",
+    "static",
+    "static_assert",
+    "static_cast",
+    "super",
+    "template",
+    "this",
+    "throw",
+    "trait",
+    "try",
+    "type",
+    "typedef",
+    "typeid",
+    "typename",
+    "typeof",
+    "union",
+    "unless",
+    "unsafe",
+    "use",
+    "using",
+    "virtual",
+    "void",
+    "volatile",
+    "where",
+    "with",
+    "writeonly",
+    "yield",
+    "brdf",
+];
+
+/// Refuses a parameter whose name the shader language reserves (`float`,
+/// `in`, `return`, `mat3`, …): bv declares each parameter as a variable of
+/// its name, and the compiler's complaint about that generated line would
+/// name internal tokens. Names starting `gl_` (GLSL) or `__` (WGSL) are
+/// reserved too.
+pub fn check_param_names(file: &BrdfFile, name: &str) -> Result<()> {
+    let (words, language) = match file.language {
+        Language::Glsl => (GLSL_RESERVED, "GLSL"),
+        Language::Wgsl => (WGSL_RESERVED, "WGSL"),
+    };
+    for p in &file.params {
+        let reserved = words.contains(&p.name.as_str())
+            || match file.language {
+                Language::Glsl => p.name.starts_with("gl_") || p.name.contains("__"),
+                Language::Wgsl => p.name.starts_with("__"),
+            };
+        if reserved {
+            return Err(UserError::Compile {
+                place: Place {
+                    file: name.to_string(),
+                    line: p.line,
+                    column: 1,
+                },
+                reason: format!(
+                    "parameter `{}` has a name that {language} reserves (a keyword, a type or bv's own); rename it",
+                    p.name
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The user's section with `#version` lines blanked (the one rewrite; see
 /// the module docs).
 pub(crate) fn lenient_copy(text: &str) -> String {
@@ -220,8 +530,42 @@ pub fn validate(module: &Module, map: &SourceMap, src: &str) -> Result<naga::val
             reason.push_str(&s.to_string());
             source = s.source();
         }
-        compile_error(map, place, reason)
+        compile_error(
+            map,
+            place,
+            recursion_reason(&reason, module).unwrap_or(reason),
+        )
     })
+}
+
+/// naga's message for a function that calls one declared after it
+/// (`[0] of kind "naga::ir::Function" depends on [1] of kind …`), which a
+/// GLSL file can only write with a prototype and mutual recursion, in the
+/// user's terms.
+fn recursion_reason(reason: &str, module: &Module) -> Option<String> {
+    const KIND: &str = "of kind \"naga::ir::Function\" depends on [";
+    let at = reason.find(KIND)?;
+    let before = &reason[..at];
+    let start = before.rfind('[')? + 1;
+    let caller: usize = before[start..before[start..].find(']')? + start]
+        .parse()
+        .ok()?;
+    let after = &reason[at + KIND.len()..];
+    let callee: usize = after[..after.find(']')?].parse().ok()?;
+    let name = |k: usize| {
+        module
+            .functions
+            .iter()
+            .nth(k)
+            .and_then(|(_, f)| f.name.clone())
+            .unwrap_or_else(|| format!("function {k}"))
+    };
+    Some(format!(
+        "`{}` and `{}` call each other: recursion (a function calling itself, directly or \
+         through others) is not supported, since a GPU cannot run it",
+        name(caller),
+        name(callee)
+    ))
 }
 
 fn is_vec3f(module: &Module, ty: Handle<naga::Type>) -> bool {

@@ -11,6 +11,7 @@
 //! The container itself (sections, parameter lines) is parsed by
 //! `bv_core::user::brdf_file`; bv-core stays free of naga.
 
+pub mod bounds;
 pub mod catalogue;
 pub mod compile;
 pub mod cpu;

@@ -100,12 +100,33 @@ pub fn emit(module: &naga::Module, file: &str) -> Result<String> {
         file: file.to_string(),
         reason: format!("internal: the renamed module does not validate: {e}"),
     })?;
-    naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty()).map_err(
-        |e| UserError::Model {
+    naga::back::wgsl::write_string(module, &info, naga::back::wgsl::WriterFlags::empty())
+        .map(|w| polyfill_names(&w))
+        .map_err(|e| UserError::Model {
             file: file.to_string(),
             reason: format!("cannot write the shader as WGSL: {e}"),
-        },
-    )
+        })
+}
+
+/// naga's WGSL writer adds functions for what WGSL lacks (GLSL's
+/// `inverse()` becomes `_naga_inverse_3x3_f32`); bv's shader composer
+/// refuses identifiers that start with `_`, so they become `bvxnaga_…`
+/// (user names never start with `bvx`: see [`renamed`]).
+fn polyfill_names(wgsl: &str) -> String {
+    const FROM: &str = "_naga_";
+    let mut out = String::with_capacity(wgsl.len());
+    let mut rest = wgsl;
+    while let Some(k) = rest.find(FROM) {
+        let starts_word = rest[..k]
+            .chars()
+            .next_back()
+            .is_none_or(|c| !(c.is_ascii_alphanumeric() || c == '_'));
+        out.push_str(&rest[..k]);
+        out.push_str(if starts_word { "bvxnaga_" } else { FROM });
+        rest = &rest[k + FROM.len()..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Puts the iteration guard at the top of every `loop` body (module docs).
@@ -182,6 +203,17 @@ mod tests {
             names
                 .iter()
                 .all(|n| !n.ends_with(|c: char| c.is_ascii_digit()))
+        );
+    }
+
+    #[test]
+    fn polyfills_get_names_the_composer_takes() {
+        let w = polyfill_names(
+            "fn _naga_inverse_3x3_f32() {}\nlet a = _naga_inverse_3x3_f32(m) + my_naga_x;",
+        );
+        assert_eq!(
+            w,
+            "fn bvxnaga_inverse_3x3_f32() {}\nlet a = bvxnaga_inverse_3x3_f32(m) + my_naga_x;"
         );
     }
 

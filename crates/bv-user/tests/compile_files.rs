@@ -51,6 +51,7 @@ const GOOD: &[&str] = &[
     "features.brdf",
     "native.brdf",
     "retro.brdf",
+    "polyfills.brdf",
     "hostile_loop.brdf",
 ];
 
@@ -294,4 +295,17 @@ fn a_broken_isfunc_section_is_refused_at_its_place() {
     let p = e.place().unwrap_or_else(|| panic!("no place in {text}"));
     // `    wi = N * undefined_thing;` is file line 11.
     assert_eq!((p.line, p.column), (11, 14), "{text}");
+}
+
+/// `inverse` and `determinant` of every size, which the GPU port gets from
+/// naga's own WGSL functions, are exact on the CPU: each matrix times its
+/// inverse gives the vector back.
+#[test]
+fn matrix_polyfills_evaluate_to_their_closed_form() {
+    let b = built("polyfills.brdf", serde_json::json!({"k": 0.5}));
+    let wi = DVec3::new(0.3, -0.2, 0.9).normalize();
+    let wo = DVec3::new(-0.5, 0.4, 0.7).normalize();
+    let f = b.eval(wi, wo);
+    let want = 0.5 * DVec3::new(2.0 + wi.dot(wo), 2.0 + wi.x, 2.0 + wo.z);
+    assert!((f - want).abs().max_element() < 1e-9, "{f} vs {want}");
 }

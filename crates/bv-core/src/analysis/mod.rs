@@ -219,6 +219,36 @@ impl PropertyReport {
     }
 }
 
+impl CheckOptions {
+    /// About how many evaluations of `brdf` [`check`] makes: `(serial,
+    /// parallel)`, the pair checks run on one thread and the Monte Carlo
+    /// albedo on all. The quadrature's count depends on the model (its
+    /// panels adapt), so with quadrature only the pair checks are counted:
+    /// the command's time limit bounds the rest. For a time estimate before
+    /// a slow model is analysed.
+    pub fn evaluations(&self, brdf: &dyn Brdf) -> (u64, u64) {
+        let pairs = self.pairs as u64;
+        let lower = if brdf.transmits() { pairs / 2 } else { 0 };
+        // Positivity once, reciprocity and isotropy twice per pair.
+        let serial = pairs + lower + 2 * pairs + 2 * pairs;
+        let aopts = albedo::AlbedoOptions {
+            method: self.albedo_method,
+            ..albedo::AlbedoOptions::default()
+        };
+        if aopts.uses_quadrature(brdf) {
+            return (serial, 0);
+        }
+        let azimuths = if brdf.claims().isotropic {
+            1
+        } else {
+            self.anisotropic_azimuths.max(1)
+        } as u64;
+        let angles = (self.theta_count.max(1) + self.grazing_deg.len()) as u64;
+        let parallel = azimuths * angles * self.samples_per_angle as u64 + self.hh_samples as u64;
+        (serial, parallel)
+    }
+}
+
 /// Runs every property check on `brdf`.
 pub fn check(brdf: &dyn Brdf, opts: &CheckOptions) -> PropertyReport {
     let c = brdf.claims();

@@ -36,7 +36,14 @@ pub fn check(brdf: &dyn Brdf, pairs: &[(DVec3, DVec3)], extra: &[(DVec3, DVec3)]
     };
     let mut first_bad: Option<PairSample> = None;
     let mut visit = |wi: DVec3, wo: DVec3| {
-        let f: Rgb = brdf.eval(wi, wo);
+        // The value as the model computed it: a model that reads NaN as 0
+        // in `eval` (a user's shader) shows it here. An evaluation that
+        // fails goes through `eval`, which records it in the model's
+        // health for the caller to report.
+        let f: Rgb = match brdf.try_eval(wi, wo) {
+            Ok(f) => f,
+            Err(_) => brdf.eval(wi, wo),
+        };
         out.evaluations += 1;
         if !f.is_finite() {
             out.non_finite += 1;

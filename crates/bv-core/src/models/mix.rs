@@ -278,6 +278,42 @@ impl Brdf for Mix {
         self.parts.iter().all(|p| p.brdf.is_analytic())
     }
 
+    fn try_eval(&self, wi: DVec3, wo: DVec3) -> crate::Result<Rgb> {
+        let mut sum = Rgb::ZERO;
+        for p in &self.parts {
+            sum += p.weight * p.brdf.try_eval(wi, wo)?;
+        }
+        Ok(sum)
+    }
+
+    /// The parts' failures together (the first reason of the first part
+    /// that failed).
+    fn health(&self) -> crate::EvalHealth {
+        self.parts.iter().map(|p| p.brdf.health()).fold(
+            crate::EvalHealth::default(),
+            |mut acc, h| {
+                acc.failed += h.failed;
+                acc.non_finite += h.non_finite;
+                acc.first_failure = acc.first_failure.or(h.first_failure);
+                acc
+            },
+        )
+    }
+
+    /// An evaluation of the mix evaluates every part.
+    fn eval_cost(&self) -> Option<std::time::Duration> {
+        self.parts
+            .iter()
+            .filter_map(|p| p.brdf.eval_cost())
+            .reduce(|a, b| a + b)
+    }
+
+    fn limit_time(&self, budget: Option<std::time::Duration>) {
+        for p in &self.parts {
+            p.brdf.limit_time(budget);
+        }
+    }
+
     fn sample(&self, wi: DVec3, u: DVec2) -> Option<DVec3> {
         // Pick part j with probability w_j / Σw from u.x, rescale u.x within its
         // interval to a fresh uniform, and let the part draw: the density of the

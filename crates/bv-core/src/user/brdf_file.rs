@@ -136,6 +136,9 @@ pub fn parse(text: &str) -> Result<BrdfFile> {
             text.len()
         )));
     }
+    // A byte-order mark, which some editors write at the start of a UTF-8
+    // file, is not part of the text.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut kind_seen = false;
     let mut params: Vec<FileParam> = Vec::new();
     let mut sections: Vec<(String, Section, usize)> = Vec::new();

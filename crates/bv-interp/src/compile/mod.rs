@@ -207,6 +207,7 @@ impl<'a> Cx<'a> {
         InterpError::Memory {
             bytes: usize::try_from(cells.max(self.estimate).saturating_mul(8))
                 .unwrap_or(usize::MAX),
+            limit: (MAX_CELLS * 8) as usize,
         }
     }
 
@@ -427,6 +428,7 @@ pub(crate) fn globals(
         if top > MAX_CELLS {
             return Err(InterpError::Memory {
                 bytes: usize::try_from(top.saturating_mul(8)).unwrap_or(usize::MAX),
+                limit: (MAX_CELLS * 8) as usize,
             });
         }
         image.resize(top as usize, 0.0);
@@ -491,7 +493,7 @@ pub(crate) fn function(
                 ret,
             })
         }
-        Err(InterpError::Memory { bytes }) => Ok(Func {
+        Err(InterpError::Memory { bytes, .. }) => Ok(Func {
             name,
             frame: Err(bytes),
             template: Box::new([]),
