@@ -68,7 +68,10 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
             if !state.is_drawn(e) {
                 text = text.weak();
             }
-            if runtime.get(e.id).is_some_and(|b| b.error.is_some()) {
+            let failing = |b: &crate::session::runtime::Built| {
+                b.error.is_some() || b.brdf.as_ref().is_some_and(|f| f.health().failed > 0)
+            };
+            if runtime.get(e.id).is_some_and(failing) {
                 text = text.color(ui.visuals().error_fg_color);
             }
             if ui
@@ -355,6 +358,27 @@ pub fn params_section(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mu
     ui.label(RichText::new(info.citation).small().weak());
     if let Some(err) = runtime.get(e.id).and_then(|b| b.error.as_ref()) {
         ui.colored_label(ui.visuals().error_fg_color, err);
+    }
+    // Evaluations that failed or were not finite read as 0 in the views:
+    // say so beside the model, with the first reason.
+    if let Some(brdf) = runtime.get(e.id).and_then(|b| b.brdf.as_ref()) {
+        let health = brdf.health();
+        if let Some(err) = health.failure(brdf.id()) {
+            ui.colored_label(
+                ui.visuals().error_fg_color,
+                format!("{err} (the views show them as 0)"),
+            );
+        }
+        if health.non_finite > 0 {
+            ui.colored_label(
+                ui.visuals().warn_fg_color,
+                format!(
+                    "{} evaluation{} returned NaN or infinity (the views show them as 0)",
+                    health.non_finite,
+                    if health.non_finite == 1 { "" } else { "s" }
+                ),
+            );
+        }
     }
     ui.add_space(4.0);
     let edits = params_ui::params_ui(

@@ -43,6 +43,21 @@ pub fn check_brdfs(state: &AppState, runtime: &Runtime) -> Result<()> {
     Ok(())
 }
 
+/// Fails when evaluations of a drawn BRDF failed while the figure was
+/// computed (a user's shader past its step budget): they read as 0, and a
+/// figure of zeros would be wrong without saying so.
+pub fn check_health(state: &AppState, runtime: &Runtime) -> Result<()> {
+    for e in state.brdfs.iter().filter(|e| state.is_drawn(e)) {
+        if let Some(b) = runtime.get(e.id).and_then(|b| b.brdf.as_ref())
+            && let Some(err) = b.health().failure(b.id())
+        {
+            let name = crate::session::naming::display_name(state, e);
+            bail!("BRDF {name}: {err}");
+        }
+    }
+    Ok(())
+}
+
 /// A whole window's UI that figures can draw: the application hands one in
 /// ([`MakeWindow`]), so that this module draws the window without knowing the
 /// viewer.
@@ -112,6 +127,7 @@ pub fn start_view(
     if let Some(e) = view.figure_error() {
         bail!("{e}");
     }
+    check_health(state, &runtime)?;
     Ok(img)
 }
 
@@ -170,6 +186,7 @@ pub fn start_ui(
         for b in &scene.brdfs {
             crate::views::albedo::curve_now(&scene, b);
         }
+        check_health(state, &runtime)?;
     }
     let img = off.start_render(frame, |ui| window.ui(ui))?;
     if let Some(e) = window.error() {

@@ -42,7 +42,7 @@ pub const MAX_NESTING: usize = 128;
 pub const MAX_OPERATORS: usize = 512;
 /// Most tokens the macro expander may read, copy or produce in all: a
 /// bound on its time and memory even where a macro expands to nothing.
-const MAX_WORK: usize = 1 << 22;
+const MAX_WORK: usize = 1 << 20;
 /// Deepest nesting of macro expansions (a macro is active at most once, so
 /// this is also a bound on a chain of aliases).
 const MAX_MACRO_DEPTH: usize = 4096;

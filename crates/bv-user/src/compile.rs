@@ -58,12 +58,34 @@ pub fn compile(text: &str, name: &str) -> Result<Compiled> {
     let mut sections = vec![&file.source];
     sections.extend(file.is_func.as_ref());
     crate::bounds::check(file.language, &sections, name)?;
-    let t: Translated = front::translate(&file, name)?;
-    front::check_signature(&t, &file, name)?;
-    safety::check(&t.module, name)?;
-    let module = port::renamed(&t, name)?;
-    let wgsl = port::emit(&module, name)?;
-    let sampler = crate::sampler::compile(&file, name)?;
+    // naga is a large compiler fed hostile text: should it panic on a file
+    // that passed the bounds, that file is refused, and bv goes on.
+    let compiled = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let t: Translated = front::translate(&file, name)?;
+        front::check_signature(&t, &file, name)?;
+        safety::check(&t.module, name)?;
+        let module = port::renamed(&t, name)?;
+        let wgsl = port::emit(&module, name)?;
+        let sampler = crate::sampler::compile(&file, name)?;
+        Ok((module, wgsl, sampler))
+    }));
+    let (module, wgsl, sampler) = match compiled {
+        Ok(result) => result?,
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("no message");
+            return Err(UserError::Model {
+                file: name.to_string(),
+                reason: format!(
+                    "the shader compiler (naga) failed on this file: {what}; please report it \
+                     with the file"
+                ),
+            });
+        }
+    };
     let decls: Vec<ParamDecl> = file.params.iter().map(|p| p.to_decl()).collect();
     Ok(Compiled {
         file,
