@@ -226,11 +226,11 @@ fn an_interrupted_save_leaves_the_old_file_intact() {
         .unwrap()
         .filter_map(|e| e.ok())
         .filter(|e| {
-            // Only this test's own temporaries: the killed-writer test in the
-            // same folder, running in parallel, cannot clean up after its
-            // child by design.
+            // Only this process's temporaries (`.bv-PID-XXXXXXXX.tmp`): the
+            // killed-writer test in the same folder, running in parallel,
+            // leaves its children's behind by design.
             let n = e.file_name().to_string_lossy().into_owned();
-            n.starts_with(".interrupted.toml.") && n.ends_with(".tmp")
+            n.starts_with(&format!(".bv-{}-", std::process::id())) && n.ends_with(".tmp")
         })
         .collect();
     assert!(leftovers.is_empty(), "{leftovers:?}");

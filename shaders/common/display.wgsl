@@ -29,7 +29,13 @@ fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
     return select(hi, lo, x <= vec3<f32>(0.0031308));
 }
 
+// Largest exposed value tone mapped as it is: every tone map shows it as
+// white already, and ACES squares its input, which overflows f32 (to
+// infinity, then NaN, drawn black) above about 1e19.
+const MAX_EXPOSED: f32 = 1e6;
+
 // Linear radiance to the encoded display value: × exposure, tone map, sRGB.
 fn display(radiance: vec3<f32>, exposure: f32, kind: u32) -> vec3<f32> {
-    return srgb_encode(tone_map(max(radiance, vec3<f32>(0.0)) * exposure, kind));
+    let x = min(max(radiance, vec3<f32>(0.0)) * exposure, vec3<f32>(MAX_EXPOSED));
+    return srgb_encode(tone_map(x, kind));
 }

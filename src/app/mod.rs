@@ -78,6 +78,13 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
             .iter()
             .map(|p| crate::cli::params::find_preset(p).with_context(|| format!("--preset {p}")))
             .collect::<anyhow::Result<Vec<_>>>()?;
+        let n = args.models.len() + presets.len();
+        if n > crate::session::state::MAX_BRDFS {
+            anyhow::bail!(
+                "{n} BRDFs (--model and --preset); a scene holds at most {}",
+                crate::session::state::MAX_BRDFS
+            );
+        }
         state.brdfs.clear();
         state.solo = None;
         for m in &args.models {

@@ -4,6 +4,7 @@
 
 use anyhow::{Context, bail};
 use bv_core::ModelSpec;
+use bv_core::error::quote;
 use bv_core::presets::{self, Preset};
 use std::sync::LazyLock;
 
@@ -80,12 +81,14 @@ pub fn find_preset(name: &str) -> anyhow::Result<&'static Preset> {
     if close.is_empty() {
         let all: Vec<&str> = SHIPPED.iter().map(|(_, p)| p.name.as_str()).collect();
         bail!(
-            "unknown preset `{name}`; the presets are: {}",
+            "unknown preset `{}`; the presets are: {}",
+            quote(name),
             all.join(", ")
         );
     }
     bail!(
-        "unknown preset `{name}`; close matches: {}",
+        "unknown preset `{}`; close matches: {}",
+        quote(name),
         close.join(", ")
     )
 }
@@ -139,7 +142,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 /// A preset's spec with `NAME=VALUE` strings applied on top (the same
 /// parsing and messages as [`spec_from_cli`]).
 pub fn preset_spec_from_cli(name: &str, params: &[String]) -> anyhow::Result<ModelSpec> {
-    let preset = find_preset(name).with_context(|| format!("--preset {name}"))?;
+    let preset = find_preset(name).with_context(|| format!("--preset {}", quote(name)))?;
     let mut spec = preset.spec.clone();
     apply_params(&mut spec, params)?;
     Ok(spec)
@@ -151,7 +154,8 @@ pub fn preset_spec_from_cli(name: &str, params: &[String]) -> anyhow::Result<Mod
 /// command line accepts exactly what scene files and `bv eval` accept, with the
 /// same messages naming the parameter and its range.
 pub fn spec_from_cli(model: &str, params: &[String]) -> anyhow::Result<ModelSpec> {
-    let mut spec = ModelSpec::new(model.trim()).with_context(|| format!("--model {model}"))?;
+    let mut spec =
+        ModelSpec::new(model.trim()).with_context(|| format!("--model {}", quote(model)))?;
     apply_params(&mut spec, params)?;
     Ok(spec)
 }
@@ -159,15 +163,17 @@ pub fn spec_from_cli(model: &str, params: &[String]) -> anyhow::Result<ModelSpec
 /// Sets `NAME=VALUE` strings on `spec`, naming the offending `--param`.
 fn apply_params(spec: &mut ModelSpec, params: &[String]) -> anyhow::Result<()> {
     for p in params {
+        // The option as messages quote it: a 100 KB value is not echoed whole.
+        let shown = quote(p);
         let Some((name, value)) = p.split_once('=') else {
-            bail!("--param {p}: expected NAME=VALUE (e.g. --param alpha=0.3)");
+            bail!("--param {shown}: expected NAME=VALUE (e.g. --param alpha=0.3)");
         };
         let name = name.trim();
         if name.is_empty() {
-            bail!("--param {p}: the parameter name is empty (expected NAME=VALUE)");
+            bail!("--param {shown}: the parameter name is empty (expected NAME=VALUE)");
         }
         spec.set_str(name, value.trim())
-            .with_context(|| format!("--param {p}"))?;
+            .with_context(|| format!("--param {shown}"))?;
     }
     Ok(())
 }
@@ -204,6 +210,20 @@ mod tests {
     fn errors_name_the_culprit() {
         let msg = |m: &str, p: &[&str]| format!("{:#}", spec_from_cli(m, &strings(p)).unwrap_err());
         assert!(msg("nope", &[]).contains("unknown model `nope`"));
+        // A huge value is quoted by its start and size, never whole.
+        for p in [
+            format!("albedo={}", "9".repeat(100_000)),
+            format!("albedo=x{}", "y".repeat(100_000)),
+            format!("{}=0.5", "q".repeat(100_000)),
+            "a".repeat(100_000),
+        ] {
+            let e = msg("lambert", &[p.as_str()]);
+            assert!(
+                e.len() < 600 && e.contains("bytes)"),
+                "{}",
+                &e[..e.len().min(600)]
+            );
+        }
         assert!(msg("lambert", &["albedo"]).contains("expected NAME=VALUE"));
         assert!(msg("lambert", &["=0.3"]).contains("name is empty"));
         let e = msg("lambert", &["albedo=2"]);

@@ -12,6 +12,7 @@ use crate::session::state::{AppState, Incident, Theme};
 use crate::session::views::ALIASES;
 use crate::views::{REGISTRY, ViewEntry};
 use anyhow::{Context as _, Result, bail};
+use bv_core::error::quote;
 use eframe::egui::Vec2;
 use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
@@ -169,7 +170,11 @@ pub fn views_for(name: &str) -> Result<Vec<&'static ViewEntry>> {
 pub fn state_for(a: &RenderArgs) -> Result<AppState> {
     let mut state = match &a.scene {
         Some(p) => {
-            let loaded = scene::load(p).with_context(|| format!("--scene {}", p.display()))?;
+            let loaded = scene::load(p).map_err(|e| match e {
+                // It names the file already.
+                scene::SceneError::File(e) => anyhow::anyhow!("--scene {e}"),
+                e => anyhow::Error::new(e).context(format!("--scene {}", p.display())),
+            })?;
             for w in &loaded.warnings {
                 super::output::eprint(&format!("bv render: {}: {w}\n", p.display()));
             }
@@ -237,21 +242,30 @@ enum Kind {
     Ply,
 }
 
-fn kind_of(path: &Path) -> Result<Kind> {
+/// The output kind `path`'s extension names, in any case (`X.PNG` is a
+/// PNG: a folder of that name would surprise everyone).
+fn ext_kind(path: &Path) -> Option<Kind> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    Ok(match ext.as_deref() {
-        Some("png") => Kind::Png,
-        Some("svg") => Kind::Svg,
-        Some("obj") => Kind::Obj,
-        Some("ply") => Kind::Ply,
-        _ => bail!(
+    match ext.as_deref() {
+        Some("png") => Some(Kind::Png),
+        Some("svg") => Some(Kind::Svg),
+        Some("obj") => Some(Kind::Obj),
+        Some("ply") => Some(Kind::Ply),
+        _ => None,
+    }
+}
+
+fn kind_of(path: &Path) -> Result<Kind> {
+    match ext_kind(path) {
+        Some(k) => Ok(k),
+        None => bail!(
             "--out {}: the extension picks the format: .png, .svg (2D plots), .obj or .ply (lobe mesh)",
             path.display()
         ),
-    })
+    }
 }
 
 /// A progress bar on stderr (a line per step when stderr is not a terminal).
@@ -350,7 +364,7 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
     }
 
     // --view all: a folder of PNGs (and SVGs).
-    if a.out.extension().is_some_and(|e| e == "png" || e == "svg") {
+    if matches!(ext_kind(&a.out), Some(Kind::Png | Kind::Svg)) {
         bail!(
             "--view all writes one file per view: --out must be a folder, not {}",
             a.out.display()
@@ -398,8 +412,11 @@ fn render_deck(
     [width, height]: [u32; 2],
     make: export::MakeSlide,
 ) -> Result<()> {
-    let loaded = deck::load(path, scene::Builds::Required)
-        .with_context(|| format!("--deck {}", path.display()))?;
+    let loaded = deck::load(path, scene::Builds::Required).map_err(|e| match e {
+        // It names the file already.
+        deck::DeckError::File(e) => anyhow::anyhow!("--deck {e}"),
+        e => anyhow::Error::new(e).context(format!("--deck {}", path.display())),
+    })?;
     for w in &loaded.warnings {
         super::output::eprint(&format!("bv render: {}: {w}\n", path.display()));
     }
@@ -418,7 +435,7 @@ fn render_deck(
             s.state.display.cosine = true;
         }
     }
-    if a.out.extension().is_some_and(|e| e == "png") {
+    if ext_kind(&a.out).is_some() {
         bail!(
             "--deck writes one PNG per scene: --out must be a folder, not {}",
             a.out.display()
@@ -449,10 +466,11 @@ fn render_deck(
         let file = a
             .out
             .join(format!("{:0digits$}-{}.png", i + 1, deck::slug(&s.title)));
+        let title = quote(&s.title);
         let img = export::render_ui(off, &s.state, frame, make(&d, i))
-            .with_context(|| format!("drawing scene {} (\"{}\")", i + 1, s.title))?;
+            .with_context(|| format!("drawing scene {} (\"{title}\")", i + 1))?;
         if export::is_blank(&img) {
-            bail!("scene {} (\"{}\") came out blank", i + 1, s.title);
+            bail!("scene {} (\"{title}\") came out blank", i + 1);
         }
         export::save_png(&img, &file)?;
         progress.step(i + 1, &file.display().to_string());

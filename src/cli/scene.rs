@@ -5,7 +5,7 @@
 use super::output::eprint;
 use crate::session::scene_file as scene;
 use crate::session::state::AppState;
-use anyhow::{Context as _, Result, bail};
+use anyhow::{Result, bail};
 use std::path::PathBuf;
 
 /// Options of `bv scene`.
@@ -97,11 +97,19 @@ fn summary(s: &AppState) -> String {
     )
 }
 
+/// Reads a scene file; the message names the file once.
+fn load(file: &std::path::Path) -> Result<scene::Loaded> {
+    scene::load(file).map_err(|e| match e {
+        scene::SceneError::File(e) => anyhow::Error::new(e),
+        e => anyhow::Error::new(e).context(file.display().to_string()),
+    })
+}
+
 /// Runs `bv scene`.
 pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
     match &a.action {
         SceneAction::Check { file } => {
-            let loaded = scene::load(file).with_context(|| format!("{}", file.display()))?;
+            let loaded = load(file)?;
             for w in &loaded.warnings {
                 eprint(&format!("bv scene: {}: warning: {w}\n", file.display()));
             }
@@ -114,7 +122,7 @@ pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
             ))
         }
         SceneAction::Print { file } => {
-            let loaded = scene::load(file).with_context(|| format!("{}", file.display()))?;
+            let loaded = load(file)?;
             for w in &loaded.warnings {
                 eprint(&format!("bv scene: {}: warning: {w}\n", file.display()));
             }

@@ -46,9 +46,15 @@ pub fn srgb_encode(c: f64) -> f64 {
     }
 }
 
+/// Largest exposed value tone mapped as it is (`MAX_EXPOSED` of
+/// display.wgsl: every tone map shows it as white, and ACES squares its
+/// input, which overflows f32 above about 1e19).
+pub const MAX_EXPOSED: f64 = 1e6;
+
 /// Linear radiance to the encoded display value (× exposure, tone map, sRGB).
 pub fn display(radiance: DVec3, exposure: f64, tone: ToneMap) -> DVec3 {
-    let t = tone.apply(radiance.max(DVec3::ZERO) * exposure);
+    let x = (radiance.max(DVec3::ZERO) * exposure).min(DVec3::splat(MAX_EXPOSED));
+    let t = tone.apply(x);
     DVec3::new(srgb_encode(t.x), srgb_encode(t.y), srgb_encode(t.z))
 }
 

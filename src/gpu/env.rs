@@ -129,6 +129,9 @@ struct EnvBuffers {
     size: (u32, u32),
     sampling: bool,
     generation: u64,
+    /// The map's [`EnvironmentMap::unit`]: the accumulated samples are in
+    /// this unit, and the display multiplies it back in with the exposure.
+    unit: f32,
 }
 
 /// What the accumulated samples belong to; any difference restarts them.
@@ -347,6 +350,7 @@ impl EnvRenderer {
             size: (map.width, map.height),
             sampling,
             generation,
+            unit: map.unit,
         })
     }
 
@@ -717,7 +721,9 @@ impl EnvRenderer {
             .map(|band| {
                 let u = ShowUniform {
                     size: [width as f32, height as f32],
-                    exposure: settings.exposure_ev.exp2() as f32,
+                    // In f64, then to f32: finite (the unit is at most 2⁸⁸,
+                    // the exposure 2¹²); the display clamps what overflows.
+                    exposure: (settings.exposure_ev.exp2() * f64::from(self.env.unit)) as f32,
                     tone: settings.tone_map.index(),
                     y0: band.y0,
                     pad: [0; 3],

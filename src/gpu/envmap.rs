@@ -17,13 +17,33 @@ pub struct EnvironmentMap {
     pub width: u32,
     /// Rows.
     pub height: u32,
-    /// Row-major radiance.
+    /// Row-major radiance, in units of [`EnvironmentMap::unit`].
     pub texels: Vec<[f32; 3]>,
+    /// The radiance of a texel value of 1: a power of two, 1 unless the
+    /// file's values are so large that rendering with them would overflow
+    /// f32 (see [`MAX_TEXEL`]); the renderer folds it into the exposure.
+    pub unit: f32,
 }
 
 /// Largest accepted side of a loaded map (a hostile header must not allocate
 /// gigabytes).
 pub const MAX_ENV_SIDE: u32 = 16384;
+
+/// Most texels of a loaded map (4096 × 2048, the usual "4k" panorama): more
+/// detail than the environment view draws, and about the 128 MiB that
+/// every wgpu device binds once uploaded (16 bytes a texel with its
+/// sampling tables: `EnvRenderer::upload`). Checked from the
+/// file's header, before anything is decoded (an 8192 × 4096 map took
+/// 1.2 GB to decode, only to be refused by the upload).
+pub const MAX_ENV_TEXELS: u64 = 1 << 23;
+
+/// Largest texel value kept as it is (2⁴⁰, about 10¹²: a thousand times an
+/// unclipped sun). Rendering multiplies radiance by BRDF values, divides by
+/// sampling densities and sums thousands of samples in f32; a map whose
+/// values reach f32's maximum overflowed to infinity and NaN and came out
+/// black. Such a map is stored divided by a power of two (exact) and
+/// [`EnvironmentMap::unit`] says by how much.
+pub const MAX_TEXEL: f32 = (1u64 << 40) as f32;
 
 impl EnvironmentMap {
     /// A constant environment (the white furnace when `c` is 1).
@@ -32,6 +52,7 @@ impl EnvironmentMap {
             width: 8,
             height: 4,
             texels: vec![c; 32],
+            unit: 1.0,
         }
     }
 
@@ -39,12 +60,27 @@ impl EnvironmentMap {
     /// file of at most [`bv_core::fsio::MAX_ENV_MAP_BYTES`] (a FIFO or a
     /// device is refused, not waited on).
     pub fn load(path: &Path) -> Result<Self> {
+        let name = path.display().to_string();
+        // The size from the header first: a map bv refuses is not read,
+        // let alone decoded. (A file handed in as bytes is checked by
+        // `decode`.)
+        if bv_core::fsio::provided(path).is_none() {
+            let (file, _) = bv_core::fsio::open_regular(
+                path,
+                bv_core::fsio::MAX_ENV_MAP_BYTES,
+                "an environment map",
+            )?;
+            let reader = image::ImageReader::new(std::io::BufReader::new(file))
+                .with_guessed_format()
+                .with_context(|| format!("reading {name}"))?;
+            check_size(reader, &name)?;
+        }
         let bytes = bv_core::fsio::read_capped(
             path,
             bv_core::fsio::MAX_ENV_MAP_BYTES,
             "an environment map",
         )?;
-        Self::decode(&bytes, &path.display().to_string())
+        Self::decode(&bytes, &name)
     }
 
     /// Writes the map as a Radiance `.hdr` file.
@@ -100,6 +136,7 @@ impl EnvironmentMap {
             width,
             height,
             texels,
+            unit: 1.0,
         }
     }
 
@@ -161,13 +198,9 @@ impl EnvironmentMap {
         let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
             .with_context(|| format!("reading {name}"))?;
-        let (w, h) = reader
-            .into_dimensions()
-            .with_context(|| format!("reading the size of {name}"))?;
-        if w == 0 || h == 0 || w > MAX_ENV_SIDE || h > MAX_ENV_SIDE {
-            bail!("{name}: {w}×{h} is not a usable environment (1..={MAX_ENV_SIDE} per side)");
-        }
+        check_size(reader, name)?;
         let img = image::load_from_memory(bytes)
+            .map_err(flat)
             .with_context(|| format!("decoding {name}"))?
             .into_rgb32f();
         let texels = img
@@ -177,15 +210,127 @@ impl EnvironmentMap {
                 [c[0], c[1], c[2]]
             })
             .collect();
-        Ok(Self {
+        let mut map = Self {
             width: img.width(),
             height: img.height(),
             texels,
-        })
+            unit: 1.0,
+        };
+        map.rescale();
+        Ok(map)
+    }
+
+    /// Divides the texels by the power of two that brings the largest to at
+    /// most [`MAX_TEXEL`], and records it in [`EnvironmentMap::unit`].
+    fn rescale(&mut self) {
+        let max = self
+            .texels
+            .iter()
+            .flatten()
+            .fold(0f32, |m, &x| if x > m { x } else { m });
+        if max <= MAX_TEXEL {
+            return;
+        }
+        // max ≤ f32::MAX < 2¹²⁸, so k ≤ 88 and 2^±k are exact f32 values.
+        let k = (f64::from(max) / f64::from(MAX_TEXEL)).log2().ceil() as i32;
+        let down = 2f32.powi(-k);
+        for t in &mut self.texels {
+            *t = t.map(|x| x * down);
+        }
+        self.unit = 2f32.powi(k);
     }
 
     /// The bundled studio ([`STUDIO_HDR`]).
     pub fn builtin_studio() -> Result<Self> {
         Self::decode(STUDIO_HDR, "the built-in studio.hdr")
+    }
+}
+
+/// Refuses a map whose header gives a size bv does not draw (see
+/// [`MAX_ENV_SIDE`], [`MAX_ENV_TEXELS`]), before any texel is decoded.
+fn check_size<R: std::io::BufRead + std::io::Seek>(
+    reader: image::ImageReader<R>,
+    name: &str,
+) -> Result<()> {
+    let (w, h) = reader
+        .into_dimensions()
+        .map_err(flat)
+        .with_context(|| format!("reading the size of {name}"))?;
+    if w == 0 || h == 0 || w > MAX_ENV_SIDE || h > MAX_ENV_SIDE {
+        bail!("{name}: {w}×{h} is not a usable environment (1..={MAX_ENV_SIDE} per side)");
+    }
+    let texels = u64::from(w) * u64::from(h);
+    if texels > MAX_ENV_TEXELS {
+        bail!(
+            "{name}: an environment map of {w}×{h} ({texels} texels) is over the limit of \
+             {MAX_ENV_TEXELS} texels (4096×2048); downscale it (the environment view draws \
+             less detail than that)"
+        );
+    }
+    Ok(())
+}
+
+/// An image error as one message: its `Display` already includes its
+/// cause, which `{:#}` would print a second time from `source()`.
+fn flat(e: image::ImageError) -> anyhow::Error {
+    anyhow::anyhow!("{e}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An OpenEXR file of `w × h` texels of `value` (RGB f32, in memory).
+    fn exr(w: u32, h: u32, value: f32) -> Vec<u8> {
+        let img = image::Rgb32FImage::from_pixel(w, h, image::Rgb([value; 3]));
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        image::DynamicImage::ImageRgb32F(img)
+            .write_to(&mut bytes, image::ImageFormat::OpenExr)
+            .unwrap();
+        bytes.into_inner()
+    }
+
+    #[test]
+    fn a_map_too_large_is_refused_from_its_header() {
+        let m = EnvironmentMap::decode(&exr(8, 4, 1.0), "small.exr").unwrap();
+        assert_eq!((m.width, m.height, m.unit), (8, 4, 1.0));
+        // A header claiming 33 M texels, with no texels after it: the size
+        // alone refuses it, so nothing is decoded.
+        let hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n";
+        let e = format!("{:#}", EnvironmentMap::decode(hdr, "big.hdr").unwrap_err());
+        assert!(
+            e.contains("8192×4096") && e.contains(&MAX_ENV_TEXELS.to_string()),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn decoding_errors_say_their_cause_once() {
+        let mut bytes = exr(8, 4, 1.0);
+        let n = bytes.len();
+        bytes.truncate(n - 16);
+        let e = format!(
+            "{:#}",
+            EnvironmentMap::decode(&bytes, "cut.exr").unwrap_err()
+        );
+        assert!(e.starts_with("decoding cut.exr: "), "{e}");
+        let cause = e.trim_start_matches("decoding cut.exr: ");
+        // No sentence of the cause appears twice.
+        for part in cause.split(": ").filter(|p| p.len() > 8) {
+            assert_eq!(e.matches(part).count(), 1, "{e}");
+        }
+    }
+
+    #[test]
+    fn a_map_near_the_largest_float_is_scaled_exactly() {
+        let bytes = exr(8, 4, f32::MAX);
+        let m = EnvironmentMap::decode(&bytes, "bright.exr").unwrap();
+        let t = m.texels[0][0];
+        assert!(t <= MAX_TEXEL && t > MAX_TEXEL / 2.0, "{t}");
+        assert_eq!(m.unit.log2().fract(), 0.0);
+        assert_eq!(f64::from(t) * f64::from(m.unit), f64::from(f32::MAX));
+        // An ordinary map is left alone.
+        let m = EnvironmentMap::decode(&exr(8, 4, 3.5), "sky.exr").unwrap();
+        assert_eq!((m.texels[5], m.unit), ([3.5; 3], 1.0));
     }
 }

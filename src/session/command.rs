@@ -122,6 +122,22 @@ impl Command {
     /// Applies the command to `state`.
     pub fn apply(self, state: &mut AppState) -> Applied {
         let mut out = Applied::default();
+        let adds = match &self {
+            Command::AddBrdf(_) | Command::AddSpec(_) | Command::AddNamed { .. } => true,
+            // A file that becomes a new BRDF (not one BRDF's new table).
+            Command::OpenFile { path, into } => {
+                super::user_models::is_file(path)
+                    || into
+                        .and_then(|id| state.entry(id))
+                        .and_then(|e| path_param(&e.spec))
+                        .is_none()
+            }
+            _ => false,
+        };
+        if adds && state.is_full() {
+            out.message = Some(AppState::full_message());
+            return out;
+        }
         match self {
             Command::AddBrdf(model) => match ModelSpec::new(&model) {
                 Ok(spec) => {
@@ -381,6 +397,44 @@ mod tests {
         let r = Command::AddBrdf("nope".into()).apply(&mut s);
         assert!(r.message.unwrap().contains("nope"));
         assert_eq!(s.brdfs.len(), 1);
+    }
+
+    #[test]
+    fn a_full_scene_refuses_another_brdf() {
+        use crate::session::state::MAX_BRDFS;
+        let mut s = AppState::default();
+        for _ in 0..MAX_BRDFS {
+            assert_eq!(
+                Command::AddBrdf("lambert".into()).apply(&mut s).message,
+                None
+            );
+        }
+        let spec = ModelSpec::new("ward").unwrap();
+        for c in [
+            Command::AddBrdf("lambert".into()),
+            Command::AddSpec(spec.clone()),
+            Command::AddNamed {
+                name: "Gold".into(),
+                spec,
+            },
+            Command::OpenFile {
+                path: "table.binary".into(),
+                into: None,
+            },
+        ] {
+            let r = c.apply(&mut s);
+            let m = r.message.unwrap();
+            assert!(m.contains(&format!("at most {MAX_BRDFS} BRDFs")), "{m}");
+            assert!(r.open.is_none());
+        }
+        assert_eq!(s.brdfs.len(), MAX_BRDFS);
+        // Removing one makes room again.
+        Command::RemoveBrdf(s.brdfs[0].id).apply(&mut s);
+        assert_eq!(
+            Command::AddBrdf("lambert".into()).apply(&mut s).message,
+            None
+        );
+        assert_eq!(s.brdfs.len(), MAX_BRDFS);
     }
 
     #[test]

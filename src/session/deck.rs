@@ -40,6 +40,7 @@
 
 use super::scene_file::{self as scene, Builds, SceneError};
 use super::state::AppState;
+use bv_core::error::quote;
 use bv_core::fsio;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -56,6 +57,16 @@ pub const END_MARKER: &str = "# end of bv deck";
 /// Largest deck file read: a deck of inline scenes is a few kB per scene.
 pub const MAX_DECK_BYTES: u64 = 4 * fsio::MAX_SCENE_BYTES;
 
+/// Most scenes in a deck: a long lecture has a few dozen. Every scene's
+/// BRDFs are built when the deck loads, so the count bounds the work.
+pub const MAX_SLIDES: usize = 200;
+
+/// Longest title or caption, in characters: a few lines' worth on a
+/// 1920-pixel slide. Laying text out costs hundreds of bytes per character
+/// (a 3 MB caption took 1.3 GB), and a slide's file name is made from its
+/// title.
+pub const MAX_TEXT_CHARS: usize = 1000;
+
 /// Why a deck could not be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum DeckError {
@@ -66,7 +77,7 @@ pub enum DeckError {
     #[error("not a valid deck file: {0}")]
     Syntax(String),
     /// A key of the deck's header has a value bv refuses.
-    #[error("bad value for `{key}`: {reason}")]
+    #[error("bad value for `{}`: {reason}", quote(.key))]
     Header {
         /// The key (`format`, `version`, `title`, `scene`).
         key: String,
@@ -74,7 +85,11 @@ pub enum DeckError {
         reason: String,
     },
     /// A key of one entry (or of its scene) has a value bv refuses.
-    #[error("scene[{entry}]{}: bad value for `{key}`: {reason}", titled(.title))]
+    #[error(
+        "scene[{entry}]{}: bad value for `{}`: {reason}",
+        titled(.title),
+        quote(.key)
+    )]
     Entry {
         /// The entry's index (0-based, as `scene[i]` in TOML tools).
         entry: usize,
@@ -106,7 +121,7 @@ pub enum DeckError {
 fn titled(title: &Option<String>) -> String {
     title
         .as_deref()
-        .map(|t| format!(" (\"{t}\")"))
+        .map(|t| format!(" (\"{}\")", quote(t)))
         .unwrap_or_default()
 }
 
@@ -260,6 +275,16 @@ pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
             "expected a non-empty array of tables ([[scene]])".into(),
         ));
     };
+    if items.len() > MAX_SLIDES {
+        return Err(header(
+            "scene",
+            format!(
+                "{} scenes; a deck holds at most {MAX_SLIDES} (split the lecture into \
+                 several decks)",
+                items.len()
+            ),
+        ));
+    }
     let mut deck = Deck {
         title,
         slides: Vec::with_capacity(items.len()),
@@ -317,12 +342,13 @@ fn entry(
         return Err(bad(
             "view",
             format!(
-                "no view `{view_name}` in this bv (views: {})",
+                "no view `{}` in this bv (views: {})",
+                quote(&view_name),
                 super::views::id_list()
             ),
         ));
     };
-    let prefix = format!("scene[{i}] (\"{title_text}\")");
+    let prefix = format!("scene[{i}] (\"{}\")", quote(&title_text));
     let (loaded, source) = match (t.get("file"), t.get("state")) {
         (Some(_), Some(_)) => {
             return Err(bad(
@@ -340,11 +366,17 @@ fn entry(
         }
         (Some(f), None) => {
             let Some(rel) = f.as_str().filter(|s| !s.trim().is_empty()) else {
-                return Err(bad("file", format!("expected a path, found {f}")));
+                return Err(bad(
+                    "file",
+                    format!("expected a path, found {}", quote(&f.to_string())),
+                ));
             };
             let path = resolve(base, rel);
-            let loaded = scene::load_with(&path, builds)
-                .map_err(|e| bad("file", format!("{}: {e}", path.display())))?;
+            let loaded = scene::load_with(&path, builds).map_err(|e| match e {
+                // The file's own errors name the path already.
+                SceneError::File(_) => bad("file", e.to_string()),
+                other => bad("file", format!("{}: {other}", path.display())),
+            })?;
             (
                 loaded,
                 Source::File {
@@ -388,11 +420,19 @@ fn entry(
     })
 }
 
+/// A title or caption: one line of at most [`MAX_TEXT_CHARS`] characters.
 fn one_line(v: &toml::Value) -> Result<String, String> {
     match v.as_str() {
         Some(s) if s.contains(['\n', '\r']) => Err("expected one line of text".into()),
+        Some(s) if s.chars().nth(MAX_TEXT_CHARS).is_some() => Err(format!(
+            "{} characters; at most {MAX_TEXT_CHARS} (a title or caption is a line on a slide)",
+            s.chars().count()
+        )),
         Some(s) => Ok(s.to_string()),
-        None => Err(format!("expected a string, found {v}")),
+        None => Err(format!(
+            "expected a string, found {}",
+            quote(&v.to_string())
+        )),
     }
 }
 
@@ -513,11 +553,27 @@ pub fn save(path: &Path, deck: &mut Deck) -> Result<(), DeckError> {
     Ok(())
 }
 
+/// Longest [`slug`], in bytes: slide files are `NNN-slug.png`, and a file
+/// name has at most 255 bytes (a title may have [`MAX_TEXT_CHARS`]).
+pub const MAX_SLUG_BYTES: usize = 80;
+
 /// A file-name-safe form of a title: lower-case ASCII letters and digits,
-/// anything else one `-` ("Cook-Torrance: D" → "cook-torrance-d").
+/// anything else one `-` ("Cook-Torrance: D" → "cook-torrance-d"), at most
+/// [`MAX_SLUG_BYTES`] long (cut at a word's end where there is one).
 pub fn slug(title: &str) -> String {
     let mut out = String::new();
     for c in title.chars() {
+        if out.len() >= MAX_SLUG_BYTES {
+            // One more character says whether the cut falls inside a word.
+            if c.is_ascii_alphanumeric()
+                && out.ends_with(|c: char| c.is_ascii_alphanumeric())
+                && let Some(end) = out.rfind('-')
+            {
+                out.truncate(end);
+            }
+            out.truncate(MAX_SLUG_BYTES);
+            break;
+        }
         if c.is_ascii_alphanumeric() {
             out.push(c.to_ascii_lowercase());
         } else if !out.ends_with('-') && !out.is_empty() {
@@ -773,5 +829,20 @@ mod tests {
         );
         assert_eq!(slug("Snell & TIR"), "snell-tir");
         assert_eq!(slug("ρ…"), "scene");
+        // Long titles: cut at a word's end, never longer than the limit.
+        let long = "Anisotropic microfacet reflection ".repeat(10);
+        let s = slug(&long);
+        assert!(
+            s.len() <= MAX_SLUG_BYTES && s.len() > MAX_SLUG_BYTES / 2,
+            "{s}"
+        );
+        assert!(
+            long.to_lowercase()
+                .replace(' ', "-")
+                .starts_with(&format!("{s}-")),
+            "{s}"
+        );
+        assert_eq!(slug(&"x".repeat(300)), "x".repeat(MAX_SLUG_BYTES));
+        assert_eq!(slug(&"ab ".repeat(300)), "ab-".repeat(26) + "ab");
     }
 }

@@ -45,7 +45,11 @@
 //! read-only files are refused, and a symlink is written through
 //! ([`fsio::write_atomic`]).
 
-use super::state::{AppState, BrdfEntry, Camera, Display, Incident, STATE_VERSION, SnellSettings};
+use super::command::MAX_NAME_CHARS;
+use super::state::{
+    AppState, BrdfEntry, Camera, Display, Incident, MAX_BRDFS, STATE_VERSION, SnellSettings,
+};
+use bv_core::error::quote;
 use bv_core::fsio;
 
 use serde::Deserialize;
@@ -73,7 +77,7 @@ pub enum SceneError {
     #[error("not a valid scene file: {0}")]
     Syntax(String),
     /// A key has a value bv refuses.
-    #[error("bad value for `{key}`: {reason}")]
+    #[error("bad value for `{}`: {reason}", quote(.key))]
     BadValue {
         /// Dotted path of the key (`incident.theta_deg`, `brdfs[2].spec`).
         key: String,
@@ -227,6 +231,17 @@ fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
                 reason: "expected an array of tables ([[brdfs]])".into(),
             });
         };
+        // Before any is built: building and drawing cost per BRDF.
+        if items.len() > MAX_BRDFS {
+            return Err(SceneError::BadValue {
+                key: "brdfs".into(),
+                reason: format!(
+                    "{} BRDFs; a scene holds at most {MAX_BRDFS} (a figure with more \
+                     curves cannot be read; split it into several scenes)",
+                    items.len()
+                ),
+            });
+        }
         let mut ids = std::collections::HashSet::new();
         for (i, item) in items.iter().enumerate() {
             let key = format!("brdfs[{i}]");
@@ -251,7 +266,10 @@ fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
                 }
             })?;
             for u in unknown {
-                warnings.push(format!("unknown key `{key}.{u}` ignored"));
+                warnings.push(format!(
+                    "unknown key `{}` ignored",
+                    quote(&format!("{key}.{u}"))
+                ));
             }
             if !ids.insert(entry.id) {
                 return Err(SceneError::BadValue {
@@ -272,9 +290,24 @@ fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
         if key == "format" || key == "generator" {
             continue;
         }
-        warnings.push(format!("unknown key `{key}` ignored"));
+        warnings.push(format!("unknown key `{}` ignored", quote(&key)));
     }
 
+    // A name is a legend entry: one longer than the window lets a user type
+    // is cut to that length, with a warning.
+    for (i, b) in state.brdfs.iter_mut().enumerate() {
+        if let Some(name) = &mut b.name
+            && let Some((cut, _)) = name.char_indices().nth(MAX_NAME_CHARS)
+        {
+            warnings.push(format!(
+                "`brdfs[{i}].name` has {} characters; a name has at most {MAX_NAME_CHARS}, \
+                 so it is cut to \"{}\"",
+                name.chars().count(),
+                &name[..cut]
+            ));
+            name.truncate(cut);
+        }
+    }
     validate(&state, &mut warnings)?;
     if let Some(base) = base {
         map_paths(&mut state, &|p| resolve_in(base, p));
@@ -510,7 +543,8 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         && super::views::info(v).is_none()
     {
         warnings.push(format!(
-            "`maximised = \"{v}\"`: no such view in this bv (views: {}); showing all views",
+            "`maximised = \"{}\"`: no such view in this bv (views: {}); showing all views",
+            quote(v),
             super::views::id_list()
         ));
     }

@@ -29,6 +29,13 @@ pub const PALETTE: [[u8; 3]; 10] = [
     [186, 176, 172], // grey
 ];
 
+/// Most BRDFs in one scene. Every view draws every BRDF (the lobe view
+/// keeps a mesh per BRDF: a scene of 100 took 1.36 GB to draw at 400×300),
+/// the palette has ten colours and a legend room for about as many; a figure
+/// with more curves than this cannot be read. Scene files, decks, the
+/// command line and the window's "add" all stop here.
+pub const MAX_BRDFS: usize = 16;
+
 /// One loaded BRDF.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BrdfEntry {
@@ -366,6 +373,17 @@ impl AppState {
         s
     }
 
+    /// Whether the scene holds [`MAX_BRDFS`] BRDFs already (the window
+    /// refuses to add another, with [`AppState::full_message`]).
+    pub fn is_full(&self) -> bool {
+        self.brdfs.len() >= MAX_BRDFS
+    }
+
+    /// Why a BRDF cannot be added to a full scene.
+    pub fn full_message() -> String {
+        format!("a scene holds at most {MAX_BRDFS} BRDFs; remove one before adding another")
+    }
+
     /// Adds a BRDF with the first palette colour not in use; selects it and
     /// returns its id.
     pub fn add(&mut self, spec: ModelSpec) -> u64 {
@@ -422,6 +440,8 @@ impl AppState {
     pub fn sanitised(mut self) -> Self {
         let mut seen = std::collections::HashSet::new();
         self.brdfs.retain(|b| seen.insert(b.id));
+        // A stored session from before the limit (scene files refuse more).
+        self.brdfs.truncate(MAX_BRDFS);
         let max_id = self.brdfs.iter().map(|b| b.id).max().unwrap_or(0);
         self.next_id = self.next_id.max(max_id + 1);
         if self.selected.is_none_or(|id| self.entry(id).is_none()) {

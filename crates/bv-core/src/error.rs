@@ -7,7 +7,7 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum BvError {
     /// The model id is not in the catalogue.
-    #[error("unknown model `{id}` (known models: {known})")]
+    #[error("unknown model `{}` (known models: {known})", quote(.id))]
     UnknownModel {
         /// The id that was asked for.
         id: String,
@@ -15,7 +15,10 @@ pub enum BvError {
         known: String,
     },
     /// A parameter name that the model does not declare.
-    #[error("model `{model}` has no parameter `{param}` (its parameters: {known})")]
+    #[error(
+        "model `{model}` has no parameter `{}` (its parameters: {known})",
+        quote(.param)
+    )]
     UnknownParam {
         /// Model id.
         model: String,
@@ -26,7 +29,8 @@ pub enum BvError {
     },
     /// A numeric value outside the declared range.
     #[error(
-        "parameter `{param}` = {} is out of range [{}, {}]",
+        "parameter `{}` = {} is out of range [{}, {}]",
+        quote(.param),
         fmt_num(*.value),
         fmt_num(*.min),
         fmt_num(*.max)
@@ -42,7 +46,7 @@ pub enum BvError {
         max: f64,
     },
     /// A value of the wrong shape (e.g. text for a number, four colour channels).
-    #[error("parameter `{param}`: {reason}")]
+    #[error("parameter `{}`: {reason}", quote(.param))]
     BadValue {
         /// Parameter name.
         param: String,
@@ -73,6 +77,20 @@ pub enum BvError {
 /// Result alias used across the core.
 pub type Result<T, E = BvError> = std::result::Result<T, E>;
 
+/// Most characters of a user's input that a message quotes.
+pub const QUOTE_CHARS: usize = 60;
+
+/// `text` as a message quotes it: whole when it is short, else its first
+/// [`QUOTE_CHARS`] characters, `…` and its size (`aaaa… (102400 bytes)`), so
+/// that a mistyped 100 KB value is not echoed back whole (a terminal, a log
+/// or a status line has no room for it, and the start says which it was).
+pub fn quote(text: &str) -> std::borrow::Cow<'_, str> {
+    match text.char_indices().nth(QUOTE_CHARS) {
+        None => std::borrow::Cow::Borrowed(text),
+        Some((cut, _)) => format!("{}… ({} bytes)", &text[..cut], text.len()).into(),
+    }
+}
+
 /// A number for messages: the shortest digits that read back as `x`, in
 /// exponent form when very large or very small (`1e300`, not 301 digits).
 pub fn fmt_num(x: f64) -> String {
@@ -87,6 +105,23 @@ pub fn fmt_num(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_input_is_quoted_short() {
+        assert_eq!(quote("alpha"), "alpha");
+        let exact = "x".repeat(QUOTE_CHARS);
+        assert_eq!(quote(&exact), exact);
+        let long = "é".repeat(100_000);
+        let q = quote(&long);
+        assert_eq!(q, format!("{}… (200000 bytes)", "é".repeat(QUOTE_CHARS)));
+        let e = BvError::UnknownParam {
+            model: "lambert".into(),
+            param: "p".repeat(100_000),
+            known: "albedo".into(),
+        }
+        .to_string();
+        assert!(e.len() < 200 && e.contains("(100000 bytes)"), "{e}");
+    }
 
     #[test]
     fn numbers_in_messages_are_short() {

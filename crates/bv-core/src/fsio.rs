@@ -17,6 +17,11 @@
 //! `O_EXCL`, never over an existing file), are synced, and the temporary is
 //! renamed over the target: readers see the old file or the whole new one,
 //! and a failed write (full disk, killed process) leaves the old file intact.
+//! The temporary's name is short (`.bv-PID-XXXXXXXX.tmp`), so it fits beside
+//! a target name of any legal length, and names its process: a process
+//! killed while writing (`kill -9`) leaves its temporary behind, and the next
+//! save into that folder removes it once its process is gone and it has not
+//! changed for a minute (never the file of a writer that is still alive).
 //! Before anything is written the target is checked:
 //! - a symlink is written **through**: its final target is replaced and the
 //!   link stays a link (a dangling link is refused, nothing is created at
@@ -440,14 +445,135 @@ pub fn write_atomic(
     Ok(())
 }
 
-/// A new temporary file beside the target, never over an existing file.
+/// The start and end of bv's temporary names (`.bv-PID-XXXXXXXX.tmp`).
+const TEMP_PREFIX: &str = ".bv-";
+const TEMP_SUFFIX: &str = ".tmp";
+
+/// How long a temporary must have been left untouched, besides its process
+/// being gone, before another save removes it. bv's writers hand over bytes
+/// they have already computed, so a live writer's temporary is always
+/// fresher than this, even one of a process this one cannot see (another
+/// container sharing the folder, whose process ids mean nothing here).
+const STALE_AFTER: std::time::Duration = std::time::Duration::from_secs(60);
+
+/// A temporary this old is removed even when a process with its number is
+/// alive (the number was reused by a process that has nothing to do with it).
+const ABANDONED_AFTER: std::time::Duration = std::time::Duration::from_secs(24 * 60 * 60);
+
+/// The name of a temporary of this process: short, so that it fits beside
+/// any legal target name (a name of 255 bytes, the longest most file systems
+/// allow, cannot have anything added to it), and carrying the process id,
+/// so that a later save can tell a killed writer's leftover from a live
+/// writer's file.
+fn temp_name(pid: u32, nonce: u32) -> String {
+    format!("{TEMP_PREFIX}{pid}-{nonce:08x}{TEMP_SUFFIX}")
+}
+
+/// The process id in `name`, if it is a temporary of bv's: the present
+/// pattern, or the one older versions used (`.TARGET.PID.N.tmp`) for the
+/// target `target`.
+fn temp_owner(name: &str, target: &str) -> Option<u32> {
+    let core = name.strip_suffix(TEMP_SUFFIX)?;
+    if let Some(rest) = core.strip_prefix(TEMP_PREFIX)
+        && let Some((pid, nonce)) = rest.split_once('-')
+        && nonce.len() == 8
+        && nonce.bytes().all(|b| b.is_ascii_hexdigit())
+        && !pid.is_empty()
+        && pid.bytes().all(|b| b.is_ascii_digit())
+    {
+        return pid.parse().ok();
+    }
+    // Older versions: `.{target}.{pid}.{n}.tmp`, only for the file being
+    // saved (another name of that shape may be someone else's).
+    let rest = core
+        .strip_prefix('.')?
+        .strip_prefix(target)?
+        .strip_prefix('.')?;
+    let (pid, n) = rest.split_once('.')?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    if !(digits(pid) && digits(n)) {
+        return None;
+    }
+    pid.parse().ok()
+}
+
+/// Whether a process `pid` may be running (true when that cannot be told).
+fn process_alive(pid: u32) -> bool {
+    if pid == std::process::id() {
+        return true;
+    }
+    #[cfg(unix)]
+    {
+        let Ok(pid) = libc::pid_t::try_from(pid) else {
+            return false;
+        };
+        if pid <= 0 {
+            return false;
+        }
+        // SAFETY: signal 0 sends nothing; it only asks whether `pid` exists.
+        if unsafe { libc::kill(pid, 0) } == 0 {
+            return true;
+        }
+        // EPERM: it exists but belongs to another user.
+        io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+    #[cfg(not(unix))]
+    {
+        true
+    }
+}
+
+/// Removes the temporaries of bv's pattern in `dir` that a killed writer
+/// left (its process is gone and the file has not been touched for
+/// [`STALE_AFTER`], or it is older than [`ABANDONED_AFTER`]); `target` is
+/// the name being saved (for the older pattern). Never a live writer's file:
+/// best effort, errors are ignored. Returns how many were removed.
+fn remove_stale_temps(dir: &Path, target: &str) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    let now = std::time::SystemTime::now();
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(|n| temp_owner(n, target)) else {
+            continue;
+        };
+        // `DirEntry::metadata` does not follow symlinks: only regular files.
+        let Ok(m) = entry.metadata() else { continue };
+        if !m.file_type().is_file() {
+            continue;
+        }
+        let Some(age) = m.modified().ok().and_then(|t| now.duration_since(t).ok()) else {
+            continue;
+        };
+        let stale = (age >= STALE_AFTER && !process_alive(pid)) || age >= ABANDONED_AFTER;
+        if stale && std::fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// A new temporary file beside the target, never over an existing file
+/// (named by [`temp_name`]); stale temporaries of bv's in the folder are
+/// removed first ([`remove_stale_temps`]), which also frees their space
+/// for this write.
 fn create_temp(dir: &Path, name: &str, existing: Option<&Metadata>) -> io::Result<(PathBuf, File)> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    use std::sync::atomic::{AtomicU32, Ordering};
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    remove_stale_temps(dir, name);
+    let pid = std::process::id();
+    // Different in every call and every process start; `create_new` makes
+    // a clash harmless (the next nonce is tried).
+    let seed = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
     let mut last = io::Error::other("no temporary name was free");
     for _ in 0..100 {
         let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
+        let nonce = seed ^ n.wrapping_mul(0x9e37_79b9);
+        let tmp = dir.join(temp_name(pid, nonce));
         let mut opts = std::fs::OpenOptions::new();
         opts.write(true).create_new(true);
         #[cfg(unix)]
@@ -624,6 +750,109 @@ mod tests {
         assert!(e.contains("disk on fire"), "{e}");
         assert_eq!(std::fs::read(&f).unwrap(), b"old");
         assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_target_name_of_the_longest_legal_length_is_written() {
+        // 255 bytes is NAME_MAX on Linux and macOS: the temporary's name
+        // must not grow with the target's.
+        let d = temp_dir("long-name");
+        let f = d.join("n".repeat(251) + ".png");
+        assert_eq!(f.file_name().unwrap().len(), 255);
+        write_bytes(&f, b"first").unwrap();
+        write_bytes(&f, b"second").unwrap();
+        assert_eq!(std::fs::read(&f).unwrap(), b"second");
+        assert_eq!(std::fs::read_dir(&d).unwrap().count(), 1);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn temporary_names_are_recognised() {
+        let name = temp_name(1234, 0xdead_beef);
+        assert_eq!(name, ".bv-1234-deadbeef.tmp");
+        assert_eq!(temp_owner(&name, "x.png"), Some(1234));
+        assert_eq!(temp_owner(".x.png.77.3.tmp", "x.png"), Some(77));
+        // The older pattern only for the file being saved; nothing else.
+        for other in [
+            ".y.png.77.3.tmp",
+            ".bv-1234-deadbee.tmp",
+            ".bv-notes.tmp",
+            ".bv--deadbeef.tmp",
+            ".bv-12a-deadbeef.tmp",
+            "bv-1234-deadbeef.tmp",
+            ".bv-1234-deadbeef.tmp.png",
+            ".x.png.77.tmp",
+        ] {
+            assert_eq!(temp_owner(other, "x.png"), None, "{other}");
+        }
+    }
+
+    /// Makes `path` (a file) look `secs` seconds old.
+    fn age(path: &Path, secs: u64) {
+        let t = std::time::SystemTime::now() - std::time::Duration::from_secs(secs);
+        File::options()
+            .write(true)
+            .open(path)
+            .unwrap()
+            .set_modified(t)
+            .unwrap();
+    }
+
+    #[test]
+    fn a_save_removes_stale_temporaries_and_keeps_live_ones() {
+        let d = temp_dir("stale");
+        // No process has this number (above every kernel's pid_max).
+        let gone = i32::MAX as u32;
+        let me = std::process::id();
+        let stale = d.join(temp_name(gone, 1));
+        let stale_old_pattern = d.join(format!(".x.png.{gone}.0.tmp"));
+        let fresh_of_gone = d.join(temp_name(gone, 2));
+        let old_but_alive = d.join(temp_name(me, 3));
+        let abandoned = d.join(temp_name(me, 4));
+        let old_pattern_other = d.join(format!(".y.png.{gone}.0.tmp"));
+        let users_file = d.join(".bv-notes.tmp");
+        for p in [
+            &stale,
+            &stale_old_pattern,
+            &fresh_of_gone,
+            &old_but_alive,
+            &abandoned,
+            &old_pattern_other,
+            &users_file,
+        ] {
+            std::fs::write(p, b"left over").unwrap();
+        }
+        for p in [
+            &stale,
+            &stale_old_pattern,
+            &old_but_alive,
+            &old_pattern_other,
+            &users_file,
+        ] {
+            age(p, 120);
+        }
+        age(&abandoned, 2 * 24 * 60 * 60);
+        // A folder with the pattern's name is not a temporary.
+        let folder = d.join(temp_name(gone, 5));
+        std::fs::create_dir(&folder).unwrap();
+
+        write_bytes(&d.join("x.png"), b"new").unwrap();
+        for (p, kept) in [
+            (&stale, false),
+            (&stale_old_pattern, false),
+            (&abandoned, false),
+            // Still being written, as far as anyone can tell.
+            (&fresh_of_gone, true),
+            // Its writer (this process) is alive.
+            (&old_but_alive, true),
+            (&old_pattern_other, true),
+            (&users_file, true),
+            (&folder, true),
+        ] {
+            assert_eq!(p.exists(), kept, "{}", p.display());
+        }
+        assert_eq!(std::fs::read(d.join("x.png")).unwrap(), b"new");
         std::fs::remove_dir_all(&d).unwrap();
     }
 

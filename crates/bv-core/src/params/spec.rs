@@ -7,6 +7,7 @@
 use super::MAX_NESTING;
 use super::decl::{ParamDecl, ParamKind};
 use super::value::{Component, ModelSpec, ParamValue, Params, json_number};
+use crate::error::quote;
 use crate::{BvError, Result, registry};
 use serde_json::{Map, Value};
 
@@ -167,7 +168,11 @@ pub fn check_value(decl: &ParamDecl, v: ParamValue, depth: usize) -> Result<Para
             if options.contains(&t.as_str()) {
                 Ok(ParamValue::Text(t))
             } else {
-                Err(bad(format!("`{t}` is not one of {}", options.join(", "))))
+                Err(bad(format!(
+                    "`{}` is not one of {}",
+                    quote(&t),
+                    options.join(", ")
+                )))
             }
         }
         (ParamKind::Bool { .. }, ParamValue::Bool(b)) => Ok(ParamValue::Bool(b)),
@@ -236,7 +241,7 @@ pub fn check_value(decl: &ParamDecl, v: ParamValue, depth: usize) -> Result<Para
         (_, other) => Err(bad(format!(
             "expected {}, found {}",
             decl.range_text(),
-            other.to_json()
+            quote(&other.to_json().to_string())
         ))),
     }
 }
@@ -271,9 +276,9 @@ pub fn cli_text_to_json(decl: &ParamDecl, text: &str) -> Result<Value> {
         let x: f64 = s
             .trim()
             .parse()
-            .map_err(|_| bad(format!("`{s}` is not a number")))?;
+            .map_err(|_| bad(format!("`{}` is not a number", quote(s))))?;
         if !x.is_finite() {
-            return Err(bad(format!("`{s}` is not a finite number")));
+            return Err(bad(format!("`{}` is not a finite number", quote(s))));
         }
         Ok(json_number(x))
     };
@@ -293,7 +298,7 @@ pub fn cli_text_to_json(decl: &ParamDecl, text: &str) -> Result<Value> {
         ParamKind::Bool { .. } => match text.trim() {
             "true" | "1" | "yes" | "on" => Ok(Value::Bool(true)),
             "false" | "0" | "no" | "off" => Ok(Value::Bool(false)),
-            other => Err(bad(format!("`{other}` is not true or false"))),
+            other => Err(bad(format!("`{}` is not true or false", quote(other)))),
         },
         ParamKind::List { .. } | ParamKind::Components { .. } => {
             serde_json::from_str(text).map_err(|e| bad(format!("expected a JSON list ({e})")))
@@ -322,7 +327,7 @@ fn check_range(id: &str, x: f64, min: f64, max: f64) -> Result<f64> {
 fn as_f64(id: &str, v: &Value) -> Result<f64> {
     v.as_f64().ok_or_else(|| BvError::BadValue {
         param: id.to_string(),
-        reason: format!("expected a number, found {v}"),
+        reason: format!("expected a number, found {}", quote(&v.to_string())),
     })
 }
 
@@ -358,23 +363,38 @@ pub fn parse_value(decl: &ParamDecl, v: &Value, depth: usize) -> Result<ParamVal
             Ok(ParamValue::Color(c))
         }
         ParamKind::Choice { options, .. } => {
-            let s = v
-                .as_str()
-                .ok_or_else(|| bad(format!("expected one of {}, found {v}", options.join(", "))))?;
+            let s = v.as_str().ok_or_else(|| {
+                bad(format!(
+                    "expected one of {}, found {}",
+                    options.join(", "),
+                    quote(&v.to_string())
+                ))
+            })?;
             if options.contains(&s) {
                 Ok(ParamValue::Text(s.to_string()))
             } else {
-                Err(bad(format!("`{s}` is not one of {}", options.join(", "))))
+                Err(bad(format!(
+                    "`{}` is not one of {}",
+                    quote(s),
+                    options.join(", ")
+                )))
             }
         }
-        ParamKind::Bool { .. } => v
-            .as_bool()
-            .map(ParamValue::Bool)
-            .ok_or_else(|| bad(format!("expected true or false, found {v}"))),
+        ParamKind::Bool { .. } => v.as_bool().map(ParamValue::Bool).ok_or_else(|| {
+            bad(format!(
+                "expected true or false, found {}",
+                quote(&v.to_string())
+            ))
+        }),
         ParamKind::Path { .. } => v
             .as_str()
             .map(|s| ParamValue::Text(s.to_string()))
-            .ok_or_else(|| bad(format!("expected a path string, found {v}"))),
+            .ok_or_else(|| {
+                bad(format!(
+                    "expected a path string, found {}",
+                    quote(&v.to_string())
+                ))
+            }),
         ParamKind::List {
             fields,
             min_items,
@@ -383,7 +403,7 @@ pub fn parse_value(decl: &ParamDecl, v: &Value, depth: usize) -> Result<ParamVal
         } => {
             let items = v
                 .as_array()
-                .ok_or_else(|| bad(format!("expected a list, found {v}")))?;
+                .ok_or_else(|| bad(format!("expected a list, found {}", quote(&v.to_string()))))?;
             if items.len() < min_items || items.len() > max_items {
                 return Err(bad(format!(
                     "has {} items; between {min_items} and {max_items} are accepted",
@@ -417,9 +437,12 @@ pub fn parse_value(decl: &ParamDecl, v: &Value, depth: usize) -> Result<ParamVal
             if depth >= MAX_NESTING {
                 return Err(bad(format!("mixes nest deeper than {MAX_NESTING} levels")));
             }
-            let items = v
-                .as_array()
-                .ok_or_else(|| bad(format!("expected a list of components, found {v}")))?;
+            let items = v.as_array().ok_or_else(|| {
+                bad(format!(
+                    "expected a list of components, found {}",
+                    quote(&v.to_string())
+                ))
+            })?;
             if items.is_empty() || items.len() > max_items {
                 return Err(bad(format!(
                     "has {} components; between 1 and {max_items} are accepted",
