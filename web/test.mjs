@@ -671,6 +671,19 @@ async function openFileChecks(context, gl, toml) {
     "a dropped MERL table");
   await opened("phong.brdf", [{ name: "phong.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
     "a dropped .brdf model");
+  // Hostile .brdf files (tests/data/brdf/hostile/: a 7,000-term sum that
+  // overflowed the stack, macros that double 40 times, a shader that loops
+  // away from the normal) are refused with their reason, each within
+  // seconds, and the page goes on: the next good file still opens.
+  for (const name of ["long_sum.brdf", "doubling_defines.brdf", "loop_away_from_normal.brdf"]) {
+    const bytes = fs.readFileSync(path.join(here, "..", "tests", "data", "brdf", "hostile", name));
+    const n = brdfs();
+    await drop(p.page, [{ name, base64: bytes.toString("base64") }]);
+    const refused = await waitLog(p, (l) => l.startsWith(`bv: could not open ${name}`), 15_000);
+    check(!!refused && brdfs() === n, `a dropped hostile ${name} is refused${refused ? `: ${refused.slice(0, 160)}` : " (no message in 15 s)"}`);
+  }
+  await opened("phong2.brdf", [{ name: "phong2.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
+    "a .brdf model dropped after the hostile ones");
   {
     const hdr = fs.readFileSync(path.join(here, "..", "assets", "studio.hdr"));
     await drop(p.page, [{ name: "studio.hdr", base64: hdr.toString("base64") }]);
