@@ -143,6 +143,8 @@ struct WebApp {
     /// they change).
     reported_brdfs: usize,
     reported_errors: usize,
+    /// The status line last told to the console.
+    reported_status: Option<String>,
 }
 
 /// A dropped file's name and its bytes, or why they could not be read.
@@ -228,6 +230,7 @@ impl WebApp {
             reads: Vec::new(),
             reported_brdfs: 0,
             reported_errors: 0,
+            reported_status: None,
         }
     }
 
@@ -358,7 +361,8 @@ impl WebApp {
     }
 
     /// Tells the console when the number of BRDFs or of files that could not
-    /// be opened changes (what a test driver waits for after a drop).
+    /// be opened changes, and the status line (what a test driver waits for
+    /// after a drop).
     fn report(&mut self) {
         let n = self.inner.viewer.state().brdfs.len();
         if n != self.reported_brdfs {
@@ -372,6 +376,15 @@ impl WebApp {
             }
         }
         self.reported_errors = errors.len();
+        // A refused file (a `.brdf` that does not compile, or one past a
+        // limit) is said on the status line.
+        let status = self.inner.viewer.status().map(str::to_string);
+        if status != self.reported_status {
+            if let Some(s) = &status {
+                info(&format!("status: {s}"));
+            }
+            self.reported_status = status;
+        }
     }
 
     fn save_scene(&mut self) {
