@@ -431,6 +431,8 @@ pub fn write_atomic(
             copy_metadata(&file, m);
         }
         file.sync_all()?;
+        // Closed before the rename (a `File` on wasm32 has nothing to close).
+        #[cfg_attr(target_arch = "wasm32", allow(clippy::drop_non_drop))]
         drop(file);
         std::fs::rename(&tmp, &target)
     })();
