@@ -3,6 +3,8 @@
 //!
 //! - [`session`]: the state, commands, evaluators, scene files, per-frame scene
 //!   (no drawing);
+//! - [`derive`]: derived results (albedo, properties, projections,
+//!   histograms), computed once per process, cached, cancellable;
 //! - [`gpu`]: the wgpu renderers and shaders (bv-core only);
 //! - [`widgets`]: egui widgets shared by the panel and the views;
 //! - [`views`]: the views, each drawing one [`session::Scene`];
@@ -12,6 +14,7 @@
 
 pub mod app;
 pub mod cli;
+pub mod derive;
 pub mod export;
 pub mod gpu;
 pub mod session;

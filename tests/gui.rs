@@ -433,7 +433,7 @@ fn two_brdfs_overlay_in_all_three_views() {
             let b = h.state().runtime().get(*id).unwrap().brdf.clone().unwrap();
             let s = &readout.values[k].2;
             // Both plots default to θo in the plane of incidence.
-            let wo = bv::views::curves::plane_direction(s.x, inc.phi_deg.to_radians());
+            let wo = bv::derive::slices::plane_direction(s.x, inc.phi_deg.to_radians());
             let exact = bv_core::mean_rgb(b.eval(wi, wo));
             assert!(
                 (s.value - exact).abs() <= 1e-12 * exact.max(1.0),
@@ -1231,7 +1231,7 @@ fn the_log_plot_reaches_down_to_what_the_data_reach() {
         .clone()
         .unwrap();
     let samples =
-        bv::views::curves::plane_of_incidence(b.as_ref(), 30f64.to_radians(), 0.0, 720, false);
+        bv::derive::slices::plane_of_incidence(b.as_ref(), 30f64.to_radians(), 0.0, 720, false);
     let max = samples.iter().map(|s| s.value).fold(0.0, f64::max);
     let min = samples
         .iter()

@@ -7,7 +7,6 @@ use bv::app::Viewer;
 use bv::session::Command;
 use bv::session::state::{AppState, Display};
 use bv::views::factor::FactorView;
-use bv::views::factor_overlay;
 use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;
 use bv_core::ModelSpec;
@@ -138,7 +137,7 @@ fn lobe<'a>(h: &'a Harness<'_, Viewer>) -> &'a Lobe3dView {
 
 fn settle(h: &mut Harness<'_, Viewer>) {
     h.run();
-    assert!(factor_overlay::wait_idle(&h.ctx));
+    assert!(bv::derive::factor::wait_idle());
     h.run();
     h.run();
 }

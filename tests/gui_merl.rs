@@ -20,7 +20,7 @@ use bv::session::state::AppState;
 use bv::views::image_slice::ImageSliceView;
 use bv::views::lobe3d::Lobe3dView;
 use bv::views::polar::PolarView;
-use bv::views::{Scene, View, sh_overlay};
+use bv::views::{Scene, View};
 use bv_core::ModelSpec;
 use bv_core::measured::merl::{MerlDims, tabulate};
 use eframe::egui::{self, Role};
@@ -265,7 +265,7 @@ fn the_sh_control_overlays_the_reconstruction_with_its_error() {
     h.get_all_by_label("SH").next().unwrap().click();
     h.run();
     assert!(h.state().state().display.sh_overlay);
-    assert!(sh_overlay::wait_idle(&h.ctx));
+    assert!(bv::derive::sh::wait_idle());
     h.run();
     h.run();
     let done = lobe(&h).sh_result().expect("SH result");
@@ -303,7 +303,7 @@ fn the_sh_control_overlays_the_reconstruction_with_its_error() {
             ..d
         }));
     h.run();
-    assert!(sh_overlay::wait_idle(&h.ctx));
+    assert!(bv::derive::sh::wait_idle());
     h.run();
     h.run();
     let r12 = lobe(&h).sh_result().unwrap();
@@ -329,7 +329,7 @@ fn a_table_is_compared_with_the_model_it_came_from() {
         .get_by_label("Cook-Torrance")
         .click();
     h.run();
-    assert!(bv::app::measured_ui::wait_compare_idle(&h.ctx));
+    assert!(bv::app::measured_ui::wait_compare_idle());
     h.run();
     h.run();
     let shown = |h: &Harness<'_, Viewer>| -> f64 {
@@ -350,7 +350,7 @@ fn a_table_is_compared_with_the_model_it_came_from() {
     // percent (bv-core's own tabulation test measures 0.13 % at θi = 30°).
     h.state_mut().push(Command::ToggleCosine);
     h.run();
-    assert!(bv::app::measured_ui::wait_compare_idle(&h.ctx));
+    assert!(bv::app::measured_ui::wait_compare_idle());
     h.run();
     h.run();
     let fcos = shown(&h);
@@ -474,19 +474,14 @@ fn timings() {
     for (name, b) in [("cook-torrance", &analytic), ("merl table", &merl)] {
         let mut best = f64::INFINITY;
         for _ in 0..5 {
-            let d = bv::views::image_slice::compute(
-                b.as_ref(),
-                std::f64::consts::FRAC_PI_2,
-                false,
-                256,
-            );
+            let d = bv::derive::slice::compute(b.as_ref(), std::f64::consts::FRAC_PI_2, false, 256);
             best = best.min(d.seconds);
         }
         println!(
             "image slice 256×256 of {name}: {:.1} ms (best of 5)",
             best * 1e3
         );
-        let key = sh_overlay::ShKey {
+        let key = bv::derive::sh::ShKey {
             revision: 1,
             incident: (45.0, 0.0),
             order: 16,
@@ -494,7 +489,7 @@ fn timings() {
             log: false,
         };
         let t = Instant::now();
-        let r = sh_overlay::compute(b.as_ref(), 1, key).unwrap();
+        let r = bv::derive::sh::compute(b.as_ref(), 1, key).unwrap();
         println!(
             "SH projection L = 16 of {name} ({} rings, mesh and curve included): {:.0} ms, error {:.1} %",
             r.lobe.n_theta,

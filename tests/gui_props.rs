@@ -8,7 +8,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bv::app::Viewer;
-use bv::app::badges::{self, Property};
+use bv::derive::properties::{self as badges, Property};
 use bv::session::Command;
 use bv::session::state::AppState;
 use bv::views::polar::PolarView;
@@ -39,7 +39,7 @@ fn state_of(models: &[&str]) -> AppState {
 
 /// Runs frames until the badges' background work is done and drawn.
 fn settle(h: &mut Harness<'_, Viewer>) {
-    let slots = badges::slots(&h.ctx);
+    let slots = badges::slots();
     let t0 = Instant::now();
     loop {
         h.run();

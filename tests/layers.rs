@@ -10,7 +10,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a folder may import the folders before it.
-const LAYERS: &[&str] = &["session", "gpu", "widgets", "views", "export", "cli", "app"];
+const LAYERS: &[&str] = &[
+    "session", "derive", "gpu", "widgets", "views", "export", "cli", "app",
+];
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let mut entries: Vec<_> = std::fs::read_dir(dir)
@@ -180,6 +182,111 @@ fn folders_import_only_the_layers_below_them() {
     assert!(wrong.is_empty(), "layering broken:\n{}", wrong.join("\n"));
 }
 
+/// What marks code that computes derived results rather than drawing them:
+/// an evaluator of its own, a job, a result cache, a parallel numerical loop.
+const COMPUTING: &[(&str, &str)] = &[
+    (
+        "Brdf for ",
+        "implements Brdf (a derived evaluator belongs in derive/)",
+    ),
+    ("Steps<", "defines a job (jobs belong in derive/)"),
+    ("Slots<", "keeps a result cache (derive/ keeps them)"),
+    ("jobs::slots(", "keeps a result cache (derive/ keeps them)"),
+    (
+        "par_iter",
+        "runs a parallel numerical loop (analyses belong in derive/)",
+    ),
+    (
+        "par_chunks",
+        "runs a parallel numerical loop (analyses belong in derive/)",
+    ),
+    (
+        "rayon::",
+        "runs a parallel numerical loop (analyses belong in derive/)",
+    ),
+];
+
+/// The computing marks in `code` (comments removed), as messages.
+fn computing_marks(code: &str) -> Vec<&'static str> {
+    let code = without_comments(code);
+    // `impl Brdf for X`, `impl bv_core::Brdf for X`, `impl<'a> Brdf for X`.
+    let code = code.replace("bv_core::Brdf for ", "Brdf for ");
+    COMPUTING
+        .iter()
+        .filter(|(mark, _)| {
+            if *mark == "Brdf for " {
+                code.match_indices(mark).any(|(k, _)| {
+                    let before = code[..k].trim_end();
+                    before.ends_with("impl") || before.ends_with('>')
+                })
+            } else {
+                code.contains(mark)
+            }
+        })
+        .map(|(_, why)| *why)
+        .collect()
+}
+
+#[test]
+fn the_computing_marks_are_recognised() {
+    assert_eq!(
+        computing_marks("struct S;\nimpl bv_core::Brdf for S { }"),
+        ["implements Brdf (a derived evaluator belongs in derive/)"]
+    );
+    assert_eq!(computing_marks("impl<'a> Brdf for ShBrdf<'a> {}").len(), 1);
+    assert!(computing_marks("impl Steps<u32> for Job {}")[0].contains("job"));
+    assert!(computing_marks("let v: Vec<_> = x.par_iter().map(f).collect();")[0].contains("loop"));
+    // Naming the trait, or a comment about one, is not computing.
+    assert!(computing_marks("fn f(b: &dyn Brdf) {} // impl Brdf for X").is_empty());
+}
+
+/// Views, widgets and the window draw; what they show is computed in
+/// `derive/` (issue 26): a view that implements `Brdf`, defines a job, keeps
+/// a result cache or runs a parallel numerical loop fails here, tests
+/// included (a test of an analysis belongs with the analysis).
+#[test]
+fn views_only_draw() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut hits = Vec::new();
+    for folder in ["views", "widgets", "app", "export"] {
+        let mut files = Vec::new();
+        rust_files(&src.join(folder), &mut files);
+        for f in files {
+            for why in computing_marks(&std::fs::read_to_string(&f).unwrap()) {
+                hits.push(format!(
+                    "{}: {why}",
+                    f.strip_prefix(&src).unwrap().display()
+                ));
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "computing outside derive/:\n{}",
+        hits.join("\n")
+    );
+}
+
+/// `derive/` is shared by the window, figures, the command line and
+/// scripts: it knows neither egui nor wgpu.
+#[test]
+fn derive_knows_no_gui_or_gpu() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/derive");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    assert!(!files.is_empty());
+    let mut hits = Vec::new();
+    for f in files {
+        let code = without_comments(&std::fs::read_to_string(&f).unwrap());
+        for word in ["egui", "wgpu", "eframe"] {
+            if code.contains(word) {
+                hits.push(format!("{} names {word}", f.display()));
+            }
+        }
+    }
+    assert!(hits.is_empty(), "{}", hits.join("\n"));
+}
+
 #[test]
 fn no_view_export_or_cli_code_names_a_model() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -188,7 +295,9 @@ fn no_view_export_or_cli_code_names_a_model() {
         .map(|m| format!("\"{}\"", m.id))
         .collect();
     let mut hits = Vec::new();
-    for folder in ["views", "export", "cli", "widgets", "app", "session", "gpu"] {
+    for folder in [
+        "views", "export", "cli", "widgets", "app", "session", "derive", "gpu",
+    ] {
         let mut files = Vec::new();
         rust_files(&src.join(folder), &mut files);
         for f in files {
@@ -235,4 +344,118 @@ fn code_the_browser_runs_takes_its_clock_from_the_platform_module() {
         }
     }
     assert!(offenders.is_empty(), "std::time::Instant in {offenders:?}");
+}
+
+/// The files of `src/<folder>/` and the other files of the folder each one
+/// names (`super::x`, `crate::<folder>::x`), comments and test modules left
+/// out (a test's `use super::*` is its own file).
+fn file_graph(folder: &str) -> BTreeMap<String, BTreeSet<String>> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("src")
+        .join(folder);
+    let mut files = Vec::new();
+    rust_files(&dir, &mut files);
+    let stem = |p: &Path| p.file_stem().unwrap().to_string_lossy().to_string();
+    let names: BTreeSet<String> = files.iter().map(|f| stem(f)).collect();
+    let mut graph = BTreeMap::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let code = without_comments(text.split("#[cfg(test)]").next().unwrap_or(""));
+        let mut to = BTreeSet::new();
+        for prefix in ["super::".to_string(), format!("crate::{folder}::")] {
+            for (k, _) in code.match_indices(&prefix) {
+                let rest = &code[k + prefix.len()..];
+                let mut heads = vec![head(rest)];
+                if let Some(group) = rest.strip_prefix('{') {
+                    heads = group
+                        .split('}')
+                        .next()
+                        .unwrap_or("")
+                        .split(',')
+                        .map(head)
+                        .collect();
+                }
+                for h in heads {
+                    if names.contains(&h) && h != stem(f) {
+                        to.insert(h);
+                    }
+                }
+            }
+        }
+        graph.insert(stem(f), to);
+    }
+    graph
+}
+
+/// The cycles of a graph, each as the path that closes it.
+fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<String> {
+    fn visit(
+        n: &str,
+        graph: &BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+        out: &mut Vec<String>,
+    ) {
+        if let Some(k) = path.iter().position(|p| p == n) {
+            out.push(format!("{} → {n}", path[k..].join(" → ")));
+            return;
+        }
+        if done.contains(n) {
+            return;
+        }
+        path.push(n.to_string());
+        for m in graph.get(n).into_iter().flatten() {
+            visit(m, graph, path, done, out);
+        }
+        path.pop();
+        done.insert(n.to_string());
+    }
+    let mut out = Vec::new();
+    let mut done = BTreeSet::new();
+    for n in graph.keys() {
+        visit(n, graph, &mut Vec::new(), &mut done, &mut out);
+    }
+    out
+}
+
+#[test]
+fn the_cycle_finder_finds_cycles() {
+    let g: BTreeMap<String, BTreeSet<String>> = [
+        ("a", vec!["b"]),
+        ("b", vec!["c"]),
+        ("c", vec!["a"]),
+        ("d", vec!["a"]),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v.into_iter().map(String::from).collect()))
+    .collect();
+    assert_eq!(cycles(&g), ["a → b → c → a"]);
+    let mut acyclic = g.clone();
+    acyclic.get_mut("c").unwrap().clear();
+    assert!(cycles(&acyclic).is_empty());
+}
+
+/// The session's files import one way too (issue 26: the state, user files,
+/// commands and scene files were a 4-file cycle): a new cycle fails here.
+#[test]
+fn session_files_form_no_cycle() {
+    let g = file_graph("session");
+    assert!(g.contains_key("state") && !g["state"].is_empty(), "{g:?}");
+    let c = cycles(&g);
+    assert!(
+        c.is_empty(),
+        "file cycles in src/session/:\n{}",
+        c.join("\n")
+    );
+}
+
+/// The derive layer's files import one way.
+#[test]
+fn derive_files_form_no_cycle() {
+    let c = cycles(&file_graph("derive"));
+    assert!(
+        c.is_empty(),
+        "file cycles in src/derive/:\n{}",
+        c.join("\n")
+    );
 }

@@ -511,7 +511,7 @@ fn scene_files_write_file_models_relative_to_their_folder_and_read_them_from_any
 
 #[test]
 fn the_sampling_views_verdict_passes_a_files_correct_isfunc_and_fails_a_wrong_one() {
-    use bv::views::sampling::{SIGNIFICANCE, options, verdict};
+    use bv::derive::sampling::{SIGNIFICANCE, options, verdict};
     use bv_core::analysis::sample_histogram::sample_histogram;
     let wi = DVec3::new(0.4, 0.2, 0.8).normalize();
     for (name, params) in [

@@ -4,16 +4,14 @@
 //! reader's warnings, and the relative L2 difference to another loaded BRDF,
 //! e.g. the analytic model a table was tabulated from).
 
+use crate::derive::compare::{self, COMPARE_RINGS, CompareKey};
 use crate::session::command::Command;
 use crate::session::loader::{self, LoadError, Loader};
 use crate::session::runtime::Runtime;
 use crate::session::state::{AppState, BrdfEntry};
-use crate::views::background::{self, Done};
 use crate::views::sh_overlay::percent;
 use crate::widgets::files::Filter;
-use bv_core::Brdf;
 use eframe::egui::{self, RichText, Role, Ui, WidgetInfo};
-use std::sync::Arc;
 
 /// What the "Load MERL…" dialog lists.
 pub const MERL_FILES: Filter = Filter {
@@ -82,20 +80,6 @@ pub fn error_window(ctx: &egui::Context, errors: &[LoadError]) -> bool {
         });
     dismissed
 }
-
-/// What a comparison depends on.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct CompareKey {
-    a: u64,
-    b: u64,
-    incident: (f64, f64),
-    cosine: bool,
-}
-
-type CompareDone = Arc<Done<CompareKey, Result<f64, String>>>;
-
-/// Quadrature rings of the comparison (the same as bv-core's tabulation test).
-const COMPARE_RINGS: usize = 96;
 
 /// The panel section of a BRDF with a measured table: dimensions, value
 /// ranges, the reader's warnings, the last load time, and the comparison
@@ -185,7 +169,8 @@ pub fn measured_section(
         incident: (state.incident.theta_deg, state.incident.phi_deg),
         cosine: state.display.cosine,
     };
-    let done = compare(ui.ctx(), e.id, key, brdf, ob, state);
+    let waker = crate::views::waker(ui.ctx());
+    let done = compare::request(&waker, e.id, key, brdf, ob, state.incident.direction());
     match done {
         Some(d) => {
             let stale = if d.key == key { "" } else { " (updating…)" };
@@ -213,38 +198,9 @@ pub fn measured_section(
     }
 }
 
-fn compare(
-    ctx: &egui::Context,
-    slot: u64,
-    key: CompareKey,
-    a: Arc<dyn Brdf>,
-    b: Arc<dyn Brdf>,
-    state: &AppState,
-) -> Option<CompareDone> {
-    let wi = state.incident.direction();
-    let slots = background::shared::<CompareKey, Result<f64, String>>(ctx, "compare");
-    let ctx2 = ctx.clone();
-    slots.request(
-        slot,
-        key,
-        background::once(move || {
-            bv_core::represent::sh::relative_l2(
-                a.as_ref(),
-                b.as_ref(),
-                wi,
-                key.cosine,
-                COMPARE_RINGS,
-            )
-            .map_err(|e| e.to_string())
-        }),
-        move || ctx2.request_repaint(),
-    )
-}
-
 /// Waits until no comparison is being computed (tests).
-pub fn wait_compare_idle(ctx: &egui::Context) -> bool {
-    background::shared::<CompareKey, Result<f64, String>>(ctx, "compare")
-        .wait_idle(std::time::Duration::from_secs(60))
+pub fn wait_compare_idle() -> bool {
+    compare::wait_idle()
 }
 
 /// The "Load MERL…" button.

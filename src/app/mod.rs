@@ -58,7 +58,7 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
     let mut state = if let Some(path) = &args.scene {
         let loaded = scene::load(path).with_context(|| format!("opening {}", path.display()))?;
         for w in &loaded.warnings {
-            crate::cli::output::eprint(&format!("bv: {}: {w}\n", path.display()));
+            crate::session::console::eprint(&format!("bv: {}: {w}\n", path.display()));
         }
         loaded.state
     } else if args.fresh {
@@ -76,7 +76,7 @@ fn initial_state(args: &ViewerArgs, saved: Option<&str>) -> anyhow::Result<AppSt
         let presets = args
             .presets
             .iter()
-            .map(|p| crate::cli::params::find_preset(p).with_context(|| format!("--preset {p}")))
+            .map(|p| bv_core::presets::find(p).with_context(|| format!("--preset {p}")))
             .collect::<anyhow::Result<Vec<_>>>()?;
         let n = args.models.len() + presets.len();
         if n > crate::session::state::MAX_BRDFS {
@@ -120,7 +120,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         bv_core::find(m)?;
     }
     for p in &args.presets {
-        crate::cli::params::find_preset(p).with_context(|| format!("--preset {p}"))?;
+        bv_core::presets::find(p).with_context(|| format!("--preset {p}"))?;
     }
     if let Some(path) = &args.scene {
         // Refuse a bad scene before a window opens.
@@ -130,7 +130,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         let loaded = crate::session::deck::load(path, scene::Builds::Warn)
             .with_context(|| format!("opening the deck {}", path.display()))?;
         for w in &loaded.warnings {
-            crate::cli::output::eprint(&format!("bv: {}: {w}\n", path.display()));
+            crate::session::console::eprint(&format!("bv: {}: {w}\n", path.display()));
         }
     }
     let size = match &args.size {
@@ -299,7 +299,7 @@ impl eframe::App for BvApp {
             ctx.request_repaint();
             if b.done() && !b.reported {
                 b.reported = true;
-                let printed = crate::cli::output::print(&format!("{}\n", b.report()));
+                let printed = crate::session::console::print(&format!("{}\n", b.report()));
                 self.finish(&ctx, printed);
             }
         }
@@ -565,7 +565,7 @@ pub fn save_color_image(img: &egui::ColorImage, path: &std::path::Path) -> anyho
     // Through the safe writer: atomic, and never over a FIFO, a device, a
     // read-only file or through a dangling link.
     crate::export::save_png(&rgba, path)?;
-    crate::cli::output::eprint(&format!(
+    crate::session::console::eprint(&format!(
         "bv: saved screenshot {} ({w}x{h})\n",
         path.display()
     ));

@@ -35,7 +35,7 @@ fn hover(p: &Preset) -> String {
 
 /// The collapsible "Presets" section.
 pub fn section(ui: &mut Ui, out: &mut Vec<Command>) {
-    let all = crate::cli::params::shipped_presets();
+    let all = bv_core::presets::shipped_presets();
     egui::CollapsingHeader::new("Presets…")
         .id_salt("bv presets")
         .show(ui, |ui| {

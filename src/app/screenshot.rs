@@ -294,7 +294,7 @@ impl ExportUi {
                                 ui.selectable_value(&mut s.format, Format::Svg, "SVG")
                                     .on_disabled_hover_text("Only the 2D plots have a vector form");
                             });
-                            let mesh = matches!(&s.target, Target::View(id) if id == "lobe");
+                            let mesh = matches!(&s.target, Target::View(id) if id == crate::session::views::LOBE.id);
                             ui.add_enabled_ui(mesh, |ui| {
                                 ui.selectable_value(&mut s.format, Format::Mesh, "OBJ / PLY")
                                     .on_disabled_hover_text("The lobe view's mesh, for Blender");
@@ -357,7 +357,7 @@ impl ExportUi {
         }
         // Keep the format consistent with the target.
         let svg = matches!(&s.target, Target::View(id) if self.svg_ok(id));
-        let mesh = matches!(&s.target, Target::View(id) if id == "lobe");
+        let mesh = matches!(&s.target, Target::View(id) if id == crate::session::views::LOBE.id);
         if (s.format == Format::Svg && !svg) || (s.format == Format::Mesh && !mesh) {
             s.format = Format::Png;
         }

@@ -54,7 +54,7 @@ pub struct Viewer {
     last_load: Option<String>,
     files: Files<()>,
     /// Hot reload of the user BRDF files drawn.
-    reloader: crate::session::user_models::Reloader,
+    reloader: crate::session::reload::Reloader,
     reloader_woken: bool,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
@@ -621,7 +621,7 @@ impl Viewer {
     /// longer compiles (with file, line and column) while its last working
     /// version stays drawn.
     fn reload_user_files(&mut self, ctx: &egui::Context) {
-        use crate::session::user_models::ReloadEvent;
+        use crate::session::reload::ReloadEvent;
         for ev in self.reloader.update(&mut self.state) {
             match ev {
                 ReloadEvent::Reloaded { path } => {

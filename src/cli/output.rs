@@ -8,7 +8,9 @@
 //! itself is gone there is nobody to tell). A closed pipe (`bv models |
 //! head`) is a quiet exit ([`is_broken_pipe`]).
 
-use std::io::{self, Write};
+use std::io;
+
+pub use crate::session::console::{StreamError, eprint, print, stdout_error, warn};
 
 /// What `--out FILE` does with what is already there (every command that
 /// writes a file goes through `bv_core::fsio::write_atomic`).
@@ -16,34 +18,6 @@ pub const OUT_HELP: &str = "Output file, written atomically (a temporary file be
 renamed over it: a failed write leaves the old file whole). A symbolic link is written \
 through to its target, which must exist; a directory, FIFO, socket, device or read-only \
 file is refused; a replaced file keeps its permissions. Missing folders are not created.";
-
-/// A read or write of a standard stream that failed.
-#[derive(Debug)]
-pub struct StreamError {
-    /// What was being done: "write to stdout", "read stdin".
-    pub action: &'static str,
-    /// What the system said.
-    pub error: io::Error,
-}
-
-impl std::fmt::Display for StreamError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "cannot {}: {}", self.action, self.error)
-    }
-}
-
-// No `source()`: the message already holds the system's text, and `main`
-// prints the whole chain.
-impl std::error::Error for StreamError {}
-
-/// `e`, from writing stdout, as the error `main` reports.
-pub fn stdout_error(e: io::Error) -> anyhow::Error {
-    StreamError {
-        action: "write to stdout",
-        error: e,
-    }
-    .into()
-}
 
 /// `e`, from reading stdin, as the error `main` reports.
 pub fn stdin_error(e: io::Error) -> anyhow::Error {
@@ -64,27 +38,6 @@ pub fn is_broken_pipe(e: &anyhow::Error) -> bool {
             .or_else(|| c.downcast_ref::<StreamError>().map(|s| s.error.kind()));
         kind == Some(io::ErrorKind::BrokenPipe)
     })
-}
-
-/// Writes `text` to stdout in one go and flushes it.
-pub fn print(text: &str) -> anyhow::Result<()> {
-    let mut out = io::stdout().lock();
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(stdout_error)
-}
-
-/// Writes `text` to stderr, best effort: a message that cannot be shown is
-/// dropped (never a panic).
-pub fn eprint(text: &str) {
-    let mut err = io::stderr().lock();
-    let _ = err.write_all(text.as_bytes());
-    let _ = err.flush();
-}
-
-/// `bv: warning: {msg}` on stderr, best effort.
-pub fn warn(msg: &str) {
-    eprint(&format!("bv: warning: {msg}\n"));
 }
 
 /// The message of `e` with its causes, as `main` prints it: each layer of

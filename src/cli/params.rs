@@ -6,7 +6,6 @@ use anyhow::{Context, bail};
 use bv_core::ModelSpec;
 use bv_core::error::quote;
 use bv_core::presets::{self, Preset};
-use std::sync::LazyLock;
 
 /// `--model ID [--param NAME=VALUE]…` or `--preset NAME [--param …]`,
 /// flattened into `check`, `bench` and `slice`.
@@ -47,96 +46,15 @@ impl ModelArgs {
     }
 }
 
-/// The shipped presets with the file name each came from (without `.toml`).
-static SHIPPED: LazyLock<Vec<(String, Preset)>> = LazyLock::new(|| {
-    presets::SHIPPED
-        .iter()
-        .filter_map(|(file, text)| {
-            let stem = file.strip_suffix(".toml").unwrap_or(file).to_string();
-            presets::parse_named(file, text).ok().map(|p| (stem, p))
-        })
-        .collect()
-});
-
-/// The same presets as one slice (what `presets::search` takes).
-static PRESETS: LazyLock<Vec<Preset>> =
-    LazyLock::new(|| SHIPPED.iter().map(|(_, p)| p.clone()).collect());
-
 /// The compiled-in presets (those that parse; the core's tests hold all).
 pub fn shipped_presets() -> &'static [Preset] {
-    &PRESETS
+    presets::shipped_presets()
 }
 
 /// The shipped preset called `name` (its display name or its file name,
 /// ignoring case). An unknown name is an error listing the close matches.
 pub fn find_preset(name: &str) -> anyhow::Result<&'static Preset> {
-    let q = name.trim().to_lowercase();
-    if let Some((_, p)) = SHIPPED
-        .iter()
-        .find(|(stem, p)| p.name.to_lowercase() == q || stem.to_lowercase() == q)
-    {
-        return Ok(p);
-    }
-    let close = close_matches(&q);
-    if close.is_empty() {
-        let all: Vec<&str> = SHIPPED.iter().map(|(_, p)| p.name.as_str()).collect();
-        bail!(
-            "unknown preset `{}`; the presets are: {}",
-            quote(name),
-            all.join(", ")
-        );
-    }
-    bail!(
-        "unknown preset `{}`; close matches: {}",
-        quote(name),
-        close.join(", ")
-    )
-}
-
-/// Names of presets that contain the query, or whose name or file name is
-/// within a few edits of it (closest first).
-fn close_matches(q: &str) -> Vec<String> {
-    let mut scored: Vec<(usize, &str)> = SHIPPED
-        .iter()
-        .filter_map(|(stem, p)| {
-            let n = p.name.to_lowercase();
-            // The bare material word of "Copper (Cook-Torrance 1982)".
-            let head = n.split(" (").next().unwrap_or(&n).to_string();
-            let d = if !q.is_empty() && (n.contains(q) || stem.contains(q)) {
-                0
-            } else {
-                edit_distance(q, &head)
-                    .min(edit_distance(q, &n))
-                    .min(edit_distance(q, stem))
-            };
-            // A third of the query's letters wrong, at least two: a typo,
-            // not another word.
-            (d <= (q.chars().count() / 3).max(2)).then_some((d, p.name.as_str()))
-        })
-        .collect();
-    scored.sort_by_key(|&(d, n)| (d, n.len()));
-    scored
-        .into_iter()
-        .take(8)
-        .map(|(_, n)| n.to_string())
-        .collect()
-}
-
-/// Levenshtein distance (insertions, deletions, substitutions), by
-/// characters.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut prev = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let cur = row[j + 1];
-            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
-            prev = cur;
-        }
-    }
-    row[b.len()]
+    Ok(presets::find(name)?)
 }
 
 /// A preset's spec with `NAME=VALUE` strings applied on top (the same
@@ -235,14 +153,6 @@ mod tests {
         );
         assert!(msg("lambert", &["albedo=abc"]).contains("not a number"));
         assert!(msg("lambert", &["albedo=0.1,0.2"]).contains("albedo"));
-    }
-
-    #[test]
-    fn edit_distance_by_hand() {
-        assert_eq!(edit_distance("", "abc"), 3);
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(edit_distance("gold", "gold"), 0);
-        assert_eq!(edit_distance("gld", "gold"), 1);
     }
 
     #[test]

@@ -12,7 +12,7 @@
 //!   (the albedo plot's ρhd and the standard error of its mean).
 
 use super::params::ModelArgs;
-use crate::views::{albedo, curves};
+use crate::derive::{albedo, slices};
 use anyhow::{Result, bail};
 use bv_core::error::fmt_num;
 use bv_core::mean_rgb;
@@ -103,14 +103,14 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
     if !(2..=1_000_000).contains(&a.samples) {
         bail!("--samples {}: expected 2..=1000000", a.samples);
     }
-    let row = |s: &curves::Sample| {
+    let row = |s: &slices::Sample| {
         vec![
             s.x.to_degrees(),
             s.rgb.x,
             s.rgb.y,
             s.rgb.z,
             mean_rgb(s.rgb),
-            curves::shown_value(s.rgb, wo_z(s.x), true),
+            slices::shown_value(s.rgb, wo_z(s.x), true),
         ]
     };
     let f_cols = |first| vec![first, "f_r", "f_g", "f_b", "f_mean", "f_cos_mean"];
@@ -130,7 +130,7 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
     super::budget::start(brdf.as_ref(), "bv slice", work, super::budget::LONG)?;
     let table = match a.curve {
         Curve::ThetaO => {
-            let s = curves::plane_of_incidence(
+            let s = slices::plane_of_incidence(
                 brdf.as_ref(),
                 a.theta_i.to_radians(),
                 a.phi_i.to_radians(),
@@ -141,11 +141,11 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
         }
         Curve::ThetaH | Curve::ThetaD => {
             let axis = if a.curve == Curve::ThetaH {
-                curves::HalfDiffAxis::ThetaH
+                slices::HalfDiffAxis::ThetaH
             } else {
-                curves::HalfDiffAxis::ThetaD
+                slices::HalfDiffAxis::ThetaD
             };
-            let s = curves::half_diff_slice(
+            let s = slices::half_diff_slice(
                 brdf.as_ref(),
                 axis,
                 a.fixed.to_radians(),
@@ -156,12 +156,12 @@ pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
                 .iter()
                 .map(|p| {
                     let (th, td) = match axis {
-                        curves::HalfDiffAxis::ThetaH => (p.x, a.fixed.to_radians()),
-                        curves::HalfDiffAxis::ThetaD => (a.fixed.to_radians(), p.x),
+                        slices::HalfDiffAxis::ThetaH => (p.x, a.fixed.to_radians()),
+                        slices::HalfDiffAxis::ThetaD => (a.fixed.to_radians(), p.x),
                     };
-                    let (_, wo) = curves::half_diff_pair(th, td);
+                    let (_, wo) = slices::half_diff_pair(th, td);
                     let mut r = row(p);
-                    r[5] = curves::shown_value(p.rgb, wo, true);
+                    r[5] = slices::shown_value(p.rgb, wo, true);
                     r
                 })
                 .collect();

@@ -7,7 +7,6 @@
 //! quantity (1/sr, or ln(1 + f) on the log scale).
 
 use crate::session::build_scene;
-use crate::session::runtime::Runtime;
 use crate::session::state::AppState;
 use crate::views::colormap;
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
@@ -31,7 +30,7 @@ pub struct Exported {
 
 /// The meshes of every drawn BRDF of `state` (primary first).
 pub fn lobe_meshes(state: &AppState) -> Vec<Exported> {
-    let mut runtime = Runtime::default();
+    let mut runtime = crate::session::runtime::shared();
     runtime.sync(state);
     let scene = build_scene(state, &runtime, false);
     let d = state.display;

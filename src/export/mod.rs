@@ -9,7 +9,7 @@ pub mod mesh;
 pub mod offscreen;
 
 use crate::session::frame::figure_scene;
-use crate::session::runtime::Runtime;
+use crate::session::runtime::{self, Runtime};
 use crate::session::state::{AppState, Theme};
 use crate::views::ViewEntry;
 use anyhow::{Context as _, Result, bail};
@@ -98,7 +98,7 @@ pub fn start_view(
     entry: &ViewEntry,
     frame: Frame,
 ) -> Result<PendingFigure> {
-    let mut runtime = Runtime::default();
+    let mut runtime = runtime::shared();
     runtime.sync(state);
     check_brdfs(state, &runtime)?;
     let mut view = (entry.make)();
@@ -173,7 +173,7 @@ pub fn start_ui(
     // The window's albedo view computes in the background; a figure shows
     // the finished curves, so compute them first (they are cached).
     {
-        let mut runtime = Runtime::default();
+        let mut runtime = runtime::shared();
         runtime.sync(state);
         check_brdfs(state, &runtime)?;
         // The window may show the environment view too small to draw, but
@@ -184,7 +184,7 @@ pub fn start_ui(
         }
         let scene = figure_scene(state, &runtime, false);
         for b in &scene.brdfs {
-            crate::views::albedo::curve_now(&scene, b);
+            crate::derive::albedo::curve_now(&scene, b);
         }
         check_health(state, &runtime)?;
     }
@@ -202,7 +202,7 @@ pub fn view_svg(
     size: [f32; 2],
     transparent: bool,
 ) -> Option<String> {
-    let mut runtime = Runtime::default();
+    let mut runtime = runtime::shared();
     runtime.sync(state);
     let scene = figure_scene(state, &runtime, transparent);
     let mut view = (entry.make)();

@@ -1,11 +1,19 @@
 //! Evaluators built from the state's specs (not saved). Each BRDF is rebuilt
 //! only when its spec changed; its revision number then changes, which is the
-//! key the views' caches use.
+//! key the derived results' caches use (`crate::derive`).
+//!
+//! Revisions are unique in the process, and a spec that another runtime of
+//! the process has built (the window's, while `bv render` or a screenshot
+//! draws the same scene) is not built again: the runtimes share the
+//! evaluator and its revision, so a result derived for one is found by the
+//! other. Headless paths (figures, decks, meshes, SVG) use the process's one
+//! [`shared`] runtime.
 
 use super::state::AppState;
 use bv_core::{Brdf, ModelSpec};
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Arc, LazyLock, Mutex, MutexGuard, Weak};
 
 /// One built BRDF.
 #[derive(Clone)]
@@ -16,15 +24,56 @@ pub struct Built {
     pub brdf: Option<Arc<dyn Brdf>>,
     /// Why building failed.
     pub error: Option<String>,
-    /// Changes at every rebuild.
+    /// Changes at every rebuild; unique in the process.
     pub revision: u64,
+}
+
+/// The last revision handed out in the process.
+static REVISION: AtomicU64 = AtomicU64::new(0);
+
+fn next_revision() -> u64 {
+    REVISION.fetch_add(1, Ordering::Relaxed) + 1
+}
+
+/// What a build is shared by: the spec (as JSON) and the catalogue revision
+/// (a reloaded user file is another model under the same id).
+type BuildKey = (String, u64);
+
+/// Evaluators some runtime of the process holds, by what they were built
+/// from. Weak: an evaluator no runtime holds is freed (a MERL table is
+/// tens of megabytes).
+static BUILDS: LazyLock<Mutex<HashMap<BuildKey, (Weak<dyn Brdf>, u64)>>> =
+    LazyLock::new(Mutex::default);
+
+/// The evaluator of `spec` and its revision: one a runtime of the process
+/// holds, or a new build.
+fn build(spec: &ModelSpec) -> (Result<Arc<dyn Brdf>, String>, bool, u64) {
+    let key = (spec.to_json().to_string(), bv_core::registry::revision());
+    let mut builds = BUILDS.lock().unwrap_or_else(|e| e.into_inner());
+    builds.retain(|_, (w, _)| w.strong_count() > 0);
+    if let Some((w, rev)) = builds.get(&key)
+        && let Some(b) = w.upgrade()
+    {
+        return (Ok(b), false, *rev);
+    }
+    // Built outside the lock would let two runtimes build the same spec at
+    // once; a build takes milliseconds (a MERL table is read by the loader
+    // beforehand), so the lock is held.
+    let revision = next_revision();
+    match spec.build() {
+        Ok(b) => {
+            let b = Arc::<dyn Brdf>::from(b);
+            builds.insert(key, (Arc::downgrade(&b), revision));
+            (Ok(b), true, revision)
+        }
+        Err(e) => (Err(e.to_string()), true, revision),
+    }
 }
 
 /// Built evaluators by BRDF id.
 #[derive(Default)]
 pub struct Runtime {
     built: HashMap<u64, Built>,
-    next_revision: u64,
     builds: u64,
 }
 
@@ -35,11 +84,11 @@ impl Runtime {
             if self.built.get(&e.id).is_some_and(|b| b.spec == e.spec) {
                 continue;
             }
-            self.next_revision += 1;
-            self.builds += 1;
-            let (brdf, error) = match e.spec.build() {
-                Ok(b) => (Some(Arc::<dyn Brdf>::from(b)), None),
-                Err(err) => (None, Some(err.to_string())),
+            let (brdf, built, revision) = build(&e.spec);
+            self.builds += u64::from(built);
+            let (brdf, error) = match brdf {
+                Ok(b) => (Some(b), None),
+                Err(err) => (None, Some(err)),
             };
             self.built.insert(
                 e.id,
@@ -47,7 +96,7 @@ impl Runtime {
                     spec: e.spec.clone(),
                     brdf,
                     error,
-                    revision: self.next_revision,
+                    revision,
                 },
             );
         }
@@ -59,10 +108,21 @@ impl Runtime {
         self.built.get(&id)
     }
 
-    /// How many builds ran since start (for tests of the caching).
+    /// How many builds this runtime ran (evaluators shared with another
+    /// runtime not counted), for tests of the caching.
     pub fn build_count(&self) -> u64 {
         self.builds
     }
+}
+
+/// The process's runtime for headless work: figures, decks, SVG and meshes
+/// drawn by `bv render`, the screenshot dialog and scripts. One runtime and
+/// one derived-result cache per process: `bv render --view all` builds each
+/// BRDF once and computes each derived result once.
+pub fn shared() -> MutexGuard<'static, Runtime> {
+    static SHARED: LazyLock<Mutex<Runtime>> = LazyLock::new(Mutex::default);
+    // A panic while it was held leaves a consistent map.
+    SHARED.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 #[cfg(test)]
@@ -73,8 +133,12 @@ mod tests {
     #[test]
     fn rebuilds_only_what_changed() {
         let mut s = AppState::default();
-        let a = s.add(ModelSpec::new("lambert").unwrap());
-        let b = s.add(ModelSpec::new("lambert").unwrap());
+        // Parameters no other test uses: tests run in parallel in one
+        // process, and a spec another test holds is shared, not built.
+        let lambert =
+            |a: f64| ModelSpec::from_json("lambert", &serde_json::json!({ "albedo": a })).unwrap();
+        let a = s.add(lambert(0.3141));
+        let b = s.add(lambert(0.2718));
         let mut rt = Runtime::default();
         rt.sync(&s);
         assert_eq!(rt.build_count(), 2);
@@ -84,7 +148,7 @@ mod tests {
         s.entry_mut(b)
             .unwrap()
             .spec
-            .set("albedo", ParamValue::Color([0.2; 3]))
+            .set("albedo", ParamValue::Color([0.2113; 3]))
             .unwrap();
         rt.sync(&s);
         assert_eq!(rt.build_count(), 3);
@@ -92,5 +156,32 @@ mod tests {
         s.brdfs.retain(|e| e.id != a);
         rt.sync(&s);
         assert!(rt.get(a).is_none());
+    }
+
+    #[test]
+    fn runtimes_share_what_they_both_hold() {
+        let mut s = AppState::default();
+        let spec =
+            ModelSpec::from_json("ward", &serde_json::json!({"alpha_x": 0.1234567})).unwrap();
+        let a = s.add(spec.clone());
+        let mut one = Runtime::default();
+        one.sync(&s);
+        let mut two = Runtime::default();
+        two.sync(&s);
+        let (x, y) = (one.get(a).unwrap(), two.get(a).unwrap());
+        assert_eq!(x.revision, y.revision);
+        assert!(Arc::ptr_eq(
+            x.brdf.as_ref().unwrap(),
+            y.brdf.as_ref().unwrap()
+        ));
+        assert_eq!(two.build_count(), 0);
+        // Freed with the last runtime holding it: a later runtime builds
+        // anew, under a new revision.
+        let rev = x.revision;
+        drop((one, two));
+        let mut three = Runtime::default();
+        three.sync(&s);
+        assert_eq!(three.build_count(), 1);
+        assert_ne!(three.get(a).unwrap().revision, rev);
     }
 }

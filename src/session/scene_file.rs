@@ -46,6 +46,7 @@
 //! ([`fsio::write_atomic`]).
 
 use super::command::MAX_NAME_CHARS;
+use super::model_names::{portable_in, resolve_in};
 use super::state::{
     AppState, BrdfEntry, Camera, Display, Incident, MAX_BRDFS, STATE_VERSION, SnellSettings,
 };
@@ -167,9 +168,9 @@ pub enum Builds {
 pub fn from_toml_in(text: &str, base: Option<&Path>, builds: Builds) -> Result<Loaded, SceneError> {
     match base {
         // `.brdf` model paths are read relative to the folder too (the
-        // specs' serde resolves them: `user_models::with_scene_dir`).
+        // specs' serde resolves them: `model_names::with_scene_dir`).
         Some(base) => {
-            super::user_models::with_scene_dir(base, || from_toml_in_dir(text, Some(base), builds))
+            super::model_names::with_scene_dir(base, || from_toml_in_dir(text, Some(base), builds))
         }
         None => from_toml_in_dir(text, None, builds),
     }
@@ -396,35 +397,6 @@ fn map_paths(state: &mut AppState, f: &dyn Fn(&str) -> String) {
     }
 }
 
-/// `p` (from a scene file in `base`) as a path usable from here.
-pub(crate) fn resolve_in(base: &Path, p: &str) -> String {
-    let path = Path::new(p);
-    if path.is_absolute() || base.as_os_str().is_empty() {
-        return p.to_string();
-    }
-    base.join(path).display().to_string()
-}
-
-/// `p` (relative to the current directory, or absolute) as it is written
-/// into a scene file in `dir`: relative to `dir` when it lies inside it, so
-/// that a folder of a scene and its tables can be moved as a whole.
-pub(crate) fn portable_in(dir: &Path, p: &str) -> String {
-    let (Ok(abs), Ok(absolute_dir)) = (std::path::absolute(p), std::path::absolute(dir)) else {
-        return p.to_string();
-    };
-    // A file model's path is canonical (symlinks resolved); the folder is
-    // compared in both forms.
-    let canonical_dir = std::fs::canonicalize(dir).ok();
-    for d in std::iter::once(absolute_dir).chain(canonical_dir) {
-        if let Ok(rel) = abs.strip_prefix(&d)
-            && !rel.as_os_str().is_empty()
-        {
-            return rel.display().to_string();
-        }
-    }
-    abs.display().to_string()
-}
-
 /// The scene text [`save`] writes to `path`: file paths relative to the
 /// scene's folder where they lie inside it, absolute otherwise (so that
 /// [`load`] finds them whatever the current directory).
@@ -436,7 +408,7 @@ pub fn to_toml_for(path: &Path, state: &AppState) -> Result<String, SceneError> 
     let mut state = state.clone();
     map_paths(&mut state, &|p| portable_in(&dir, p));
     // File models' paths are written by the specs' serde, in the folder.
-    super::user_models::with_scene_dir(&dir, || to_toml(&state))
+    super::model_names::with_scene_dir(&dir, || to_toml(&state))
 }
 
 fn ends_with_marker(text: &str) -> bool {

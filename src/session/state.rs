@@ -490,13 +490,13 @@ mod spec_json {
     pub fn serialize<S: Serializer>(spec: &ModelSpec, s: S) -> Result<S::Ok, S::Error> {
         let mut v = spec.to_json();
         // A user file's model (alone or in a mix) is saved by its path.
-        crate::session::user_models::model_names_for_save(&mut v);
+        crate::session::model_names::model_names_for_save(&mut v);
         v.serialize(s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<ModelSpec, D::Error> {
         let mut v = Value::deserialize(d)?;
-        crate::session::user_models::model_names_for_load(&mut v);
+        crate::session::model_names::model_names_for_load(&mut v);
         spec_from_json(&v).map_err(serde::de::Error::custom)
     }
 }

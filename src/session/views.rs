@@ -18,85 +18,124 @@ pub struct ViewInfo {
     pub in_grid: bool,
 }
 
+/// The 3D polar lobe.
+pub const LOBE: ViewInfo = ViewInfo {
+    id: "lobe",
+    title: "3D lobe",
+    in_grid: true,
+};
+
+/// The sphere lit by one light.
+pub const LIT_SPHERE: ViewInfo = ViewInfo {
+    id: "lit_sphere",
+    title: "Lit sphere",
+    in_grid: true,
+};
+
+/// The plane of incidence as a polar plot.
+pub const POLAR: ViewInfo = ViewInfo {
+    id: "polar",
+    title: "Plane of incidence (polar)",
+    in_grid: true,
+};
+
+/// f against an angle.
+pub const CARTESIAN: ViewInfo = ViewInfo {
+    id: "cartesian",
+    title: "f versus angle",
+    in_grid: true,
+};
+
+/// An object under an environment map.
+pub const ENVIRONMENT: ViewInfo = ViewInfo {
+    id: "environment",
+    title: "Environment",
+    in_grid: true,
+};
+
+/// The directional albedo ρhd(θi).
+pub const ALBEDO: ViewInfo = ViewInfo {
+    id: "albedo",
+    title: "Directional albedo ρhd(θi)",
+    in_grid: true,
+};
+
+/// The Fresnel curves.
+pub const FRESNEL: ViewInfo = ViewInfo {
+    id: "fresnel",
+    title: "Fresnel reflectance",
+    in_grid: true,
+};
+
+/// The image slice in half/difference angles.
+pub const SLICE: ViewInfo = ViewInfo {
+    id: "slice",
+    title: "Image slice (θh × θd)",
+    in_grid: true,
+};
+
+/// The reciprocity map.
+pub const RECIPROCITY: ViewInfo = ViewInfo {
+    id: "reciprocity",
+    title: "Reciprocity map",
+    in_grid: false,
+};
+
+/// Snell's law at an interface.
+pub const SNELL: ViewInfo = ViewInfo {
+    id: "snell",
+    title: "Snell's law at an interface",
+    in_grid: false,
+};
+
+/// The microfacet terms D, G, F.
+pub const TERMS: ViewInfo = ViewInfo {
+    id: "terms",
+    title: "Microfacet terms D, G, F",
+    in_grid: false,
+};
+
+/// Importance sampling and its χ² test.
+pub const SAMPLING: ViewInfo = ViewInfo {
+    id: "sampling",
+    title: "Importance sampling",
+    in_grid: false,
+};
+
+/// The factorisation view (SVD against SH).
+pub const FACTOR: ViewInfo = ViewInfo {
+    id: "factor",
+    title: "Factorisation (SVD vs SH)",
+    in_grid: false,
+};
+
 /// Every view, in layout order (the first two share the top row, the others
 /// fill the rows below).
 pub const VIEWS: &[ViewInfo] = &[
-    ViewInfo {
-        id: "lobe",
-        title: "3D lobe",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "lit_sphere",
-        title: "Lit sphere",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "polar",
-        title: "Plane of incidence (polar)",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "cartesian",
-        title: "f versus angle",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "environment",
-        title: "Environment",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "albedo",
-        title: "Directional albedo ρhd(θi)",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "fresnel",
-        title: "Fresnel reflectance",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "slice",
-        title: "Image slice (θh × θd)",
-        in_grid: true,
-    },
-    ViewInfo {
-        id: "reciprocity",
-        title: "Reciprocity map",
-        in_grid: false,
-    },
-    ViewInfo {
-        id: "snell",
-        title: "Snell's law at an interface",
-        in_grid: false,
-    },
-    ViewInfo {
-        id: "terms",
-        title: "Microfacet terms D, G, F",
-        in_grid: false,
-    },
-    ViewInfo {
-        id: "sampling",
-        title: "Importance sampling",
-        in_grid: false,
-    },
-    ViewInfo {
-        id: "factor",
-        title: "Factorisation (SVD vs SH)",
-        in_grid: false,
-    },
+    LOBE,
+    LIT_SPHERE,
+    POLAR,
+    CARTESIAN,
+    ENVIRONMENT,
+    ALBEDO,
+    FRESNEL,
+    SLICE,
+    RECIPROCITY,
+    SNELL,
+    TERMS,
+    SAMPLING,
+    FACTOR,
 ];
 
 /// Other names a view answers to on the command line (`bv render --view
 /// lobe3d`).
 pub const ALIASES: &[(&str, &str)] = &[
-    ("lobe3d", "lobe"),
-    ("3d", "lobe"),
-    ("lit", "lit_sphere"),
-    ("sphere", "lit_sphere"),
-    ("lit-sphere", "lit_sphere"),
-    ("env", "environment"),
+    ("lobe3d", LOBE.id),
+    ("3d", LOBE.id),
+    ("lit", LIT_SPHERE.id),
+    ("sphere", LIT_SPHERE.id),
+    ("lit-sphere", LIT_SPHERE.id),
+    ("env", ENVIRONMENT.id),
 ];
 
 /// The view with id `id`.

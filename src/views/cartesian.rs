@@ -5,9 +5,10 @@
 
 use super::BrdfColor as _;
 use super::chart::{self, Chart, Marker, Palette, Series};
-use super::curves::{self, HalfDiffAxis};
+use super::curves;
 use super::polar::{Readout, readout_ui};
 use super::{Scene, View};
+use crate::derive::slices::{self, HalfDiffAxis};
 use crate::session::command::Command;
 use crate::session::state::CartesianAxis;
 use eframe::egui::{self, Color32, RichText, Ui};
@@ -41,13 +42,16 @@ impl View for CartesianView {
         super::display_toggles(ui, scene, out);
         let p = scene.state.plots;
         let mut axis = p.axis;
-        egui::ComboBox::new(super::view_id("cartesian").with("axis"), "x axis")
-            .selected_text(axis_name(axis))
-            .show_ui(ui, |ui| {
-                ui.selectable_value(&mut axis, CartesianAxis::ThetaO, "θo (plane of incidence)");
-                ui.selectable_value(&mut axis, CartesianAxis::ThetaH, "θh (fixed θd)");
-                ui.selectable_value(&mut axis, CartesianAxis::ThetaD, "θd (fixed θh)");
-            });
+        egui::ComboBox::new(
+            super::view_id(crate::session::views::CARTESIAN.id).with("axis"),
+            "x axis",
+        )
+        .selected_text(axis_name(axis))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut axis, CartesianAxis::ThetaO, "θo (plane of incidence)");
+            ui.selectable_value(&mut axis, CartesianAxis::ThetaH, "θh (fixed θd)");
+            ui.selectable_value(&mut axis, CartesianAxis::ThetaD, "θd (fixed θh)");
+        });
         if axis != p.axis {
             out.push(Command::SetCartesianAxis(axis));
         }
@@ -102,7 +106,7 @@ impl View for CartesianView {
         let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         let mut plot = super::with_legend(
-            Plot::new(super::view_id("cartesian"))
+            Plot::new(super::view_id(crate::session::views::CARTESIAN.id))
                 .width(size.x.max(50.0))
                 .height(size.y.max(50.0)),
             size,
@@ -163,7 +167,7 @@ impl View for CartesianView {
         let wi = scene.wi();
         let response = plot.show(ui, |pui| {
             if axis == CartesianAxis::ThetaO {
-                let li = curves::incident_signed_angle(theta_i).to_degrees();
+                let li = slices::incident_signed_angle(theta_i).to_degrees();
                 pui.vline(
                     VLine::new("", li)
                         .color(light)
@@ -222,7 +226,7 @@ impl View for CartesianView {
                     }
                 }
             }
-            let mut order: Vec<&(&super::SceneBrdf, Vec<curves::Sample>)> = data.iter().collect();
+            let mut order: Vec<&(&super::SceneBrdf, Vec<slices::Sample>)> = data.iter().collect();
             order.sort_by_key(|(b, _)| b.selected);
             for (b, samples) in order {
                 let pts: Vec<[f64; 2]> = samples
@@ -246,22 +250,22 @@ impl View for CartesianView {
             && let Some(pc) = response.inner
         {
             let x = pc.x.to_radians();
-            let values: Vec<(String, Color32, curves::Sample)> = scene
+            let values: Vec<(String, Color32, slices::Sample)> = scene
                 .brdfs
                 .iter()
                 .map(|b| {
                     let s = match axis {
                         CartesianAxis::ThetaO => {
-                            curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, x, d.cosine)
+                            slices::plane_value(b.brdf.as_ref(), theta_i, phi_i, x, d.cosine)
                         }
-                        CartesianAxis::ThetaH => curves::half_diff_value(
+                        CartesianAxis::ThetaH => slices::half_diff_value(
                             b.brdf.as_ref(),
                             HalfDiffAxis::ThetaH,
                             p.fixed_theta_d_deg.to_radians(),
                             x,
                             d.cosine,
                         ),
-                        CartesianAxis::ThetaD => curves::half_diff_value(
+                        CartesianAxis::ThetaD => slices::half_diff_value(
                             b.brdf.as_ref(),
                             HalfDiffAxis::ThetaD,
                             p.fixed_theta_h_deg.to_radians(),
@@ -306,7 +310,7 @@ impl View for CartesianView {
 /// The curves of one frame and the axes they need (shared by the plot and
 /// its SVG).
 struct Data<'s> {
-    curves: Vec<(&'s super::SceneBrdf, Vec<curves::Sample>)>,
+    curves: Vec<(&'s super::SceneBrdf, Vec<slices::Sample>)>,
     /// The y range: in decades on the log scale.
     bottom: f64,
     top: f64,
@@ -322,7 +326,7 @@ impl<'s> Data<'s> {
             scene.incident.theta_deg.to_radians(),
             scene.incident.phi_deg.to_radians(),
         );
-        let eval = |b: &super::SceneBrdf| -> Vec<curves::Sample> {
+        let eval = |b: &super::SceneBrdf| -> Vec<slices::Sample> {
             match p.axis {
                 CartesianAxis::ThetaO => {
                     let n = if b.brdf.transmits() {
@@ -330,16 +334,16 @@ impl<'s> Data<'s> {
                     } else {
                         SAMPLES
                     };
-                    curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+                    slices::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
                 }
-                CartesianAxis::ThetaH => curves::half_diff_slice(
+                CartesianAxis::ThetaH => slices::half_diff_slice(
                     b.brdf.as_ref(),
                     HalfDiffAxis::ThetaH,
                     p.fixed_theta_d_deg.to_radians(),
                     SAMPLES / 2,
                     d.cosine,
                 ),
-                CartesianAxis::ThetaD => curves::half_diff_slice(
+                CartesianAxis::ThetaD => slices::half_diff_slice(
                     b.brdf.as_ref(),
                     HalfDiffAxis::ThetaD,
                     p.fixed_theta_h_deg.to_radians(),
@@ -348,7 +352,7 @@ impl<'s> Data<'s> {
                 ),
             }
         };
-        let curves: Vec<(&super::SceneBrdf, Vec<curves::Sample>)> =
+        let curves: Vec<(&super::SceneBrdf, Vec<slices::Sample>)> =
             scene.brdfs.iter().map(|b| (b, eval(b))).collect();
         let values = || curves.iter().flat_map(|(_, s)| s.iter()).map(|s| s.value);
         let vmax = values().fold(0.0, f64::max);
@@ -421,7 +425,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
     };
     if p.axis == CartesianAxis::ThetaO {
         c.vlines.push(Marker {
-            at: curves::incident_signed_angle(theta_i).to_degrees(),
+            at: slices::incident_signed_angle(theta_i).to_degrees(),
             color: super::light_color(dark),
             dashed: false,
             label: "ωi".into(),
@@ -445,7 +449,7 @@ pub fn chart(scene: &Scene<'_>, dark: bool) -> Chart {
             }
         }
     }
-    let mut order: Vec<&(&super::SceneBrdf, Vec<curves::Sample>)> = data.curves.iter().collect();
+    let mut order: Vec<&(&super::SceneBrdf, Vec<slices::Sample>)> = data.curves.iter().collect();
     order.sort_by_key(|(b, _)| b.selected);
     for (b, samples) in order {
         c.series.push(Series {

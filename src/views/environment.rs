@@ -573,8 +573,16 @@ impl View for EnvironmentView {
     fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         let env = &scene.state.lighting.env;
         let mut next = env.clone();
-        exposure_control(ui, "environment", &mut next.exposure_ev);
-        tone_control(ui, "environment", &mut next.tone_map);
+        exposure_control(
+            ui,
+            crate::session::views::ENVIRONMENT.id,
+            &mut next.exposure_ev,
+        );
+        tone_control(
+            ui,
+            crate::session::views::ENVIRONMENT.id,
+            &mut next.tone_map,
+        );
         egui::ComboBox::from_id_salt("bv env object")
             .selected_text(env.object.label())
             .width(60.0)
@@ -606,7 +614,13 @@ impl View for EnvironmentView {
         if r.double_clicked() {
             next.rotation_deg = 0.0;
         }
-        arrangement_control(ui, "environment", scene, &mut next.side_by_side, out);
+        arrangement_control(
+            ui,
+            crate::session::views::ENVIRONMENT.id,
+            scene,
+            &mut next.side_by_side,
+            out,
+        );
         // The map: a path field (Enter loads), the studio button.
         let edit = self
             .path_edit

@@ -14,20 +14,17 @@
 //! figures compute it before drawing. Anisotropic models are refused with the
 //! reason: the table has no φh axis.
 
-use super::background::{self, Slots};
-use super::factor_overlay::{self, Factored};
 use super::{Scene, SceneBrdf, View};
+use crate::derive::factor::{self, Factored, ViewOutcome as Outcome};
 use crate::session::command::Command;
 use crate::session::state::Display;
 use bv_core::measured::merl::theta_h_centre;
 use bv_core::represent::sh;
-use bv_core::represent::sh_table::{self, TableErrors};
+use bv_core::represent::sh_table::{self};
 use eframe::egui::{
     self, Align2, Color32, FontId, Mesh, Pos2, Rect, Sense, Shape, Stroke, Ui, UiBuilder, Vec2,
 };
 use egui_plot::{Corner, GridMark, Legend, Line, LineStyle, MarkerShape, Plot, PlotPoints, Points};
-use std::sync::Arc;
-use std::time::Duration;
 
 /// Factors drawn below the chart.
 pub const SHOWN: usize = 3;
@@ -38,105 +35,6 @@ pub const CHANNEL: usize = 1;
 /// Smallest error drawn on the log axis (a rebuild this good is exact for
 /// the eye; 0 would be −∞).
 const FLOOR: f64 = 1e-6;
-
-/// What the view shows of one BRDF.
-#[derive(Debug)]
-pub struct FactorData {
-    /// The table and its factorisation.
-    pub factored: Arc<Factored>,
-    /// The rebuilt tables' errors for K = 1..=8 (index K − 1).
-    pub svd_error: TableErrors,
-    /// SH's errors over the same cells for L = 0..=16 (index L).
-    pub sh_error: TableErrors,
-}
-
-/// The view's result: its data or why there is none.
-pub type Outcome = Arc<Result<FactorData, String>>;
-
-/// What [`step`] has finished so far.
-#[derive(Default)]
-struct Partial {
-    table: Option<(bv_core::measured::merl::MerlTable, Duration)>,
-    factored: Option<Arc<Factored>>,
-    sh_job: Option<sh_table::ShTableJob>,
-    sh_error: Option<TableErrors>,
-}
-
-#[cfg(test)]
-fn compute(
-    brdf: &dyn bv_core::Brdf,
-    id: u64,
-    revision: u64,
-    tables: &Slots<u64, factor_overlay::FactoredOutcome>,
-) -> Outcome {
-    let mut partial = Partial::default();
-    background::run_to_end(|| step(&mut partial, brdf, id, revision, tables))
-}
-
-/// Quadrature rings, and θh rows of the table, per step of SH's errors: a
-/// few per worker thread (one worker in a browser page, where a step must
-/// fit in a slice of a frame).
-fn sh_step_size() -> (usize, usize) {
-    let threads = rayon::current_num_threads();
-    (4 * threads, threads)
-}
-
-/// One step of the view's computation (so that a browser page draws
-/// between them): the factorisation (tabulation, then the SVDs), SH's errors
-/// over the table (a few rings of one lobe's projection, or a few rows of
-/// the table, a step), then the rank-K rebuilds' errors.
-fn step(
-    partial: &mut Partial,
-    brdf: &dyn bv_core::Brdf,
-    id: u64,
-    revision: u64,
-    tables: &Slots<u64, factor_overlay::FactoredOutcome>,
-) -> Option<Outcome> {
-    let fail = |e: String| Some(Arc::new(Err(e)));
-    let Some(factored) = partial.factored.clone() else {
-        match factor_overlay::factored_step(tables, id, revision, brdf, &mut partial.table)? {
-            Ok(f) => partial.factored = Some(f),
-            Err(e) => return fail(e),
-        }
-        return None;
-    };
-    let Some(sh_error) = partial.sh_error.take() else {
-        let job = match &mut partial.sh_job {
-            Some(j) => j,
-            None => match sh_table::ShTableJob::new(
-                sh::MAX_ORDER,
-                sh_table::VIEW_INCIDENT,
-                super::sh_overlay::RINGS,
-            ) {
-                Ok(j) => partial.sh_job.insert(j),
-                Err(e) => return fail(e.to_string()),
-            },
-        };
-        let (rings, rows) = sh_step_size();
-        match job.step(brdf, &factored.table, rings, rows)? {
-            Ok(e) => partial.sh_error = Some(e),
-            Err(e) => return fail(e.to_string()),
-        }
-        return None;
-    };
-    match sh_table::factor_table_error(&factored.fac, &factored.table) {
-        Ok(svd_error) => Some(Arc::new(Ok(FactorData {
-            factored,
-            svd_error,
-            sh_error,
-        }))),
-        Err(e) => fail(e.to_string()),
-    }
-}
-
-fn slots(ctx: &egui::Context) -> Arc<Slots<u64, Outcome>> {
-    background::shared(ctx, "factorization view")
-}
-
-/// Waits until the view's work (and the factorisations) is done (tests).
-pub fn wait_idle(ctx: &egui::Context) -> bool {
-    slots(ctx).wait_idle(Duration::from_secs(120)) && factor_overlay::wait_idle(ctx)
-}
 
 /// The factorisation view.
 #[derive(Default)]
@@ -156,16 +54,9 @@ impl FactorView {
         scene: &Scene<'_>,
         b: &SceneBrdf,
     ) -> Option<(Outcome, bool)> {
-        let tables = factor_overlay::factorizations(ctx);
-        let (id, rev) = (b.id, b.revision);
-        let brdf = b.brdf.clone();
-        let (shown, busy) =
-            slots(ctx).for_frame(ctx, id, rev, scene.figure, Duration::from_millis(100), {
-                let mut partial = Partial::default();
-                move || step(&mut partial, brdf.as_ref(), id, rev, &tables)
-            });
-        self.waiting = busy;
-        shown
+        let shown = factor::view_data(&super::waker(ctx), scene, b);
+        self.waiting = shown.busy;
+        shown.value()
     }
 }
 
@@ -583,37 +474,5 @@ mod tests {
         assert_eq!(diverging(0.0, false), Color32::from_rgb(240, 240, 240));
         assert_eq!(diverging(1.0, false), Color32::from_rgb(225, 50, 40));
         assert_eq!(diverging(-2.0, true), Color32::from_rgb(59, 110, 235));
-    }
-
-    /// A glossy model: the SVD's K = 1 beats SH's L = 0 over the same cells
-    /// (a product of two 2D functions holds more of a half-angle lobe than
-    /// one constant per θi), both fall with more terms, and the errors of the
-    /// cells are the factorisation's own.
-    #[test]
-    fn errors_for_a_glossy_model() {
-        let b = bv_core::ModelSpec::from_json(
-            "cook-torrance",
-            &serde_json::json!({"kd": 0.1, "ks": 0.8, "alpha": 0.2}),
-        )
-        .unwrap()
-        .build()
-        .unwrap();
-        let out = compute(b.as_ref(), 1, 1, &Slots::default());
-        let d = out.as_ref().as_ref().unwrap();
-        let sh = &d.sh_error.cosine;
-        assert_eq!(sh.len(), sh::MAX_ORDER + 1);
-        let svd = &d.svd_error.cosine;
-        assert_eq!(svd.len(), usize::from(TERMS));
-        assert!(svd[0] < sh[0], "{svd:?} {sh:?}");
-        assert!(svd[7] < svd[0]);
-        assert!(sh[16] < sh[0], "{sh:?}");
-        for (a, b) in d.svd_error.plain.iter().zip(&d.factored.fac.rel_l2_error_f) {
-            assert!((a - b).abs() < 1e-9);
-        }
-        // The cosine-weighted error of the cells is the factored space's own
-        // (up to the clamp at 0, which only lowers it).
-        for (a, b) in svd.iter().zip(&d.factored.fac.rel_l2_error) {
-            assert!(*a <= b + 1e-9 && *a > 0.5 * b, "{a} vs {b}");
-        }
     }
 }

@@ -549,7 +549,7 @@ impl View for FresnelView {
         let plot_h = (size.y - strip_h - readout_h).max(50.0);
         let plot = super::with_legend(
             super::curves::with_linear_y(
-                Plot::new(super::view_id("fresnel"))
+                Plot::new(super::view_id(crate::session::views::FRESNEL.id))
                     .width(size.x.max(50.0))
                     .height(plot_h),
             ),

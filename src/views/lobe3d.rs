@@ -11,10 +11,12 @@
 
 use super::BrdfColor as _;
 use super::camera::{self, CameraMatrices};
-use super::factor_overlay::{self, FactorDone};
+use super::factor_overlay;
 use super::lobe_gpu::LobeCallback;
-use super::sh_overlay::{self, ShDone};
+use super::sh_overlay;
 use super::{Scene, View, colormap, curves};
+use crate::derive::factor::FactorDone;
+use crate::derive::sh::ShDone;
 use crate::gpu::lobe::{LineSeg, LobeCamera, LobeFrame, MeshDraw, MeshStyle};
 use crate::session::command::Command;
 use crate::session::state::{Camera, Display, Incident};
@@ -603,9 +605,17 @@ impl View for Lobe3dView {
             set(out, &|n| n.color_by_value = !n.color_by_value);
         }
         sh_overlay::control(ui, scene, out);
-        sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
+        sh_overlay::error_label(
+            ui,
+            scene,
+            crate::derive::sh::request(&super::waker(ui.ctx()), scene).as_ref(),
+        );
         factor_overlay::control(ui, scene, out);
-        factor_overlay::error_label(ui, scene, factor_overlay::request(ui.ctx(), scene).as_ref());
+        factor_overlay::error_label(
+            ui,
+            scene,
+            crate::derive::factor::request(&super::waker(ui.ctx()), scene).as_ref(),
+        );
         if super::toolbar_toggle(
             ui,
             d.auto_scale,
@@ -641,8 +651,11 @@ impl View for Lobe3dView {
         if scene.transparent {
             bg = [0.0; 4];
         }
-        self.set_sh(sh_overlay::request(ui.ctx(), scene));
-        self.set_factor(factor_overlay::request(ui.ctx(), scene));
+        self.set_sh(crate::derive::sh::request(&super::waker(ui.ctx()), scene));
+        self.set_factor(crate::derive::factor::request(
+            &super::waker(ui.ctx()),
+            scene,
+        ));
         let frame = self.frame(scene, rect.size(), bg, dark);
         // A lost device (a browser took it back) fails every buffer the
         // renderer would create: say so instead of drawing.

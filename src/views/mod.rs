@@ -10,7 +10,6 @@
 //! ([`install_context`]).
 
 pub mod albedo;
-pub mod background;
 pub mod camera;
 pub mod cartesian;
 pub mod chart;
@@ -99,26 +98,43 @@ pub struct ViewEntry {
     pub make: fn() -> Box<dyn View>,
 }
 
-/// The constructor of the view with session id `id`. Add a view here and in
+/// Each view's constructor, by the view it draws (its id is spelled once,
+/// in [`crate::session::views`]). Add a view here and in
 /// [`crate::session::views::VIEWS`].
-fn make(id: &str) -> Option<fn() -> Box<dyn View>> {
-    let make: fn() -> Box<dyn View> = match id {
-        "lobe" => || Box::new(lobe3d::Lobe3dView::new()),
-        "lit_sphere" => || Box::new(lit_sphere::LitSphereView::new()),
-        "polar" => || Box::new(polar::PolarView::default()),
-        "cartesian" => || Box::new(cartesian::CartesianView::default()),
-        "environment" => || Box::new(environment::EnvironmentView::new()),
-        "albedo" => || Box::new(albedo::AlbedoView::default()),
-        "fresnel" => || Box::new(fresnel::FresnelView::default()),
-        "slice" => || Box::new(image_slice::ImageSliceView::default()),
-        "reciprocity" => || Box::new(reciprocity::ReciprocityView::default()),
-        "snell" => || Box::new(snell::SnellView::default()),
-        "terms" => || Box::new(terms::TermsView::default()),
-        "sampling" => || Box::new(sampling::SamplingView::default()),
-        "factor" => || Box::new(factor::FactorView::default()),
-        _ => return None,
-    };
-    Some(make)
+const CONSTRUCTORS: &[(views::ViewInfo, fn() -> Box<dyn View>)] = &[
+    (views::LOBE, || Box::new(lobe3d::Lobe3dView::new())),
+    (views::LIT_SPHERE, || {
+        Box::new(lit_sphere::LitSphereView::new())
+    }),
+    (views::POLAR, || Box::new(polar::PolarView::default())),
+    (views::CARTESIAN, || {
+        Box::new(cartesian::CartesianView::default())
+    }),
+    (views::ENVIRONMENT, || {
+        Box::new(environment::EnvironmentView::new())
+    }),
+    (views::ALBEDO, || Box::new(albedo::AlbedoView::default())),
+    (views::FRESNEL, || Box::new(fresnel::FresnelView::default())),
+    (views::SLICE, || {
+        Box::new(image_slice::ImageSliceView::default())
+    }),
+    (views::RECIPROCITY, || {
+        Box::new(reciprocity::ReciprocityView::default())
+    }),
+    (views::SNELL, || Box::new(snell::SnellView::default())),
+    (views::TERMS, || Box::new(terms::TermsView::default())),
+    (views::SAMPLING, || {
+        Box::new(sampling::SamplingView::default())
+    }),
+    (views::FACTOR, || Box::new(factor::FactorView::default())),
+];
+
+/// The constructor of the view `v`.
+fn make(v: &views::ViewInfo) -> Option<fn() -> Box<dyn View>> {
+    CONSTRUCTORS
+        .iter()
+        .find(|(c, _)| c == v)
+        .map(|(_, make)| *make)
 }
 
 /// Every view, in the session's layout order (see
@@ -132,7 +148,7 @@ pub static REGISTRY: std::sync::LazyLock<Vec<ViewEntry>> = std::sync::LazyLock::
                 id: v.id,
                 title: v.title,
                 in_grid: v.in_grid,
-                make: make(v.id)?,
+                make: make(v)?,
             })
         })
         .collect()
@@ -289,6 +305,16 @@ pub fn display_toggles(ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
     if toolbar_toggle(ui, d.cosine, "× cos θo", "Multiply by cos θo (C)") {
         out.push(Command::ToggleCosine);
     }
+}
+
+/// The waker of derived results shown in `ctx`'s window: a finished or
+/// progressing job asks for a frame.
+pub fn waker(ctx: &egui::Context) -> crate::derive::Waker {
+    let ctx = ctx.clone();
+    crate::derive::Waker::new(move |after| match after {
+        None => ctx.request_repaint(),
+        Some(d) => ctx.request_repaint_after(d),
+    })
 }
 
 /// The id egui uses for a view's widgets.

@@ -5,8 +5,9 @@
 //! and the exact values under the pointer.
 
 use super::BrdfColor as _;
-use super::curves::{self, Sample};
+use super::curves;
 use super::{Scene, View, factor_overlay, sh_overlay};
+use crate::derive::slices::{self, Sample};
 use crate::session::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
@@ -174,9 +175,17 @@ impl View for PolarView {
     fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         super::display_toggles(ui, scene, out);
         sh_overlay::control(ui, scene, out);
-        sh_overlay::error_label(ui, scene, sh_overlay::request(ui.ctx(), scene).as_ref());
+        sh_overlay::error_label(
+            ui,
+            scene,
+            crate::derive::sh::request(&super::waker(ui.ctx()), scene).as_ref(),
+        );
         factor_overlay::control(ui, scene, out);
-        factor_overlay::error_label(ui, scene, factor_overlay::request(ui.ctx(), scene).as_ref());
+        factor_overlay::error_label(
+            ui,
+            scene,
+            crate::derive::factor::request(&super::waker(ui.ctx()), scene).as_ref(),
+        );
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
@@ -189,7 +198,7 @@ impl View for PolarView {
         let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
         let (curves, outer) = polar_curves(scene);
         // The SH reconstruction of the selected lobe, dashed.
-        let sh = sh_overlay::request(ui.ctx(), scene).and_then(|done| {
+        let sh = crate::derive::sh::request(&super::waker(ui.ctx()), scene).and_then(|done| {
             let r = done.value.as_ref().ok()?;
             let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;
             let pts: Vec<[f64; 2]> = r
@@ -209,19 +218,20 @@ impl View for PolarView {
         self.sh_curve = sh.as_ref().map(|s| s.2.clone());
         // The factorisation's reconstruction, dashed in amber (as its
         // wireframe in the 3D lobe).
-        let factor = factor_overlay::request(ui.ctx(), scene).and_then(|done| {
-            let r = done.value.as_ref().ok()?;
-            let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;
-            let pts: Vec<[f64; 2]> = r
-                .plane
-                .iter()
-                .map(|s| {
-                    let rad = radius(s.value, d.log);
-                    [rad * s.x.sin(), rad * s.x.cos()]
-                })
-                .collect();
-            Some((format!("{} factor K = {}", b.label, r.terms), pts))
-        });
+        let factor =
+            crate::derive::factor::request(&super::waker(ui.ctx()), scene).and_then(|done| {
+                let r = done.value.as_ref().ok()?;
+                let b = scene.brdfs.iter().find(|b| b.id == r.brdf_id)?;
+                let pts: Vec<[f64; 2]> = r
+                    .plane
+                    .iter()
+                    .map(|s| {
+                        let rad = radius(s.value, d.log);
+                        [rad * s.x.sin(), rad * s.x.cos()]
+                    })
+                    .collect();
+                Some((format!("{} factor K = {}", b.label, r.terms), pts))
+            });
         self.factor_curve = factor.as_ref().map(|f| f.1.clone());
         let factor_color = if dark {
             egui::Color32::from_rgb(255, 184, 51)
@@ -247,7 +257,7 @@ impl View for PolarView {
         let log = d.log;
 
         let plot = super::with_legend(
-            Plot::new(super::view_id("polar")),
+            Plot::new(super::view_id(crate::session::views::POLAR.id)),
             size,
             scene.brdfs.len(),
             Corner::RightTop,
@@ -339,7 +349,7 @@ impl View for PolarView {
                 .allow_hover(false),
             );
             // Light (left) and mirror direction (right).
-            let li = curves::incident_signed_angle(theta_i);
+            let li = slices::incident_signed_angle(theta_i);
             let lp = [outer * 1.2 * li.sin(), outer * 1.2 * li.cos()];
             pui.line(
                 Line::new("", PlotPoints::from(vec![lp, [0.0, 0.0]]))
@@ -458,7 +468,7 @@ impl View for PolarView {
                             (
                                 b.label.clone(),
                                 b.color(),
-                                curves::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine),
+                                slices::plane_value(b.brdf.as_ref(), theta_i, phi_i, a, d.cosine),
                             )
                         })
                         .collect(),
@@ -469,7 +479,7 @@ impl View for PolarView {
             readout_ui(ui, self.readout.as_ref(), d.cosine);
             self.swap = self.pinned.and_then(|a| {
                 let b = scene.primary()?;
-                let wo = curves::plane_direction(a, phi_i);
+                let wo = slices::plane_direction(a, phi_i);
                 Some(SwapReadout::new(
                     b.label.clone(),
                     b.brdf.as_ref(),
@@ -512,7 +522,7 @@ fn polar_curves(scene: &Scene<'_>) -> (Vec<PolarCurve>, f64) {
             } else {
                 SAMPLES
             };
-            let pts = curves::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
+            let pts = slices::plane_of_incidence(b.brdf.as_ref(), theta_i, phi_i, n, d.cosine)
                 .iter()
                 .map(|s| {
                     let r = radius(s.value, d.log);
@@ -626,7 +636,7 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
     );
     let light = super::light_color(dark);
     let mirror = super::mirror_color(dark);
-    let li = curves::incident_signed_angle(theta_i);
+    let li = slices::incident_signed_angle(theta_i);
     let lp = [outer * 1.2 * li.sin(), outer * 1.2 * li.cos()];
     svg.line(at(lp), at([0.0, 0.0]), light, 2.5, None);
     svg.text(

@@ -12,33 +12,23 @@
 //! (else the first drawn), computed on a background thread and cached by the
 //! BRDF's revision and ωi; figures compute it before drawing.
 
-use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
+use crate::derive::reciprocity::{self, Key};
 use crate::session::command::Command;
-use crate::session::platform::Instant;
-use bv_core::analysis::reciprocity_map::{ReciprocityMap, hemisphere_to_disc, reciprocity_map};
+use bv_core::analysis::reciprocity_map::{ReciprocityMap, hemisphere_to_disc};
 use eframe::egui::{
     self, Align2, Color32, ColorImage, FontId, Pos2, Rect, Sense, Stroke, TextureHandle,
     TextureOptions, Ui, Vec2,
 };
 use glam::DVec3;
 use std::sync::Arc;
-use std::time::Duration;
 
-/// Map resolution in the window (pixels per side): 16 384 pairs, a few
-/// milliseconds for an analytic model.
-pub const WINDOW_RES: usize = 160;
-/// Map resolution of figures.
-pub const FIGURE_RES: usize = 320;
 /// The colour bar's lowest decade: `bv check`'s verdict threshold (values
 /// below it are reciprocal to the check and drawn as the bottom colour).
 pub const LOG_MIN: i32 = -6;
 /// The colour bar's top decade (a relative difference is at most 1 for
 /// non-negative values).
 pub const LOG_MAX: i32 = 0;
-
-/// What a map was computed for: BRDF revision, ωi (θ, φ bits), resolution.
-pub type Key = (u64, u64, u64, usize);
 
 /// The position of `v` on the colour bar, 0..1.
 pub fn bar_position(v: f64) -> f32 {
@@ -62,11 +52,6 @@ pub fn to_image(map: &ReciprocityMap) -> ColorImage {
     ColorImage::new([map.width, map.height], pixels)
 }
 
-/// The maps of the process, shared through egui's memory (slot: BRDF id).
-fn slots(ctx: &egui::Context) -> Arc<Slots<Key, Arc<ReciprocityMap>>> {
-    background::shared(ctx, "reciprocity map")
-}
-
 /// The reciprocity-map view.
 #[derive(Default)]
 pub struct ReciprocityView {
@@ -78,15 +63,6 @@ pub struct ReciprocityView {
     waiting: bool,
 }
 
-fn key_of(scene: &Scene<'_>, b: &SceneBrdf, res: usize) -> Key {
-    (
-        b.revision,
-        scene.incident.theta_deg.to_bits(),
-        scene.incident.phi_deg.to_bits(),
-        res,
-    )
-}
-
 impl ReciprocityView {
     /// The map of `b` for this frame: computed now for a figure, else the
     /// latest finished one (with whether it is stale).
@@ -96,35 +72,10 @@ impl ReciprocityView {
         scene: &Scene<'_>,
         b: &SceneBrdf,
     ) -> Option<(Key, Arc<ReciprocityMap>, bool)> {
-        let res = if scene.figure { FIGURE_RES } else { WINDOW_RES };
-        let key = key_of(scene, b, res);
-        let wi = scene.wi();
-        let slots = slots(ctx);
-        if scene.figure {
-            if let Some(d) = slots.latest(b.id)
-                && d.key == key
-            {
-                return Some((key, d.value.clone(), false));
-            }
-            let t0 = Instant::now();
-            let m = Arc::new(reciprocity_map(b.brdf.as_ref(), wi, res, res));
-            slots.insert(b.id, key, m.clone(), t0.elapsed());
-            return Some((key, m, false));
-        }
-        let brdf = b.brdf.clone();
-        let c = ctx.clone();
-        let done = slots.request(
-            b.id,
-            key,
-            background::once(move || Arc::new(reciprocity_map(brdf.as_ref(), wi, res, res))),
-            move || c.request_repaint(),
-        );
-        self.waiting = slots.busy(b.id);
-        if self.waiting {
-            ctx.request_repaint_after(Duration::from_millis(50));
-        }
-        let d = done?;
-        Some((d.key, d.value.clone(), d.key != key))
+        let shown = reciprocity::map(&super::waker(ctx), scene, b);
+        self.waiting = shown.busy;
+        let d = shown.done?;
+        Some((d.key, d.value.clone(), shown.stale))
     }
 
     fn texture(&mut self, ctx: &egui::Context, key: Key, map: &ReciprocityMap) -> TextureHandle {

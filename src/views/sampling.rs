@@ -13,90 +13,15 @@
 //! evaluations, so that a browser page keeps drawing) and cached by the
 //! BRDF's revision and ωi; figures compute it before drawing.
 
-use super::background::{self, Slots};
 use super::{Scene, SceneBrdf, View, colormap};
+use crate::derive::sampling::{self, N_PHI, N_THETA, Outcome, SIGNIFICANCE, verdict};
 use crate::session::command::Command;
 use bv_core::analysis::reciprocity_map::hemisphere_to_disc;
-use bv_core::analysis::sample_histogram::{HistogramJob, HistogramOptions, SampleHistogram};
 use eframe::egui::{
     self, Align2, Color32, FontId, Mesh, Pos2, Rect, Sense, Shape, Stroke, Ui, Vec2,
 };
 use glam::DVec3;
 use std::f64::consts::PI;
-use std::sync::Arc;
-use std::time::Duration;
-
-/// Bins in `cos θ`: 10 rings of equal solid angle.
-pub const N_THETA: usize = 10;
-/// Bins in φ.
-pub const N_PHI: usize = 24;
-/// Draws for the histogram: enough that every bin a sampler visits has tens
-/// of draws, and quick (tens of milliseconds for an analytic model).
-pub const SAMPLES: usize = 100_000;
-/// Directions shown as points.
-pub const POINTS: usize = 1_500;
-/// The p-value below which the sampler is called inconsistent with its
-/// density (a 1 % test, as in PBRT-v4's and Mitsuba's χ² sampling tests).
-pub const SIGNIFICANCE: f64 = 0.01;
-
-/// What a histogram was computed for: BRDF revision, ωi (θ, φ bits).
-pub type Key = (u64, u64, u64);
-
-/// The histogram options this view uses.
-pub fn options() -> HistogramOptions {
-    HistogramOptions {
-        n_theta: N_THETA,
-        n_phi: N_PHI,
-        samples: SAMPLES,
-        seed: 1,
-        max_points: POINTS,
-        ..HistogramOptions::default()
-    }
-}
-
-type Outcome = Arc<Result<SampleHistogram, String>>;
-
-/// Draws or density evaluations per step of the background job: a few
-/// milliseconds of an analytic model in a browser page, where a step must
-/// fit in a slice of a frame.
-const WORK_PER_STEP: usize = 8192;
-
-/// One step of the histogram's computation (`job` holds it between steps).
-fn step(job: &mut Option<HistogramJob>, brdf: &dyn bv_core::Brdf, wi: DVec3) -> Option<Outcome> {
-    let j = match job {
-        Some(j) => j,
-        None => match HistogramJob::new(wi, &options()) {
-            Ok(j) => job.insert(j),
-            Err(e) => return Some(Arc::new(Err(e.to_string()))),
-        },
-    };
-    j.step(brdf, WORK_PER_STEP).map(|h| Arc::new(Ok(h)))
-}
-
-/// The verdict line of a histogram.
-pub fn verdict(h: &SampleHistogram) -> String {
-    let c = &h.chi2;
-    let sign = if c.p_value >= SIGNIFICANCE {
-        "passed: the draws follow the pdf"
-    } else {
-        "FAILED: the draws do not follow the pdf"
-    };
-    let mut s = format!(
-        "χ² = {} with {} degrees of freedom, p = {}: {sign} (1 % test)",
-        bv_core::text::fmt_value(c.statistic),
-        c.dof,
-        bv_core::text::fmt_value(c.p_value),
-    );
-    if c.impossible > 0 {
-        s.push_str(&format!("; {} draws where the pdf is 0", c.impossible));
-    }
-    s
-}
-
-/// The histograms of the process, shared through egui's memory (slot: BRDF id).
-fn slots(ctx: &egui::Context) -> Arc<Slots<Key, Outcome>> {
-    background::shared(ctx, "sample histogram")
-}
 
 /// The sampling view.
 #[derive(Default)]
@@ -108,14 +33,6 @@ pub struct SamplingView {
     waiting: bool,
 }
 
-fn key_of(scene: &Scene<'_>, b: &SceneBrdf) -> Key {
-    (
-        b.revision,
-        scene.incident.theta_deg.to_bits(),
-        scene.incident.phi_deg.to_bits(),
-    )
-}
-
 impl SamplingView {
     fn histogram(
         &mut self,
@@ -123,21 +40,9 @@ impl SamplingView {
         scene: &Scene<'_>,
         b: &SceneBrdf,
     ) -> Option<(Outcome, bool)> {
-        let wi = scene.wi();
-        let brdf = b.brdf.clone();
-        let (shown, busy) = slots(ctx).for_frame(
-            ctx,
-            b.id,
-            key_of(scene, b),
-            scene.figure,
-            Duration::from_millis(50),
-            {
-                let mut job = None;
-                move || step(&mut job, brdf.as_ref(), wi)
-            },
-        );
-        self.waiting = busy;
-        shown
+        let shown = sampling::histogram(&super::waker(ctx), scene, b);
+        self.waiting = shown.busy;
+        shown.value()
     }
 }
 
@@ -354,80 +259,5 @@ impl View for SamplingView {
 
     fn busy(&self) -> bool {
         self.waiting
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The view's histogram, computed in its background job's steps.
-    fn compute(brdf: &dyn bv_core::Brdf, wi: DVec3) -> Outcome {
-        let mut job = None;
-        background::run_to_end(|| step(&mut job, brdf, wi))
-    }
-
-    /// The steps of the background job add up to the one-shot histogram of
-    /// bv-core (same draws, same bins, same χ²), though the job takes
-    /// `SAMPLES / WORK_PER_STEP` and more steps.
-    #[test]
-    fn the_stepped_histogram_is_the_one_shot_one() {
-        let ct = bv_core::ModelSpec::new("cook-torrance")
-            .unwrap()
-            .build()
-            .unwrap();
-        let wi = DVec3::new(0.5, -0.2, 0.8).normalize();
-        let mut job = None;
-        let mut steps = 0;
-        let stepped = background::run_to_end(|| {
-            steps += 1;
-            step(&mut job, ct.as_ref(), wi)
-        });
-        assert!(steps > SAMPLES / WORK_PER_STEP, "{steps} steps");
-        let once =
-            bv_core::analysis::sample_histogram::sample_histogram(ct.as_ref(), wi, &options())
-                .unwrap();
-        assert_eq!(stepped.as_ref().as_ref().unwrap(), &once);
-    }
-
-    /// Lambert's cosine sampler matches its density; a sampler that draws
-    /// uniformly while claiming the cosine density is rejected.
-    #[test]
-    fn the_verdict_tells_a_good_sampler_from_a_bad_one() {
-        let lambert = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
-        let wi = DVec3::new(0.3, 0.1, 0.95).normalize();
-        let good = compute(lambert.as_ref(), wi);
-        let good = good.as_ref().as_ref().unwrap();
-        assert!(good.chi2.p_value >= SIGNIFICANCE, "{}", verdict(good));
-        assert!(verdict(good).contains("passed"));
-
-        #[derive(Debug)]
-        struct Liar;
-        impl bv_core::Brdf for Liar {
-            fn id(&self) -> &'static str {
-                "uniform sampler claiming the cosine density"
-            }
-            fn eval(&self, _wi: DVec3, _wo: DVec3) -> bv_core::Rgb {
-                bv_core::Rgb::splat(std::f64::consts::FRAC_1_PI)
-            }
-            fn claims(&self) -> bv_core::Claims {
-                bv_core::Claims {
-                    reciprocal: true,
-                    energy_conserving: true,
-                    isotropic: true,
-                }
-            }
-            fn sample(&self, _wi: DVec3, u: glam::DVec2) -> Option<DVec3> {
-                // Uniform over the hemisphere: z uniform in (0, 1].
-                let z = 1.0 - u.x;
-                let s = (1.0 - z * z).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                Some(DVec3::new(s * phi.cos(), s * phi.sin(), z))
-            }
-        }
-        let bad = compute(&Liar, wi);
-        let bad = bad.as_ref().as_ref().unwrap();
-        assert!(bad.chi2.p_value < 1e-6, "{}", verdict(bad));
-        assert!(verdict(bad).contains("FAILED"));
     }
 }

@@ -20,6 +20,7 @@ use super::chart::{self, Chart, Marker, Palette, Series};
 use super::curves;
 use super::svg::Svg;
 use super::{Scene, View};
+use crate::derive::slices;
 use crate::session::command::Command;
 use bv_core::frame;
 use eframe::egui::{self, RichText, Ui};
@@ -135,7 +136,7 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
             let points = xs_signed
                 .iter()
                 .map(|&x| {
-                    let wo = curves::plane_direction(x.to_radians(), phi_i);
+                    let wo = slices::plane_direction(x.to_radians(), phi_i);
                     let g = frame::half_vector(wi, wo).map_or(f64::NAN, |h| (t.g2)(wi, wo, h));
                     [x, g]
                 })
@@ -151,7 +152,7 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
         if show.g1 {
             let points = xs_signed
                 .iter()
-                .map(|&x| [x, (t.g1)(curves::plane_direction(x.to_radians(), phi_i))])
+                .map(|&x| [x, (t.g1)(slices::plane_direction(x.to_radians(), phi_i))])
                 .collect();
             g_series.push(Series {
                 label: format!("{}: G1(ωo)", b.label),
@@ -196,7 +197,7 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
             ..Default::default()
         };
         c.vlines.push(Marker {
-            at: curves::incident_signed_angle(theta_i.to_radians()).to_degrees(),
+            at: slices::incident_signed_angle(theta_i.to_radians()).to_degrees(),
             color: super::light_color(dark),
             dashed: false,
             label: "ωi".into(),
@@ -396,7 +397,7 @@ impl View for TermsView {
                 let log_y =
                     self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
                 // The scale is part of the id: each keeps its own zoom.
-                let id = super::view_id("terms").with((k, log_y));
+                let id = super::view_id(crate::session::views::TERMS.id).with((k, log_y));
                 plot_chart(ui, id, c, height, log_y);
             }
         }

@@ -26,6 +26,7 @@ pub mod models;
 pub mod optics;
 pub mod params;
 pub mod presets;
+pub mod quadrature;
 pub mod registry;
 pub mod represent;
 pub mod rotated;

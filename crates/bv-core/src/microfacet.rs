@@ -8,6 +8,7 @@
 
 use crate::batch::lanes::{LaneMask, Lanes};
 use crate::batch::math;
+use crate::quadrature::{gauss_legendre, integrate};
 use crate::{BvError, Ndf, Result};
 use glam::{DVec2, DVec3};
 use std::f64::consts::{FRAC_1_PI, PI};
@@ -123,50 +124,6 @@ pub fn v_groove_g(wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
     }
     let k = 2.0 * h.z / oh;
     1.0f64.min(k * wo.z).min(k * wi.z)
-}
-
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton iteration on P_n, Golub
-/// & Welsch's initial guesses; exact for polynomials of degree 2n − 1).
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            // P_n(x) and P_n'(x) by the three-term recurrence.
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let kf = k as f64;
-                let p2 = ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf;
-                p0 = p1;
-                p1 = p2;
-            }
-            let pn = if n == 0 { 1.0 } else { p1 };
-            let pn1 = if n == 0 { 0.0 } else { p0 };
-            dp = n as f64 * (x * pn - pn1) / (x * x - 1.0);
-            let dx = pn / dp;
-            x -= dx;
-            if dx.abs() < 1e-16 {
-                break;
-            }
-        }
-        out.push((x, 2.0 / ((1.0 - x * x) * dp * dp)));
-    }
-    out
-}
-
-/// Integral of `f` over `[a, b]` by composite Gauss–Legendre (`panels` equal
-/// panels of `gl` nodes each).
-pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, panels: usize, gl: &[(f64, f64)]) -> f64 {
-    let h = (b - a) / panels as f64;
-    let mut sum = 0.0;
-    for p in 0..panels {
-        let lo = a + p as f64 * h;
-        for &(x, w) in gl {
-            sum += w * f(lo + 0.5 * h * (x + 1.0));
-        }
-    }
-    sum * 0.5 * h
 }
 
 /// The constant `c` of Blinn's distribution `c · exp(−(θh/α)²)` such that

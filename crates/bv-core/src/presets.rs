@@ -22,9 +22,11 @@
 //! The presets shipped in the repository's `assets/presets/` are compiled
 //! into the library ([`SHIPPED`]), so the binary has them without the folder.
 
+use crate::error::quote;
 use crate::{BvError, ModelSpec, Result};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 /// The categories a preset may declare.
 pub const CATEGORIES: &[&str] = &["conductor", "dielectric", "cook-torrance-1982", "other"];
@@ -224,9 +226,110 @@ pub fn shipped() -> Loaded {
     out
 }
 
+/// The shipped presets with the file name each came from (without `.toml`).
+static SHIPPED_NAMED: LazyLock<Vec<(String, Preset)>> = LazyLock::new(|| {
+    SHIPPED
+        .iter()
+        .filter_map(|(file, text)| {
+            let stem = file.strip_suffix(".toml").unwrap_or(file).to_string();
+            parse_named(file, text).ok().map(|p| (stem, p))
+        })
+        .collect()
+});
+
+/// The same presets as one slice (what [`search`] takes).
+static PRESETS: LazyLock<Vec<Preset>> =
+    LazyLock::new(|| SHIPPED_NAMED.iter().map(|(_, p)| p.clone()).collect());
+
+/// The compiled-in presets (those that parse; the core's tests hold all).
+pub fn shipped_presets() -> &'static [Preset] {
+    &PRESETS
+}
+
+/// The shipped preset called `name` (its display name or its file name,
+/// ignoring case): what the panel, `--preset` and decks look up. An unknown
+/// name is an error listing the close matches.
+pub fn find(name: &str) -> Result<&'static Preset> {
+    let q = name.trim().to_lowercase();
+    if let Some((_, p)) = SHIPPED_NAMED
+        .iter()
+        .find(|(stem, p)| p.name.to_lowercase() == q || stem.to_lowercase() == q)
+    {
+        return Ok(p);
+    }
+    let close = close_matches(&q);
+    if close.is_empty() {
+        let all: Vec<&str> = SHIPPED_NAMED.iter().map(|(_, p)| p.name.as_str()).collect();
+        return Err(BvError::Invalid(format!(
+            "unknown preset `{}`; the presets are: {}",
+            quote(name),
+            all.join(", ")
+        )));
+    }
+    Err(BvError::Invalid(format!(
+        "unknown preset `{}`; close matches: {}",
+        quote(name),
+        close.join(", ")
+    )))
+}
+
+/// Names of presets that contain the query, or whose name or file name is
+/// within a few edits of it (closest first).
+fn close_matches(q: &str) -> Vec<String> {
+    let mut scored: Vec<(usize, &str)> = SHIPPED_NAMED
+        .iter()
+        .filter_map(|(stem, p)| {
+            let n = p.name.to_lowercase();
+            // The bare material word of "Copper (Cook-Torrance 1982)".
+            let head = n.split(" (").next().unwrap_or(&n).to_string();
+            let d = if !q.is_empty() && (n.contains(q) || stem.contains(q)) {
+                0
+            } else {
+                edit_distance(q, &head)
+                    .min(edit_distance(q, &n))
+                    .min(edit_distance(q, stem))
+            };
+            // A third of the query's letters wrong, at least two: a typo,
+            // not another word.
+            (d <= (q.chars().count() / 3).max(2)).then_some((d, p.name.as_str()))
+        })
+        .collect();
+    scored.sort_by_key(|&(d, n)| (d, n.len()));
+    scored
+        .into_iter()
+        .take(8)
+        .map(|(_, n)| n.to_string())
+        .collect()
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions), by
+/// characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn edit_distance_by_hand() {
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("gold", "gold"), 0);
+        assert_eq!(edit_distance("gld", "gold"), 1);
+    }
     use crate::Rgb;
 
     #[test]

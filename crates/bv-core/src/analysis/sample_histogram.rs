@@ -18,7 +18,7 @@
 //! density leaves unaccounted for over the hemisphere.
 
 use super::chi2::{ChiSquare, chi_square};
-use crate::represent::sh::gauss_legendre;
+use crate::quadrature::gauss_legendre;
 use crate::{Brdf, BvError, Result, sampling};
 use glam::DVec3;
 use std::f64::consts::PI;

@@ -15,6 +15,7 @@
 //! `Y_l0 = K_l0 P_l(z)`, `Y_lm = √2 K_lm P_l^m(z) cos mφ`,
 //! `Y_l,−m = √2 K_lm P_l^m(z) sin mφ` (m > 0). Index `l(l + 1) + m`.
 
+use crate::quadrature::gauss_legendre;
 use crate::{Brdf, BvError, Result, Rgb, mean_rgb};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -90,34 +91,6 @@ pub enum Domain {
     Hemisphere,
     /// The whole sphere (transmitting models).
     Sphere,
-}
-
-/// Gauss–Legendre nodes and weights on [−1, 1] (Newton on `P_n`; Golub–Welsch
-/// would do too). Exact for polynomials of degree ≤ 2n − 1.
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-    let mut out = Vec::with_capacity(n);
-    for i in 0..n {
-        // Tricomi's initial guess for the i-th root.
-        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0f64, x);
-            for k in 2..=n {
-                let kf = k as f64;
-                (p0, p1) = (p1, ((2.0 * kf - 1.0) * x * p1 - (kf - 1.0) * p0) / kf);
-            }
-            let p = if n == 0 { 1.0 } else { p1 };
-            let pm1 = if n == 1 { 1.0 } else { p0 };
-            dp = n as f64 * (x * p - pm1) / (x * x - 1.0);
-            let dx = p / dp;
-            x -= dx;
-            if dx.abs() < 1e-15 {
-                break;
-            }
-        }
-        out.push((x, 2.0 / ((1.0 - x * x) * dp * dp)));
-    }
-    out
 }
 
 /// A quadrature over a domain: `n_theta` Gauss–Legendre rings in `z = cos θ`
@@ -497,24 +470,6 @@ mod tests {
         for (i, (a, b)) in got.iter().zip(want).enumerate() {
             assert!((a - b).abs() < 1e-14, "{i}: {a} vs {b}");
         }
-    }
-
-    #[test]
-    fn gauss_legendre_three_points() {
-        // Nodes 0, ±√(3/5), weights 8/9, 5/9 (hand-derived from P3 = (5x³ − 3x)/2).
-        let mut g = gauss_legendre(3);
-        g.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let r = (0.6f64).sqrt();
-        let want = [(-r, 5.0 / 9.0), (0.0, 8.0 / 9.0), (r, 5.0 / 9.0)];
-        for (a, b) in g.iter().zip(want) {
-            assert!((a.0 - b.0).abs() < 1e-14 && (a.1 - b.1).abs() < 1e-14);
-        }
-        // 64 nodes integrate x^126 exactly: 2/127.
-        let s: f64 = gauss_legendre(64)
-            .iter()
-            .map(|(x, w)| w * x.powi(126))
-            .sum();
-        assert!((s - 2.0 / 127.0).abs() < 1e-13, "{s}");
     }
 
     #[test]

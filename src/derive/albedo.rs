@@ -1,0 +1,327 @@
+//! Directional albedo curves: `ρhd(θi) = ∫ f cos θo dωo` (plus the weights
+//! of delta lobes) against θi, with error bands, and the bihemispherical
+//! albedo ρhh. They are `bv_core::analysis::albedo`'s, the estimators
+//! `bv check` reports: deterministic Gauss–Kronrod quadrature for analytic
+//! models (band: its error estimate), Monte Carlo for measured ones (band:
+//! ±3 standard errors).
+//!
+//! A curve costs up to [`N_THETA`] × some 10⁵ evaluations plus ρhh, so it is
+//! a job in steps of a few θi (with progress), cached by (build revision, φi):
+//! the albedo view, figures, `bv render` and `bv slice` share it.
+
+use super::jobs::{self, Shown, Slots, Steps, Waker};
+use crate::session::frame::{Scene, SceneBrdf};
+use bv_core::analysis::albedo::{AlbedoOptions, Estimate, rho_hd_auto, rho_hh_auto, theta_grid};
+use bv_core::analysis::directions::stream_seed;
+use bv_core::{Brdf, mean_rgb};
+use rayon::prelude::*;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// θi samples: 0°, 2°, …, 88° (90° is left out: no light arrives there).
+pub const N_THETA: usize = 45;
+/// Evaluations per θi.
+pub const SAMPLES: usize = 4096;
+/// Evaluations for ρhh.
+pub const RHH_SAMPLES: usize = 32768;
+/// Seed of the estimates (fixed: the same BRDF always gives the same curve).
+pub const SEED: u64 = 0x0062_7661_6c62;
+/// Half-width of a Monte Carlo error band in standard errors (±3σ covers the
+/// true value with about 99 % probability for these 16-replica estimates); a
+/// quadrature's band is its error estimate.
+pub const BAND_SIGMAS: f64 = 3.0;
+
+/// The estimators' settings (quadrature for analytic models).
+fn options(seed: u64) -> AlbedoOptions {
+    AlbedoOptions {
+        samples: SAMPLES,
+        seed,
+        ..AlbedoOptions::default()
+    }
+}
+
+/// One finished curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlbedoData {
+    /// θi in degrees.
+    pub theta_deg: Vec<f64>,
+    /// ρhd at each θi.
+    pub rho: Vec<Estimate>,
+    /// ρhh.
+    pub rho_hh: Estimate,
+}
+
+/// The computation of an [`AlbedoData`] in steps: a few θi per step (as
+/// many as there are worker threads, computed in parallel; one in a browser
+/// page, where a step must fit in a slice of a frame), then ρhh.
+#[derive(Debug)]
+pub struct AlbedoJob {
+    phi_i: f64,
+    thetas: Vec<f64>,
+    rho: Vec<Estimate>,
+    per_step: usize,
+}
+
+impl AlbedoJob {
+    /// A job for the curve at azimuth `phi_i` (radians) computing
+    /// `per_step` θi per step (at least one).
+    pub fn new(phi_i: f64, per_step: usize) -> Self {
+        Self {
+            phi_i,
+            thetas: theta_grid(N_THETA),
+            rho: Vec::with_capacity(N_THETA),
+            per_step: per_step.max(1),
+        }
+    }
+
+    /// Steps finished ([`STEPS`] in all).
+    pub fn done(&self) -> usize {
+        self.rho.len()
+    }
+
+    /// Computes the next θi of `brdf` (or, once all are done, ρhh) and
+    /// returns the curve once it is complete. `brdf` must be the same at
+    /// every step.
+    pub fn step(&mut self, brdf: &dyn Brdf) -> Option<AlbedoData> {
+        let k0 = self.rho.len();
+        if k0 < self.thetas.len() {
+            let k1 = (k0 + self.per_step).min(self.thetas.len());
+            let phi_i = self.phi_i;
+            let part: Vec<Estimate> = self.thetas[k0..k1]
+                .par_iter()
+                .enumerate()
+                .map(|(j, &t)| {
+                    rho_hd_auto(brdf, t, phi_i, &options(stream_seed(SEED, (k0 + j) as u64)))
+                })
+                .collect();
+            self.rho.extend(part);
+            return None;
+        }
+        let rho_hh = rho_hh_auto(brdf, RHH_SAMPLES, &options(SEED));
+        Some(AlbedoData {
+            theta_deg: self.thetas.iter().map(|t| t.to_degrees()).collect(),
+            rho: std::mem::take(&mut self.rho),
+            rho_hh,
+        })
+    }
+}
+
+impl AlbedoData {
+    /// Computes the curve of `brdf` for light at azimuth `phi_i` (radians),
+    /// counting finished steps in `progress` ([`STEPS`] in all); `None` when
+    /// `cancel` was raised.
+    pub fn compute(
+        brdf: &dyn Brdf,
+        phi_i: f64,
+        progress: &AtomicUsize,
+        cancel: &AtomicBool,
+    ) -> Option<Self> {
+        // Every θi in one parallel step: the one-shot computation.
+        let mut job = AlbedoJob::new(phi_i, N_THETA);
+        loop {
+            if cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let d = job.step(brdf);
+            progress.store(job.done() + usize::from(d.is_some()), Ordering::Relaxed);
+            if d.is_some() {
+                return d;
+            }
+        }
+    }
+
+    /// The plotted value (channel mean) and its band half-width at sample `k`.
+    pub fn mean_and_band(&self, k: usize) -> (f64, f64) {
+        let e = &self.rho[k];
+        (mean_rgb(e.value), mean_rgb(e.allowance(BAND_SIGMAS)))
+    }
+
+    /// Whether some channel exceeds 1 by more than its error band somewhere.
+    pub fn exceeds_one(&self) -> bool {
+        self.rho.iter().any(|e| {
+            let band = e.allowance(BAND_SIGMAS);
+            (0..3).any(|c| e.value[c] - band[c] > 1.0 + 1e-9)
+        })
+    }
+
+    /// How the numbers were computed, for the legend: `quadrature` or
+    /// `monte carlo`.
+    pub fn method(&self) -> &'static str {
+        self.rho.first().map_or("quadrature", |e| e.method.name())
+    }
+}
+
+/// Steps of a computation (one per θi, one for ρhh).
+pub const STEPS: usize = N_THETA + 1;
+
+/// What a curve is keyed by: the BRDF's build revision (a turned surface
+/// has its own) and φi's bits.
+pub type Key = (u64, u64);
+
+/// A job computing the curve of one BRDF in steps, with progress.
+struct Run {
+    job: AlbedoJob,
+    brdf: Arc<dyn Brdf>,
+}
+
+impl Steps<Arc<AlbedoData>> for Run {
+    fn step(&mut self) -> Option<Arc<AlbedoData>> {
+        self.job.step(self.brdf.as_ref()).map(Arc::new)
+    }
+
+    fn progress(&self) -> Option<(usize, usize)> {
+        Some((self.job.done(), STEPS))
+    }
+}
+
+/// The curves of the process (slot: BRDF id).
+pub fn slots() -> Arc<Slots<Key, Arc<AlbedoData>>> {
+    jobs::slots("albedo curve")
+}
+
+/// The key of `b`'s curve under the scene's light.
+pub fn key_of(scene: &Scene<'_>, b: &SceneBrdf) -> Key {
+    (b.revision, scene.incident.phi_deg.to_bits())
+}
+
+fn run(scene: &Scene<'_>, b: &SceneBrdf, per_step: usize) -> Run {
+    Run {
+        job: AlbedoJob::new(scene.incident.phi_deg.to_radians(), per_step),
+        brdf: b.brdf.clone(),
+    }
+}
+
+/// The curve of `b`, computed now (blocking) unless it is cached or a job
+/// is computing it (then waited for): figures, `bv render`, scripts.
+pub fn curve_now(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<AlbedoData> {
+    // Every θi in one parallel step: the one-shot computation.
+    let value = slots().now(b.id, key_of(scene, b), run(scene, b, N_THETA));
+    value.value.clone()
+}
+
+/// The curve of `b` for this frame. A figure gets it computed now
+/// ([`curve_now`]); the window gets the latest finished one (stale when
+/// of older parameters) while a job computes the current one. A new key
+/// cancels the job of an older one (its result would be shown only
+/// briefly), and nothing starts while the pointer drags a control
+/// (`scene.interacting`): a drag computes the curve where it ends.
+pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<AlbedoData>> {
+    let key = key_of(scene, b);
+    if scene.figure {
+        return Shown {
+            done: Some(slots().now(b.id, key, run(scene, b, N_THETA))),
+            stale: false,
+            busy: false,
+            progress: None,
+        };
+    }
+    let slots = slots();
+    let done = if scene.interacting {
+        slots.latest(b.id)
+    } else {
+        slots.request_latest(
+            b.id,
+            key,
+            run(scene, b, rayon::current_num_threads()),
+            waker,
+        )
+    };
+    let busy = slots.busy(b.id);
+    if busy {
+        waker.wake_after(std::time::Duration::from_millis(100));
+    }
+    Shown {
+        stale: done.as_ref().is_some_and(|d| d.key != key),
+        done,
+        busy,
+        progress: slots.progress(b.id),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lambert_albedo_is_flat_at_its_albedo() {
+        // ρhd of a Lambertian surface is its albedo at every θi (∫ a/π cos dω = a).
+        let b = bv_core::ModelSpec::from_json("lambert", &serde_json::json!({"albedo": 0.6}))
+            .unwrap()
+            .build()
+            .unwrap();
+        let d = AlbedoData::compute(
+            b.as_ref(),
+            0.0,
+            &AtomicUsize::new(0),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        assert_eq!(d.rho.len(), N_THETA);
+        for k in 0..N_THETA {
+            let (v, band) = d.mean_and_band(k);
+            assert!(
+                (v - 0.6).abs() <= band.max(1e-9) + 1e-3,
+                "{k}: {v} ± {band}"
+            );
+        }
+        assert!((mean_rgb(d.rho_hh.value) - 0.6).abs() < 0.01);
+        assert!(!d.exceeds_one());
+    }
+
+    /// A job of one θi per step (as in a browser page) gives the curve that
+    /// bv-core's estimators give called one θi at a time here, and so the
+    /// one-shot computation's.
+    #[test]
+    fn the_curve_in_steps_is_the_one_shot_curve() {
+        let b = bv_core::ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"alpha": 0.3, "kd": 0.2}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let phi = 0.4;
+        let mut job = AlbedoJob::new(phi, 1);
+        let mut steps = 0;
+        let stepped = loop {
+            steps += 1;
+            if let Some(d) = job.step(b.as_ref()) {
+                break d;
+            }
+        };
+        assert_eq!(steps, STEPS);
+        let thetas = theta_grid(N_THETA);
+        let by_hand: Vec<Estimate> = thetas
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| rho_hd_auto(b.as_ref(), t, phi, &options(stream_seed(SEED, k as u64))))
+            .collect();
+        assert_eq!(stepped.rho, by_hand);
+        assert_eq!(
+            stepped.rho_hh,
+            rho_hh_auto(b.as_ref(), RHH_SAMPLES, &options(SEED))
+        );
+        let once = AlbedoData::compute(
+            b.as_ref(),
+            phi,
+            &AtomicUsize::new(0),
+            &AtomicBool::new(false),
+        )
+        .unwrap();
+        assert_eq!(stepped, once);
+    }
+
+    #[test]
+    fn cancelled_jobs_give_nothing() {
+        let b = bv_core::ModelSpec::new("lambert").unwrap().build().unwrap();
+        assert!(
+            AlbedoData::compute(
+                b.as_ref(),
+                0.0,
+                &AtomicUsize::new(0),
+                &AtomicBool::new(true)
+            )
+            .is_none()
+        );
+    }
+}
