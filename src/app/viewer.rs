@@ -13,10 +13,11 @@ use super::shortcuts::{self, Action};
 use crate::session::build_scene;
 use crate::session::command::Command;
 use crate::session::deck::{self, DeckError};
-use crate::session::loader::{self, LoadError, LoadTarget, Loader};
+use crate::session::loader::{LoadError, Loader};
 use crate::session::runtime::Runtime;
 use crate::session::scene_file as scene;
 use crate::session::state::{AppState, Theme};
+use crate::session::workspace::{Asks, Workspace};
 use crate::views::{REGISTRY, Scene, View, ViewEntry};
 use crate::widgets::files::Files;
 use eframe::egui::{self, Rect, RichText, Ui, UiBuilder, Vec2};
@@ -40,22 +41,14 @@ pub const GESTURES: &[(&str, &str)] = &[
 
 /// The viewer.
 pub struct Viewer {
-    state: AppState,
-    runtime: Runtime,
+    /// The live session: state, evaluators, waiting commands, reads.
+    ws: Workspace,
     views: Vec<(&'static ViewEntry, Box<dyn View>)>,
-    pending: Vec<Command>,
-    status: Option<String>,
     help: bool,
     applied_look: Option<(Theme, bool)>,
     present: Presenter,
     deck: Option<DeckSession>,
-    loader: Loader,
-    load_errors: Vec<LoadError>,
-    last_load: Option<String>,
     files: Files<()>,
-    /// Hot reload of the user BRDF files drawn.
-    reloader: crate::session::reload::Reloader,
-    reloader_woken: bool,
     /// Treat the frame as if a pointer button were held (scripted drags).
     pub force_interacting: bool,
     /// Draw as a figure (a screenshot of the window): views finish slow work
@@ -76,21 +69,13 @@ impl Viewer {
     /// A viewer showing `state`.
     pub fn new(state: AppState) -> Self {
         Self {
-            state: state.sanitised(),
-            runtime: Runtime::default(),
+            ws: Workspace::new(state),
             views: REGISTRY.iter().map(|e| (e, (e.make)())).collect(),
-            pending: Vec::new(),
-            status: None,
             help: false,
             applied_look: None,
             present: Presenter::default(),
             deck: None,
-            loader: Loader::default(),
-            load_errors: Vec::new(),
-            last_load: None,
             files: Files::default(),
-            reloader: Default::default(),
-            reloader_woken: false,
             force_interacting: false,
             figure: false,
             export: ExportUi::default(),
@@ -110,8 +95,7 @@ impl Viewer {
 
     /// Replaces the whole state (a scene was opened).
     pub fn replace_state(&mut self, state: AppState) {
-        self.state = state.sanitised();
-        self.pending.clear();
+        self.ws.replace_state(state);
     }
 
     /// Opens a scene file; returns its warnings. On error the state is
@@ -121,7 +105,7 @@ impl Viewer {
         // shows the error) rather than refusing the user's whole scene.
         let loaded = scene::load_with(path, scene::Builds::Warn)?;
         // Keep the theme the user chose for the window.
-        let theme = self.state.theme;
+        let theme = self.ws.state.theme;
         self.replace_state(AppState {
             theme,
             ..loaded.state
@@ -132,7 +116,7 @@ impl Viewer {
 
     /// Saves the state as a scene file (atomically).
     pub fn save_scene(&mut self, path: &Path) -> Result<(), scene::SceneError> {
-        scene::save(path, &self.state)?;
+        scene::save(path, &self.ws.state)?;
         self.export.scene_path = Some(path.to_path_buf());
         Ok(())
     }
@@ -151,15 +135,15 @@ impl Viewer {
             return;
         }
         if on {
-            self.present.maximised_before = Some(self.state.maximised.clone());
+            self.present.maximised_before = Some(self.ws.state.maximised.clone());
             self.present.controls = false;
-            if self.state.maximised.is_none() {
-                self.state.maximised = REGISTRY.first().map(|e| e.id.to_string());
+            if self.ws.state.maximised.is_none() {
+                self.ws.state.maximised = REGISTRY.first().map(|e| e.id.to_string());
             }
         } else if self.deck.is_none()
             && let Some(m) = self.present.maximised_before.take()
         {
-            self.state.maximised = m;
+            self.ws.state.maximised = m;
         }
         self.present.on = on;
     }
@@ -206,14 +190,14 @@ impl Viewer {
         let Some(slide) = d.deck.slides.get_mut(d.index) else {
             return;
         };
-        if let Some(v) = &self.state.maximised {
+        if let Some(v) = &self.ws.state.maximised {
             slide.view = v.clone();
         }
         let theme = slide.state.theme;
         slide.state = AppState {
             theme,
             maximised: Some(slide.view.clone()),
-            ..self.state.clone()
+            ..self.ws.state.clone()
         };
     }
 
@@ -226,7 +210,7 @@ impl Viewer {
         };
         // The window keeps the theme the lecturer chose for the room.
         let theme = if self.applied_look.is_some() {
-            self.state.theme
+            self.ws.state.theme
         } else {
             slide.state.theme
         };
@@ -252,13 +236,14 @@ impl Viewer {
             return;
         }
         let at = self
+            .ws
             .state
             .maximised
             .as_deref()
             .and_then(|m| REGISTRY.iter().position(|e| e.id == m))
             .unwrap_or(0) as i64;
         let to = (at + i64::from(delta)).rem_euclid(n) as usize;
-        self.state.maximised = Some(REGISTRY[to].id.to_string());
+        self.ws.state.maximised = Some(REGISTRY[to].id.to_string());
     }
 
     /// Jumps to the first (`last = false`) or last slide, or view.
@@ -272,7 +257,7 @@ impl Viewer {
             } else {
                 REGISTRY.first()
             };
-            self.state.maximised = e.map(|e| e.id.to_string());
+            self.ws.state.maximised = e.map(|e| e.id.to_string());
         }
     }
 
@@ -320,7 +305,7 @@ impl Viewer {
     fn strip_action(&mut self, a: StripAction) {
         match a {
             StripAction::Step(d) => self.step(d),
-            StripAction::View(id) => self.state.maximised = Some(id.to_string()),
+            StripAction::View(id) => self.ws.state.maximised = Some(id.to_string()),
             StripAction::ToggleControls => self.present.controls = !self.present.controls,
             StripAction::Exit => self.set_presenting(false),
         }
@@ -332,13 +317,13 @@ impl Viewer {
                 Ok(w) => {
                     let line = screenshot::warnings_line(&path, &w);
                     if !w.is_empty() {
-                        self.status = Some(line.clone());
+                        self.ws.status = Some(line.clone());
                     }
                     self.export.toast(line, false);
                 }
                 Err(e) => {
                     let msg = format!("Could not open {}: {e}", path.display());
-                    self.status = Some(msg.clone());
+                    self.ws.status = Some(msg.clone());
                     self.export.toast(msg, true);
                 }
             },
@@ -348,7 +333,7 @@ impl Viewer {
                     .toast(format!("Saved the scene to {}", path.display()), false),
                 Err(e) => {
                     let msg = format!("Could not save the scene: {e}");
-                    self.status = Some(msg.clone());
+                    self.ws.status = Some(msg.clone());
                     self.export.toast(msg, true);
                 }
             },
@@ -362,7 +347,7 @@ impl Viewer {
                     screenshot::Target::Window => None,
                 };
                 match self.export.export_figure(
-                    &self.state,
+                    &self.ws.state,
                     &settings,
                     &path,
                     geometry,
@@ -380,13 +365,13 @@ impl Viewer {
 
     /// The background reads of measured tables.
     pub fn loader(&self) -> &Loader {
-        &self.loader
+        &self.ws.loader
     }
 
     /// Files that could not be opened, oldest first (the error dialog shows
     /// the first until it is dismissed).
     pub fn load_errors(&self) -> &[LoadError] {
-        &self.load_errors
+        &self.ws.load_errors
     }
 
     /// Whether the file dialog is open.
@@ -394,70 +379,35 @@ impl Viewer {
         self.files.is_open()
     }
 
-    /// Applies the reads that have finished: a valid table becomes a BRDF (or
-    /// a BRDF's new file), a refused one an entry of the error dialog.
+    /// Applies the reads that have finished (see
+    /// [`Workspace::finish_loads`]).
     fn finish_loads(&mut self) {
-        for done in self.loader.poll() {
-            let path = std::fs::canonicalize(&done.path).unwrap_or(done.path.clone());
-            let text = path.display().to_string();
-            match done.result {
-                Ok(_) => {
-                    self.last_load = Some(format!(
-                        "read {} ({:.1} MB) in {:.2} s",
-                        loader::file_name(&path),
-                        done.bytes as f64 / 1e6,
-                        done.elapsed.as_secs_f64()
-                    ));
-                    let value = bv_core::ParamValue::Text(text);
-                    let cmd = match done.target {
-                        LoadTarget::Into { brdf, param } => {
-                            Command::SetParam { brdf, param, value }
-                        }
-                        LoadTarget::New => {
-                            let Some((model, param, _)) = loader::file_model_for(&path) else {
-                                self.status = Some("no model of this bv reads files".into());
-                                continue;
-                            };
-                            let mut spec = bv_core::ModelSpec::defaults(model);
-                            if let Err(e) = spec.set(param, value) {
-                                self.status = Some(e.to_string());
-                                continue;
-                            }
-                            Command::AddSpec(spec)
-                        }
-                    };
-                    self.apply(vec![cmd]);
-                }
-                Err(message) => self.load_errors.push(LoadError {
-                    path: text,
-                    message,
-                }),
-            }
-        }
+        let asks = self.ws.finish_loads();
+        self.answer(asks);
     }
 
     /// Waits (up to `timeout`) for the background reads and applies them; for
     /// tests and scripted drivers. Returns whether all finished.
     pub fn wait_for_loads(&mut self, timeout: std::time::Duration) -> bool {
-        let ok = self.loader.wait(timeout);
+        let ok = self.ws.loader.wait(timeout);
         self.finish_loads();
         ok
     }
 
     /// The current state (what is saved).
     pub fn state(&self) -> &AppState {
-        &self.state
+        &self.ws.state
     }
 
     /// Queues a command, applied at the start of the next frame.
     pub fn push(&mut self, c: Command) {
-        self.pending.push(c);
+        self.ws.push(c);
     }
 
     /// Applies the queued commands now.
     pub fn apply_pending(&mut self) {
-        let cmds = std::mem::take(&mut self.pending);
-        self.apply(cmds);
+        let asks = self.ws.apply_pending();
+        self.answer(asks);
     }
 
     /// The view of concrete type `T`, if registered.
@@ -473,7 +423,7 @@ impl Viewer {
     pub fn views_busy(&self) -> bool {
         // A view is hidden by another one being maximised, or by being
         // outside the overview grid.
-        let shown = |e: &ViewEntry| match self.state.maximised.as_deref() {
+        let shown = |e: &ViewEntry| match self.ws.state.maximised.as_deref() {
             Some(m) => m == e.id,
             None => e.in_grid,
         };
@@ -487,33 +437,33 @@ impl Viewer {
 
     /// The last status message (refused values, unknown models).
     pub fn status(&self) -> Option<&str> {
-        self.status.as_deref()
+        self.ws.status.as_deref()
     }
 
     /// The built evaluators.
     pub fn runtime(&self) -> &Runtime {
-        &self.runtime
+        &self.ws.runtime
     }
 
+    /// Applies `cmds` (the session's job, [`Workspace::apply`]) and does what
+    /// they ask of the window.
     fn apply(&mut self, cmds: Vec<Command>) {
-        for c in cmds {
-            let r = c.apply(&mut self.state);
-            if r.toggle_help {
-                self.help = !self.help;
-            }
-            if let Some(m) = r.message {
-                self.status = Some(m);
-            }
-            if let Some((path, target)) = r.open {
-                self.loader.start(path.into(), target);
-            }
-            if r.open_dialog && !self.files.is_open() {
-                self.files.open(
-                    (),
-                    "Open a MERL table (.binary) or a BRDF file (.brdf)",
-                    measured_ui::OPENABLE_FILES,
-                );
-            }
+        let asks = self.ws.apply(cmds);
+        self.answer(asks);
+    }
+
+    /// Shows what applying commands asked for: the help overlay, the file
+    /// dialog.
+    fn answer(&mut self, asks: Asks) {
+        if asks.toggle_help % 2 == 1 {
+            self.help = !self.help;
+        }
+        if asks.open_dialog && !self.files.is_open() {
+            self.files.open(
+                (),
+                "Open a MERL table (.binary) or a BRDF file (.brdf)",
+                measured_ui::OPENABLE_FILES,
+            );
         }
     }
 
@@ -527,9 +477,9 @@ impl Viewer {
         // the focus yet when the user starts typing.
         let keyboard_free =
             shortcuts::keyboard_free(&ctx) && !self.files.is_open() && !self.export.files_open();
-        let look = (self.state.theme, self.present.on);
+        let look = (self.ws.state.theme, self.present.on);
         if self.applied_look != Some(look) {
-            let theme = match self.state.theme {
+            let theme = match self.ws.state.theme {
                 Theme::Dark => egui::Theme::Dark,
                 Theme::Light => egui::Theme::Light,
             };
@@ -538,7 +488,7 @@ impl Viewer {
             if self.present.on || self.applied_look.is_some_and(|(_, p)| p) {
                 ctx.set_visuals_of(
                     theme,
-                    presentation::visuals(self.state.theme, self.present.on),
+                    presentation::visuals(self.ws.state.theme, self.present.on),
                 );
             }
             ctx.set_theme(theme);
@@ -548,11 +498,11 @@ impl Viewer {
         self.apply_pending();
         self.finish_loads();
         self.reload_user_files(&ctx);
-        if self.loader.busy() {
+        if self.ws.loader.busy() {
             // Keep the progress bar moving while nothing else happens.
             ctx.request_repaint_after(std::time::Duration::from_millis(40));
         }
-        self.runtime.sync(&self.state);
+        self.ws.runtime.sync(&self.ws.state);
         let interacting = self.force_interacting || ctx.input(|i| i.pointer.any_down());
         let mut out = Vec::new();
         let mut strip = Vec::new();
@@ -566,7 +516,7 @@ impl Viewer {
             self.left_panel(ui, &mut out);
         }
         {
-            let mut scene = build_scene(&self.state, &self.runtime, interacting);
+            let mut scene = build_scene(&self.ws.state, &self.ws.runtime, interacting);
             scene.figure = self.figure;
             let panel = egui::CentralPanel::default()
                 .frame(self.panel_frame(egui::Frame::central_panel(ui.style())));
@@ -589,7 +539,7 @@ impl Viewer {
             ctx.request_repaint();
         }
         self.shortcuts(&ctx, keyboard_free, &mut out);
-        dropped_files(&ctx, &self.state, &self.runtime, &mut out);
+        dropped_files(&ctx, &self.ws.state, &self.ws.runtime, &mut out);
         self.help_window(&ctx);
         if let Some(((), path)) = self.files.show(&ctx) {
             out.push(Command::OpenFile {
@@ -597,8 +547,8 @@ impl Viewer {
                 into: None,
             });
         }
-        if measured_ui::error_window(&ctx, &self.load_errors) {
-            self.load_errors.remove(0);
+        if measured_ui::error_window(&ctx, &self.ws.load_errors) {
+            self.ws.load_errors.remove(0);
             ctx.request_repaint();
         }
         for r in self.export.ui(&ctx) {
@@ -607,10 +557,10 @@ impl Viewer {
         if !out.is_empty() {
             // Repaint only for real changes, so a widget that re-sends the same
             // value cannot keep the app busy.
-            let before = self.state.clone();
+            let before = self.ws.state.clone();
             let help = self.help;
             self.apply(out);
-            if self.state != before || self.help != help {
+            if self.ws.state != before || self.help != help {
                 ctx.request_repaint();
             }
         }
@@ -621,26 +571,12 @@ impl Viewer {
     /// longer compiles (with file, line and column) while its last working
     /// version stays drawn.
     fn reload_user_files(&mut self, ctx: &egui::Context) {
-        use crate::session::reload::ReloadEvent;
-        for ev in self.reloader.update(&mut self.state) {
-            match ev {
-                ReloadEvent::Reloaded { path } => {
-                    self.load_errors.retain(|e| e.path != path);
-                    self.status = Some(format!("reloaded {path}"));
-                }
-                ReloadEvent::Failed { path, message } => {
-                    self.load_errors.retain(|e| e.path != path);
-                    self.load_errors.push(LoadError { path, message });
-                }
-            }
+        let c = ctx.clone();
+        let (changed, settles) = self.ws.reload_user_files(move || c.request_repaint());
+        if changed {
             ctx.request_repaint();
         }
-        if !self.reloader_woken {
-            let c = ctx.clone();
-            self.reloader.set_waker(move || c.request_repaint());
-            self.reloader_woken = true;
-        }
-        if let Some(wait) = self.reloader.settles_in() {
+        if let Some(wait) = settles {
             ctx.request_repaint_after(wait);
         }
     }
@@ -682,7 +618,7 @@ impl Viewer {
                 }
                 ui.menu_button("Views", |ui| {
                     for e in REGISTRY.iter() {
-                        let on = self.state.maximised.as_deref() == Some(e.id);
+                        let on = self.ws.state.maximised.as_deref() == Some(e.id);
                         if ui
                             .selectable_label(on, e.title)
                             .on_hover_text("Show this view alone (again: back to the overview)")
@@ -701,7 +637,7 @@ impl Viewer {
                     {
                         out.push(Command::ToggleHelp);
                     }
-                    let (label, next) = match self.state.theme {
+                    let (label, next) = match self.ws.state.theme {
                         Theme::Dark => ("light theme", Theme::Light),
                         Theme::Light => ("dark theme", Theme::Dark),
                     };
@@ -716,6 +652,7 @@ impl Viewer {
     /// Presentation mode's title band and strip of views.
     fn presentation_bands(&mut self, ui: &mut Ui, strip: &mut Vec<StripAction>) {
         let shown = self
+            .ws
             .state
             .maximised
             .as_deref()
@@ -753,28 +690,28 @@ impl Viewer {
                 egui::ScrollArea::vertical()
                     .auto_shrink([false, false])
                     .show(ui, |ui| {
-                        panel::brdf_list(ui, &self.state, &self.runtime, out);
-                        measured_ui::progress_ui(ui, &self.loader);
+                        panel::brdf_list(ui, &self.ws.state, &self.ws.runtime, out);
+                        measured_ui::progress_ui(ui, &self.ws.loader);
                         ui.separator();
-                        panel::light_ui(ui, &self.state, out);
+                        panel::light_ui(ui, &self.ws.state, out);
                         ui.separator();
-                        panel::params_section(ui, &self.state, &self.runtime, out);
-                        if let Some(e) = self.state.selected_entry() {
+                        panel::params_section(ui, &self.ws.state, &self.ws.runtime, out);
+                        if let Some(e) = self.ws.state.selected_entry() {
                             measured_ui::measured_section(
                                 ui,
-                                &self.state,
-                                &self.runtime,
+                                &self.ws.state,
+                                &self.ws.runtime,
                                 e,
-                                self.last_load.as_deref(),
+                                self.ws.last_load.as_deref(),
                             );
                         }
-                        if let Some(msg) = &self.status {
+                        if let Some(msg) = &self.ws.status {
                             ui.separator();
                             ui.horizontal_wrapped(|ui| {
                                 ui.colored_label(ui.visuals().warn_fg_color, msg);
                             });
                             if ui.small_button("dismiss").clicked() {
-                                self.status = None;
+                                self.ws.status = None;
                             }
                         }
                     });
@@ -845,7 +782,7 @@ impl Viewer {
                         out.push(Command::Maximise(None));
                     }
                 }
-                Action::ToggleTheme => out.push(Command::SetTheme(match self.state.theme {
+                Action::ToggleTheme => out.push(Command::SetTheme(match self.ws.state.theme {
                     Theme::Dark => Theme::Light,
                     Theme::Light => Theme::Dark,
                 })),
@@ -856,7 +793,7 @@ impl Viewer {
                         .toast(format!("Saved the deck to {}", p.display()), false),
                     Err(e) => {
                         let msg = format!("Could not save the deck: {e}");
-                        self.status = Some(msg.clone());
+                        self.ws.status = Some(msg.clone());
                         self.export.toast(msg, true);
                     }
                 },
@@ -1172,6 +1109,7 @@ fn view_frame(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::session::loader::LoadTarget;
 
     #[test]
     fn a_dropped_file_opens_as_a_new_brdf_or_fills_an_empty_one() {

@@ -31,6 +31,7 @@ pub mod scene_file;
 pub mod state;
 pub mod user_models;
 pub mod views;
+pub mod workspace;
 
 pub use command::Command;
 pub use frame::{Scene, SceneBrdf, build_scene};
