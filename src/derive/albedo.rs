@@ -201,10 +201,12 @@ pub fn curve_now(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<AlbedoData> {
 
 /// The curve of `b` for this frame. A figure gets it computed now
 /// ([`curve_now`]); the window gets the latest finished one (stale when
-/// of older parameters) while a job computes the current one. A new key
-/// cancels the job of an older one (its result would be shown only
-/// briefly), and nothing starts while the pointer drags a control
-/// (`scene.interacting`): a drag computes the curve where it ends.
+/// of older parameters) while a job computes the current one. Nothing
+/// starts while the pointer drags a control (`scene.interacting`): a drag
+/// computes the curve where it ends. (A job of an older key is not
+/// cancelled: the slot is the BRDF's id, which another scene of the process
+/// — a figure of a deck while the window shows its own — may share, and two
+/// scenes cancelling each other's jobs would never finish one.)
 pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<AlbedoData>> {
     let key = key_of(scene, b);
     if scene.figure {
@@ -219,7 +221,7 @@ pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<
     let done = if scene.interacting {
         slots.latest(b.id)
     } else {
-        slots.request_latest(
+        slots.request(
             b.id,
             key,
             run(scene, b, rayon::current_num_threads()),

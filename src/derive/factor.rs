@@ -40,7 +40,8 @@ pub type FactoredOutcome = Result<Arc<Factored>, String>;
 
 /// The process's factorisations (slot: BRDF id, key: build revision).
 pub fn factorizations() -> Arc<Slots<u64, FactoredOutcome>> {
-    jobs::slots("factorization")
+    // A factorisation holds a whole table (tens of megabytes): keep few.
+    jobs::slots_keeping("factorization", 2)
 }
 
 /// The factorisation of `brdf` at `revision`, from `slots` or computed now
@@ -339,7 +340,7 @@ fn view_step(
 
 /// The process's factorisation-view data (slot: BRDF id, key: revision).
 pub fn view_slots() -> Arc<Slots<u64, ViewOutcome>> {
-    jobs::slots("factorization view")
+    jobs::slots_keeping("factorization view", 2)
 }
 
 /// The factorisation view's data of `b` for this frame: computed now for a

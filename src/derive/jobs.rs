@@ -17,7 +17,7 @@
 
 use crate::session::platform::{self, Instant};
 use std::any::{Any, TypeId};
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, LazyLock, Mutex, MutexGuard};
 use std::time::Duration;
 
@@ -130,6 +130,11 @@ impl<K, V> Slot<K, V> {
 
 struct Inner<K, V> {
     slots: HashMap<u64, Slot<K, V>>,
+    /// The last finished results of any slot, newest last, found by key
+    /// (a slider back where it was, another window or test with the same
+    /// BRDF): at most `keep`.
+    recent: VecDeque<Arc<Done<K, V>>>,
+    keep: usize,
     clock: u64,
     /// Results computed (jobs finished and values computed by callers).
     computed: u64,
@@ -148,6 +153,8 @@ impl<K, V> Default for Slots<K, V> {
         Self {
             inner: Mutex::new(Inner {
                 slots: HashMap::new(),
+                recent: VecDeque::new(),
+                keep: DEFAULT_KEEP,
                 clock: 0,
                 computed: 0,
                 steps: 0,
@@ -161,6 +168,9 @@ impl<K, V> std::fmt::Debug for Slots<K, V> {
         f.debug_struct("Slots").finish_non_exhaustive()
     }
 }
+
+/// Finished results a kind keeps beyond each slot's latest, by default.
+pub const DEFAULT_KEEP: usize = 16;
 
 /// Slots not asked for in this many requests are dropped (removed BRDFs).
 const FORGET_AFTER: u64 = 2000;
@@ -186,6 +196,25 @@ impl<K, V: Clone> Shown<K, V> {
     }
 }
 
+impl<K, V> Inner<K, V>
+where
+    K: PartialEq,
+{
+    /// A finished result of `key` among the recent ones.
+    fn recent(&self, key: &K) -> Option<Arc<Done<K, V>>> {
+        self.recent.iter().rev().find(|d| d.key == *key).cloned()
+    }
+
+    /// Remembers a finished result (newest last, the oldest dropped).
+    fn remember(&mut self, done: &Arc<Done<K, V>>) {
+        self.recent.retain(|d| d.key != done.key);
+        self.recent.push_back(done.clone());
+        while self.recent.len() > self.keep {
+            self.recent.pop_front();
+        }
+    }
+}
+
 impl<K, V> Slots<K, V>
 where
     K: Clone + PartialEq + Send + Sync + 'static,
@@ -194,6 +223,14 @@ where
     fn lock(&self) -> MutexGuard<'_, Inner<K, V>> {
         // A poisoned lock means a job panicked; the map itself is consistent.
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Slots that keep `keep` finished results beyond each slot's latest
+    /// (fewer for large results: a factorisation holds a whole table).
+    pub fn keeping(keep: usize) -> Self {
+        let s = Self::default();
+        s.lock().keep = keep;
+        s
     }
 
     /// The latest finished result of `slot` (whatever its key), starting
@@ -212,8 +249,17 @@ where
         let now = g.clock;
         g.slots
             .retain(|_, s| s.running.is_some() || now.saturating_sub(s.last_use) < FORGET_AFTER);
+        let recent = g.recent(&key);
         let s = g.slots.entry(slot).or_insert_with(|| Slot::new(now));
         s.last_use = now;
+        if let Some(d) = recent
+            && s.done.as_ref().is_none_or(|x| x.key != key)
+        {
+            // Computed before (for this slot or another): no job, and a
+            // waiting one for an older key is moot.
+            s.done = Some(d);
+            s.waiting = None;
+        }
         let have = s.done.as_ref().is_some_and(|d| d.key == key);
         let running = s.running.as_ref() == Some(&key);
         let mut start = None;
@@ -239,26 +285,6 @@ where
         done
     }
 
-    /// [`Slots::request`] for a job whose older keys are of no more use (a
-    /// curve at the parameters the slider has left): a running job of
-    /// another key is cancelled at its next step, and `compute` runs after
-    /// it.
-    pub fn request_latest(
-        self: &Arc<Self>,
-        slot: u64,
-        key: K,
-        compute: impl Steps<V>,
-        waker: &Waker,
-    ) -> Option<Arc<Done<K, V>>> {
-        if let Some(s) = self.lock().slots.get_mut(&slot)
-            && s.running.as_ref().is_some_and(|k| *k != key)
-            && s.done.as_ref().is_none_or(|d| d.key != key)
-        {
-            s.cancel = true;
-        }
-        self.request(slot, key, compute, waker)
-    }
-
     /// Stores a result computed by the caller (figures compute before they
     /// draw instead of waiting for a job).
     pub fn insert(&self, slot: u64, key: K, value: V, elapsed: Duration) -> Arc<Done<K, V>> {
@@ -270,6 +296,7 @@ where
         let mut g = self.lock();
         g.clock += 1;
         g.computed += 1;
+        g.remember(&done);
         let now = g.clock;
         let s = g.slots.entry(slot).or_insert_with(|| Slot::new(now));
         s.last_use = now;
@@ -282,9 +309,15 @@ where
         self.lock().slots.get(&slot).and_then(|s| s.done.clone())
     }
 
-    /// The finished result of `slot` for `key`, without starting anything.
+    /// The finished result of `key` (in `slot`, or among the recent results
+    /// of any slot), without starting anything.
     pub fn get(&self, slot: u64, key: &K) -> Option<Arc<Done<K, V>>> {
-        self.latest(slot).filter(|d| d.key == *key)
+        let g = self.lock();
+        g.slots
+            .get(&slot)
+            .and_then(|s| s.done.clone())
+            .filter(|d| d.key == *key)
+            .or_else(|| g.recent(key))
     }
 
     /// Whether a job of `slot` is running or waiting.
@@ -343,7 +376,9 @@ where
                     let s = g.slots.get(&slot);
                     (
                         s.is_some_and(|s| s.running.as_ref() == Some(&key)),
-                        s.and_then(|s| s.done.clone()).filter(|d| d.key == key),
+                        s.and_then(|s| s.done.clone())
+                            .filter(|d| d.key == key)
+                            .or_else(|| g.recent(&key)),
                     )
                 };
                 if let Some(d) = done {
@@ -434,12 +469,11 @@ where
                 g.steps += 1;
                 match r {
                     Ok(None) => {
+                        // Whoever shows the progress polls it (`for_frame`
+                        // asks to be called again while a job runs): a wake
+                        // per step would ask for a frame per step.
                         if let Some(s) = g.slots.get_mut(&slot) {
                             s.progress = progress;
-                        }
-                        drop(g);
-                        if progress.is_some() {
-                            waker.wake();
                         }
                         return false;
                     }
@@ -453,14 +487,20 @@ where
                 if out.is_some() {
                     g.computed += 1;
                 }
+                let done = out.map(|value| {
+                    Arc::new(Done {
+                        key: key.clone(),
+                        value,
+                        elapsed,
+                    })
+                });
+                if let Some(d) = &done {
+                    g.remember(d);
+                }
                 match g.slots.get_mut(&slot) {
                     Some(s) => {
-                        if let Some(value) = out {
-                            s.done = Some(Arc::new(Done {
-                                key: key.clone(),
-                                value,
-                                elapsed,
-                            }));
+                        if let Some(d) = done {
+                            s.done = Some(d);
                         }
                         s.cancel = false;
                         s.progress = None;
@@ -500,8 +540,19 @@ type Store = HashMap<(TypeId, &'static str), Arc<dyn Any + Send + Sync>>;
 static STORE: LazyLock<Mutex<Store>> = LazyLock::new(Mutex::default);
 
 /// The process's slots of type `Slots<K, V>` named `name`: the same object
-/// for the window, figures, the command line and tests.
+/// for the window, figures, the command line and tests (keeping
+/// [`DEFAULT_KEEP`] recent results).
 pub fn slots<K, V>(name: &'static str) -> Arc<Slots<K, V>>
+where
+    K: Clone + PartialEq + Send + Sync + 'static,
+    V: Send + Sync + 'static,
+{
+    slots_keeping(name, DEFAULT_KEEP)
+}
+
+/// [`slots`], keeping `keep` recent results when it makes them (the first
+/// call for a name decides).
+pub fn slots_keeping<K, V>(name: &'static str, keep: usize) -> Arc<Slots<K, V>>
 where
     K: Clone + PartialEq + Send + Sync + 'static,
     V: Send + Sync + 'static,
@@ -509,7 +560,7 @@ where
     let mut store = STORE.lock().unwrap_or_else(|e| e.into_inner());
     let any = store
         .entry((TypeId::of::<Slots<K, V>>(), name))
-        .or_insert_with(|| Arc::new(Slots::<K, V>::default()))
+        .or_insert_with(|| Arc::new(Slots::<K, V>::keeping(keep)))
         .clone();
     drop(store);
     // The entry was made with this very type (the key holds its TypeId).
@@ -651,5 +702,25 @@ mod tests {
             "the job's value, not a second computation"
         );
         assert_eq!(s.computed(), 1);
+    }
+
+    #[test]
+    fn a_key_computed_before_is_found_without_a_job() {
+        let s: Arc<Slots<u32, u32>> = Arc::new(Slots::keeping(2));
+        s.insert(1, 10, 100, Duration::ZERO);
+        s.insert(1, 11, 110, Duration::ZERO);
+        // Slot 1 shows key 11 now; key 10 is still remembered, also for
+        // another slot, and asking for it starts nothing.
+        let d = s
+            .request(2, 10, once(|| panic!("no job")), &Waker::none())
+            .unwrap();
+        assert_eq!(d.value, 100);
+        assert!(!s.busy(2));
+        assert_eq!(s.get(1, &10).unwrap().value, 100);
+        // The oldest of more than `keep` is forgotten.
+        s.insert(3, 12, 120, Duration::ZERO);
+        s.insert(3, 13, 130, Duration::ZERO);
+        assert!(s.get(5, &10).is_none());
+        assert_eq!(s.get(5, &13).unwrap().value, 130);
     }
 }

@@ -2,17 +2,18 @@
 //! only when its spec changed; its revision number then changes, which is the
 //! key the derived results' caches use (`crate::derive`).
 //!
-//! Revisions are unique in the process, and a spec that another runtime of
-//! the process has built (the window's, while `bv render` or a screenshot
-//! draws the same scene) is not built again: the runtimes share the
-//! evaluator and its revision, so a result derived for one is found by the
-//! other. Headless paths (figures, decks, meshes, SVG) use the process's one
-//! [`shared`] runtime.
+//! A revision names what was built, not when: it is a hash of the spec and
+//! the catalogue's revision (a reloaded user file is another model under the
+//! same id). So a result derived for one build is found by any later build
+//! of the same spec, in this runtime (a slider dragged back) or another one
+//! (the window's, while `bv render` or a screenshot draws the same scene).
+//! A spec another runtime of the process holds is not even built again: the
+//! runtimes share the evaluator. Headless paths (figures, decks, meshes,
+//! SVG) use the process's one [`shared`] runtime.
 
 use super::state::AppState;
 use bv_core::{Brdf, ModelSpec};
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, LazyLock, Mutex, MutexGuard, Weak};
 
 /// One built BRDF.
@@ -24,15 +25,21 @@ pub struct Built {
     pub brdf: Option<Arc<dyn Brdf>>,
     /// Why building failed.
     pub error: Option<String>,
-    /// Changes at every rebuild; unique in the process.
+    /// Names the build: equal for builds of the same spec under the same
+    /// catalogue, different otherwise (the key of derived results). The top
+    /// bit is clear (`session::frame` sets it for a turned surface).
     pub revision: u64,
 }
 
-/// The last revision handed out in the process.
-static REVISION: AtomicU64 = AtomicU64::new(0);
-
-fn next_revision() -> u64 {
-    REVISION.fetch_add(1, Ordering::Relaxed) + 1
+/// The revision of a build of `key`: a 63-bit hash (FNV-1a, stable across
+/// runs and platforms) of the spec's JSON and the catalogue revision.
+fn revision_of(key: &BuildKey) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in key.0.bytes().chain(key.1.to_le_bytes()) {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    (h & !(1 << 63)).max(1)
 }
 
 /// What a build is shared by: the spec (as JSON) and the catalogue revision
@@ -59,7 +66,7 @@ fn build(spec: &ModelSpec) -> (Result<Arc<dyn Brdf>, String>, bool, u64) {
     // Built outside the lock would let two runtimes build the same spec at
     // once; a build takes milliseconds (a MERL table is read by the loader
     // beforehand), so the lock is held.
-    let revision = next_revision();
+    let revision = revision_of(&key);
     match spec.build() {
         Ok(b) => {
             let b = Arc::<dyn Brdf>::from(b);
@@ -176,12 +183,17 @@ mod tests {
         ));
         assert_eq!(two.build_count(), 0);
         // Freed with the last runtime holding it: a later runtime builds
-        // anew, under a new revision.
+        // anew, under the same revision (its derived results still apply).
         let rev = x.revision;
         drop((one, two));
         let mut three = Runtime::default();
         three.sync(&s);
         assert_eq!(three.build_count(), 1);
-        assert_ne!(three.get(a).unwrap().revision, rev);
+        assert_eq!(three.get(a).unwrap().revision, rev);
+        // Another spec, another revision.
+        let b = s
+            .add(ModelSpec::from_json("ward", &serde_json::json!({"alpha_x": 0.1234568})).unwrap());
+        three.sync(&s);
+        assert_ne!(three.get(b).unwrap().revision, rev);
     }
 }

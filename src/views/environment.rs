@@ -707,14 +707,7 @@ impl View for EnvironmentView {
         });
 
         if let Some(why) = gpu_image::unavailable(ui.ctx(), "The environment view") {
-            backdrop.fill(&painter);
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                why,
-                egui::FontId::proportional(14.0),
-                weak,
-            );
+            gpu_image::unavailable_notice(&painter, rect, backdrop, &why, weak);
             return;
         }
         let (drawables, mut errors) =
@@ -805,13 +798,7 @@ impl View for EnvironmentView {
             });
         }
         if self.renderer.building() {
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                "compiling the shaders…",
-                egui::FontId::proportional(14.0),
-                weak,
-            );
+            gpu_image::centre_note(&painter, rect, "compiling the shaders…", weak);
         }
         if let Some(e) = self.error() {
             errors.push(e);
@@ -864,26 +851,14 @@ impl View for EnvironmentView {
                 Some(rect.width() / drawables.len().max(1) as f32),
             );
         }
-        let mut y = rect.min.y + 30.0;
-        for e in &errors {
-            let r = gpu_image::plate_text(
-                &painter,
-                egui::pos2(rect.min.x + 6.0, y),
-                Align2::LEFT_TOP,
-                e,
-                ui.visuals().warn_fg_color,
-            );
-            y = r.max.y + 4.0;
-        }
-        if drawables.is_empty() && errors.is_empty() {
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                "No BRDF shown: add one on the left",
-                egui::FontId::proportional(14.0),
-                weak,
-            );
-        }
+        gpu_image::errors_and_empty(
+            ui,
+            &painter,
+            rect,
+            rect.min.y + 30.0,
+            &errors,
+            drawables.is_empty(),
+        );
         if hovering_file {
             painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
             painter.text(

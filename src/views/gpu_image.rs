@@ -486,6 +486,61 @@ pub fn sphere_circle(rect: egui::Rect, tiles: usize) -> impl Fn(usize) -> (egui:
     }
 }
 
+/// What a view of the drawn BRDFs says when none is drawn.
+pub const NOTHING_DRAWN: &str = "No BRDF shown: add one on the left";
+
+/// A note in the middle of a view (its empty state, a renderer being built,
+/// a device it cannot draw with), in the weak text colour.
+pub fn centre_note(painter: &egui::Painter, rect: egui::Rect, text: &str, color: egui::Color32) {
+    painter.text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        text,
+        egui::FontId::proportional(14.0),
+        color,
+    );
+}
+
+/// The chrome the GPU image views share below their picture: the errors as
+/// warning plates stacked from `top` down the left edge, and, when nothing
+/// is drawn and nothing went wrong, [`NOTHING_DRAWN`] in the middle.
+pub fn errors_and_empty(
+    ui: &egui::Ui,
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    top: f32,
+    errors: &[String],
+    nothing_drawn: bool,
+) {
+    let mut y = top;
+    for e in errors {
+        let r = plate_text(
+            painter,
+            egui::pos2(rect.min.x + 6.0, y),
+            egui::Align2::LEFT_TOP,
+            e,
+            ui.visuals().warn_fg_color,
+        );
+        y = r.max.y + 4.0;
+    }
+    if nothing_drawn && errors.is_empty() {
+        centre_note(painter, rect, NOTHING_DRAWN, ui.visuals().weak_text_color());
+    }
+}
+
+/// A GPU view that cannot draw on this device (see [`unavailable`]): its
+/// backdrop filled and the reason in the middle.
+pub fn unavailable_notice(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    backdrop: Backdrop,
+    why: &str,
+    color: egui::Color32,
+) {
+    backdrop.fill(painter);
+    centre_note(painter, rect, why, color);
+}
+
 /// Draws text on a translucent plate (messages over rendered images).
 pub fn plate_text(
     painter: &egui::Painter,

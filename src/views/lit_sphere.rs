@@ -367,14 +367,7 @@ impl View for LitSphereView {
         // models on the CPU.
         let on_cpu = gpu_image::lacks_storage_buffers(ui.ctx());
         if !on_cpu && let Some(why) = gpu_image::unavailable(ui.ctx(), "The lit sphere") {
-            backdrop.fill(&painter);
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                why,
-                egui::FontId::proportional(14.0),
-                weak,
-            );
+            gpu_image::unavailable_notice(&painter, rect, backdrop, &why, weak);
             return;
         }
         let id = if on_cpu {
@@ -534,26 +527,14 @@ impl LitSphereView {
                 weak,
             );
         }
-        let mut y = rect.min.y + 24.0;
-        for e in errors {
-            let r = gpu_image::plate_text(
-                &painter,
-                egui::pos2(rect.min.x + 6.0, y),
-                Align2::LEFT_TOP,
-                e,
-                ui.visuals().warn_fg_color,
-            );
-            y = r.max.y + 4.0;
-        }
-        if drawables.is_empty() && errors.is_empty() {
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                "No BRDF shown: add one on the left",
-                egui::FontId::proportional(14.0),
-                weak,
-            );
-        }
+        gpu_image::errors_and_empty(
+            ui,
+            &painter,
+            rect,
+            rect.min.y + 24.0,
+            &errors,
+            drawables.is_empty(),
+        );
     }
 
     /// The radiance under the pointer, from bv-core in f64 (what the pixel

@@ -903,13 +903,7 @@ impl Lobe3dView {
             );
         }
         if scene.brdfs.is_empty() {
-            painter.text(
-                rect.center(),
-                Align2::CENTER_CENTER,
-                "No BRDF shown: add one on the left",
-                font,
-                weak,
-            );
+            super::gpu_image::centre_note(&painter, rect, super::gpu_image::NOTHING_DRAWN, weak);
         }
     }
 }
