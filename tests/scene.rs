@@ -208,7 +208,10 @@ e = 50
 
 #[test]
 fn an_interrupted_save_leaves_the_old_file_intact() {
-    let path = tmp("interrupted.toml");
+    // A folder of its own: the other tests of this binary save in parallel,
+    // and a save of theirs in flight is a temporary of this process too.
+    let path = tmp("interrupted/interrupted.toml");
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
     let old = rich_state();
     scene::save(&path, &old).unwrap();
     let before = std::fs::read(&path).unwrap();

@@ -151,14 +151,9 @@ struct PendingPng {
     what: &'static str,
 }
 
-/// Which views have a vector (SVG) form: asked of each view on an empty scene.
+/// Which views have a vector (SVG) form.
 fn svg_views() -> Vec<&'static str> {
-    let state = AppState::default();
-    REGISTRY
-        .iter()
-        .filter(|e| export::view_svg(&state, e, [200.0, 150.0], false).is_some())
-        .map(|e| e.id)
-        .collect()
+    export::files::svg_views().iter().map(|e| e.id).collect()
 }
 
 impl ExportUi {
@@ -472,30 +467,21 @@ impl ExportUi {
             }
             Format::Svg => {
                 let e = entry.ok_or_else(|| anyhow::anyhow!("SVG needs a 2D plot view"))?;
-                let svg = export::view_svg(state, e, [size.x, size.y], settings.transparent)
-                    .ok_or_else(|| {
-                        anyhow::anyhow!("{} has no vector form; save it as PNG", e.title)
-                    })?;
-                export::write_file(path, svg.as_bytes())?;
+                export::files::write_view_svg(
+                    state,
+                    e,
+                    [size.x, size.y],
+                    settings.transparent,
+                    path,
+                )?;
                 Ok(format!("Saved {} as SVG to {}", e.title, path.display()))
             }
             Format::Mesh => {
-                let meshes = export::mesh::lobe_meshes(state);
-                let Some(first) = meshes.first() else {
-                    anyhow::bail!("no BRDF is shown: nothing to export");
-                };
-                let ply = path
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("ply"));
-                let text = if ply {
-                    export::mesh::to_ply(state, first)
-                } else {
-                    export::mesh::to_obj(state, &meshes)
-                };
-                export::write_file(path, text.as_bytes())?;
+                let ply = export::files::Kind::of(path) == Some(export::files::Kind::Ply);
+                let n = export::files::write_mesh(state, ply, path)?;
                 Ok(format!(
                     "Saved the lobe mesh{} to {}",
-                    if ply { "" } else { "es" },
+                    if n == 1 { "" } else { "es" },
                     path.display()
                 ))
             }

@@ -4,6 +4,7 @@
 //! per view into a folder, with a progress bar on stderr.
 
 use super::params::spec_from_cli;
+use crate::export::files::{self, Kind};
 use crate::export::{self, Frame, Offscreen};
 use crate::session::deck;
 use crate::session::lighting::MAX_TARGET_SPP;
@@ -233,33 +234,8 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
     Ok(state.sanitised())
 }
 
-/// The output kinds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
-    Png,
-    Svg,
-    Obj,
-    Ply,
-}
-
-/// The output kind `path`'s extension names, in any case (`X.PNG` is a
-/// PNG: a folder of that name would surprise everyone).
-fn ext_kind(path: &Path) -> Option<Kind> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match ext.as_deref() {
-        Some("png") => Some(Kind::Png),
-        Some("svg") => Some(Kind::Svg),
-        Some("obj") => Some(Kind::Obj),
-        Some("ply") => Some(Kind::Ply),
-        _ => None,
-    }
-}
-
 fn kind_of(path: &Path) -> Result<Kind> {
-    match ext_kind(path) {
+    match Kind::of(path) {
         Some(k) => Ok(k),
         None => bail!(
             "--out {}: the extension picks the format: .png, .svg (2D plots), .obj or .ply (lobe mesh)",
@@ -339,8 +315,7 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
             bail!("--view window: only PNG (--out FILE.png)");
         }
         let mut off = open_device(frame)?;
-        let img = export::render_window(&mut off, &state, frame, shell.window)?;
-        return export::save_png(&img, &a.out);
+        return files::write_window_png(&mut off, &state, frame, (shell.window)(&state), &a.out);
     }
     if !all {
         let e = views[0];
@@ -348,23 +323,23 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
         return match kind {
             Kind::Png => {
                 let mut off = open_device(frame)?;
-                write_png(&mut off, &state, e, frame, &a.out)
+                files::write_view_png(&mut off, &state, e, frame, &a.out)
             }
-            Kind::Svg => write_svg(&state, e, frame, &a.out),
+            Kind::Svg => files::write_view_svg(&state, e, svg_size(frame), a.transparent, &a.out),
             Kind::Obj | Kind::Ply => {
-                if e.id != "lobe" {
+                if e.id != crate::session::views::LOBE.id {
                     bail!(
                         "--out {}: meshes come from the lobe view (--view lobe3d)",
                         a.out.display()
                     );
                 }
-                write_mesh(&state, kind, &a.out)
+                files::write_mesh(&state, kind == Kind::Ply, &a.out).map(|_| ())
             }
         };
     }
 
     // --view all: a folder of PNGs (and SVGs).
-    if matches!(ext_kind(&a.out), Some(Kind::Png | Kind::Svg)) {
+    if matches!(Kind::of(&a.out), Some(Kind::Png | Kind::Svg)) {
         bail!(
             "--view all writes one file per view: --out must be a folder, not {}",
             a.out.display()
@@ -373,10 +348,11 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
     std::fs::create_dir_all(&a.out)
         .with_context(|| format!("cannot create the folder {}", a.out.display()))?;
     let svg_views: Vec<&ViewEntry> = if a.svg {
+        let vector = files::svg_views();
         views
             .iter()
             .copied()
-            .filter(|e| export::view_svg(&AppState::default(), e, [200.0, 150.0], false).is_some())
+            .filter(|e| vector.iter().any(|v| v.id == e.id))
             .collect()
     } else {
         Vec::new()
@@ -390,13 +366,13 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
     progress.step(done, "starting");
     for e in &views {
         let path = a.out.join(format!("{}.png", e.id));
-        write_png(&mut off, &state, e, frame, &path)?;
+        files::write_view_png(&mut off, &state, e, frame, &path)?;
         done += 1;
         progress.step(done, &path.display().to_string());
     }
     for e in &svg_views {
         let path = a.out.join(format!("{}.svg", e.id));
-        write_svg(&state, e, frame, &path)?;
+        files::write_view_svg(&state, e, svg_size(frame), a.transparent, &path)?;
         done += 1;
         progress.step(done, &path.display().to_string());
     }
@@ -435,7 +411,7 @@ fn render_deck(
             s.state.display.cosine = true;
         }
     }
-    if ext_kind(&a.out).is_some() {
+    if Kind::of(&a.out).is_some() {
         bail!(
             "--deck writes one PNG per scene: --out must be a folder, not {}",
             a.out.display()
@@ -467,12 +443,8 @@ fn render_deck(
             .out
             .join(format!("{:0digits$}-{}.png", i + 1, deck::slug(&s.title)));
         let title = quote(&s.title);
-        let img = export::render_ui(off, &s.state, frame, make(&d, i))
+        files::write_window_png(off, &s.state, frame, make(&d, i), &file)
             .with_context(|| format!("drawing scene {} (\"{title}\")", i + 1))?;
-        if export::is_blank(&img) {
-            bail!("scene {} (\"{title}\") came out blank", i + 1);
-        }
-        export::save_png(&img, &file)?;
         progress.step(i + 1, &file.display().to_string());
     }
     Ok(())
@@ -494,50 +466,13 @@ fn open_device(frame: Frame) -> Result<Offscreen> {
     Ok(off)
 }
 
-fn write_png(
-    off: &mut Offscreen,
-    state: &AppState,
-    e: &ViewEntry,
-    frame: Frame,
-    path: &Path,
-) -> Result<()> {
-    let img = export::render_view(off, state, e, frame)
-        .with_context(|| format!("drawing the {} view", e.id))?;
-    export::save_png(&img, path)
-}
-
-fn write_svg(state: &AppState, e: &ViewEntry, frame: Frame, path: &Path) -> Result<()> {
-    let size = [
+/// The size of a view's SVG in points: the frame less its margins (what
+/// the PNG of the same frame draws the view in).
+fn svg_size(frame: Frame) -> [f32; 2] {
+    [
         frame.size.x - 2.0 * export::FIGURE_MARGIN,
         frame.size.y - 2.0 * export::FIGURE_MARGIN,
-    ];
-    let Some(svg) = export::view_svg(state, e, size, frame.transparent) else {
-        bail!(
-            "the {} view has no vector form; write a .png (SVG: {})",
-            e.id,
-            REGISTRY
-                .iter()
-                .filter(
-                    |v| export::view_svg(&AppState::default(), v, [200.0, 150.0], false).is_some()
-                )
-                .map(|v| v.id)
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    };
-    export::write_file(path, svg.as_bytes())
-}
-
-fn write_mesh(state: &AppState, kind: Kind, path: &Path) -> Result<()> {
-    let meshes = export::mesh::lobe_meshes(state);
-    let Some(first) = meshes.first() else {
-        bail!("no BRDF is drawn: nothing to export");
-    };
-    let text = match kind {
-        Kind::Ply => export::mesh::to_ply(state, first),
-        _ => export::mesh::to_obj(state, &meshes),
-    };
-    export::write_file(path, text.as_bytes())
+    ]
 }
 
 #[cfg(test)]

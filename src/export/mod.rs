@@ -5,6 +5,7 @@
 //! through here, so a figure from the command line and one from the window
 //! are drawn by the same code.
 
+pub mod files;
 pub mod mesh;
 pub mod offscreen;
 
@@ -14,6 +15,7 @@ use crate::session::state::{AppState, Theme};
 use crate::views::ViewEntry;
 use anyhow::{Context as _, Result, bail};
 use eframe::egui;
+pub use files::{is_blank, save_png, write_file};
 pub use offscreen::{Frame, Offscreen, PendingFigure};
 use std::path::Path;
 
@@ -207,49 +209,4 @@ pub fn view_svg(
     let scene = figure_scene(state, &runtime, transparent);
     let mut view = (entry.make)();
     view.svg(&scene, size, is_dark(state))
-}
-
-/// Saves a PNG, creating missing parent folders; written through a temporary
-/// file so that a failed write leaves no half image behind.
-pub fn save_png(img: &image::RgbaImage, path: &Path) -> Result<()> {
-    let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .context("encoding the PNG")?;
-    write_file(path, &bytes)
-}
-
-/// Writes a file atomically, creating missing parent folders. FIFOs,
-/// devices, directories and read-only files are refused and a symlink is
-/// written through to its target ([`bv_core::fsio::write_atomic`]); the
-/// error names the file once and says why.
-///
-/// In a browser page the file becomes a download named by `path`'s file
-/// name (the page has no file system to write to).
-pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
-    #[cfg(target_arch = "wasm32")]
-    {
-        let name = path
-            .file_name()
-            .map_or_else(|| "bv-figure".into(), |n| n.to_string_lossy().into_owned());
-        crate::session::platform::download(&name, bytes)
-            .map_err(|e| anyhow::anyhow!("the browser refused the download of {name}: {e}"))
-    }
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        bv_core::fsio::create_parent_dirs(path)?;
-        bv_core::fsio::write_atomic(path, |f| f.write_all(bytes))?;
-        Ok(())
-    }
-}
-
-/// Whether an image has more than one colour (a blank render is one colour).
-pub fn is_blank(img: &image::RgbaImage) -> bool {
-    let mut px = img.pixels();
-    match px.next() {
-        Some(first) => px.all(|p| p == first),
-        None => true,
-    }
 }
