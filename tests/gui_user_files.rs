@@ -240,9 +240,12 @@ fn the_lit_sphere_draws_the_reloaded_shader() {
     }
     let took = t0.elapsed();
     println!("lit sphere redrawn {took:?} after the save");
-    // Within a second of saving on an idle machine (the settle time, the
-    // compile, one specialised pipeline, and this loop's full-window
-    // renders); twice that for a machine busy with other builds.
-    assert!(took < Duration::from_secs(2), "the redraw took {took:?}");
+    // About a second on an idle machine (the settle time, the compile, one
+    // specialised pipeline, and this loop's full-window renders), more while
+    // the reloaded model's derived results (its albedo curve, its badges:
+    // the shader changed, so they are computed again) share the CPU. A
+    // speed target belongs in a benchmark; this bound catches a redraw that
+    // never comes or waits for something it should not.
+    assert!(took < Duration::from_secs(15), "the redraw took {took:?}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -621,9 +621,19 @@ impl Backdrop {
     }
 }
 
-/// The view background of the theme (sRGB 0..1), shared with the lobe view.
+/// The background of the GPU views (the 3D lobe, the lit sphere, the
+/// environment) in a theme, sRGB 0..1 with alpha.
+pub fn view_background(dark: bool) -> [f32; 4] {
+    if dark {
+        [0.106, 0.11, 0.122, 1.0]
+    } else {
+        [0.985, 0.985, 0.985, 1.0]
+    }
+}
+
+/// [`view_background`] without alpha.
 pub fn theme_background(dark: bool) -> [f32; 3] {
-    let b = super::lobe3d::background(dark);
+    let b = view_background(dark);
     [b[0], b[1], b[2]]
 }
 

@@ -692,13 +692,10 @@ impl View for Lobe3dView {
     }
 }
 
-/// Background of the lobe view (sRGB 0..1).
+/// Background of the lobe view (sRGB 0..1): the GPU views' one
+/// ([`super::gpu_image::view_background`]).
 pub fn background(dark: bool) -> [f32; 4] {
-    if dark {
-        [0.106, 0.11, 0.122, 1.0]
-    } else {
-        [0.985, 0.985, 0.985, 1.0]
-    }
+    super::gpu_image::view_background(dark)
 }
 
 fn handle_input(
