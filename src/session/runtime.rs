@@ -49,8 +49,11 @@ type BuildKey = (String, u64);
 /// Evaluators some runtime of the process holds, by what they were built
 /// from. Weak: an evaluator no runtime holds is freed (a MERL table is
 /// tens of megabytes).
-static BUILDS: LazyLock<Mutex<HashMap<BuildKey, (Weak<dyn Brdf>, u64)>>> =
-    LazyLock::new(Mutex::default);
+static BUILDS: LazyLock<Mutex<Builds>> = LazyLock::new(Mutex::default);
+
+/// What a runtime of the process holds, by what it was built from: the
+/// evaluator (weak) and its revision.
+type Builds = HashMap<BuildKey, (Weak<dyn Brdf>, u64)>;
 
 /// The evaluator of `spec` and its revision: one a runtime of the process
 /// holds, or a new build.

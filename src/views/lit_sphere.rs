@@ -532,7 +532,7 @@ impl LitSphereView {
             &painter,
             rect,
             rect.min.y + 24.0,
-            &errors,
+            errors,
             drawables.is_empty(),
         );
     }

@@ -98,10 +98,13 @@ pub struct ViewEntry {
     pub make: fn() -> Box<dyn View>,
 }
 
+/// A view's constructor.
+type MakeView = fn() -> Box<dyn View>;
+
 /// Each view's constructor, by the view it draws (its id is spelled once,
 /// in [`crate::session::views`]). Add a view here and in
 /// [`crate::session::views::VIEWS`].
-const CONSTRUCTORS: &[(views::ViewInfo, fn() -> Box<dyn View>)] = &[
+const CONSTRUCTORS: &[(views::ViewInfo, MakeView)] = &[
     (views::LOBE, || Box::new(lobe3d::Lobe3dView::new())),
     (views::LIT_SPHERE, || {
         Box::new(lit_sphere::LitSphereView::new())
