@@ -15,6 +15,15 @@
 // and a dropped MERL table, .brdf model and environment map open. Then the
 // first-frame checks again with WebGPU off (WebGL2 only). Screenshots go to
 // web/shots (or --shots DIR); timings and the renderer are printed.
+//
+// WebGPU: a minimal page (plain JavaScript, no bv) first probes whether this
+// browser keeps a WebGPU device that presents to a canvas. Where it does, the
+// WebGPU page must stay on WebGPU to the end (its renderer is printed last),
+// every view is drawn on WebGPU (the environment view included), and a loss
+// is tested apart, by destroying the page's device (`GPUDevice.destroy()`):
+// the page falls back to WebGL2. Where the minimal page loses its device too,
+// the browser is at fault and the WebGPU page is only required to fall back.
+// Every loss's reason is printed.
 import { chromium } from "playwright-core";
 import http from "node:http";
 import fs from "node:fs";
@@ -33,6 +42,25 @@ const H = 800;
 // The software renderers in CI are slow: generous waits, checked often.
 const FIRST_FRAME_TIMEOUT = 60_000;
 const SETTLE_MS = Number(process.env.BV_WEB_SETTLE_MS || 3000);
+// Chromium's switches for WebGPU in a headless browser without a GPU. With
+// `--enable-unsafe-webgpu` alone, headless Chromium 156's GPU process has no
+// shared image to back a WebGPU canvas with (it logs "Could not find
+// SharedImageBackingFactory … WebgpuSwapChainTexture") and takes the device
+// back at the first present: "Device was destroyed", or "A valid external
+// Instance reference no longer exists" when the page had asked for a second
+// adapter (as wgpu's WebGPU detection does). A page of a few lines does the
+// same; the probe below tells which case a browser is. With Vulkan in the
+// GPU process (SwiftShader's) the canvas has its backing; ANGLE is then
+// named too: left to choose, the GPU process lost WebGL and WebGPU alike at
+// the first present, and ANGLE on Vulkan gave no WebGL2 at all.
+// BV_WEBGPU_ARGS replaces them (space-separated), e.g. for a real GPU.
+const WEBGPU_ARGS = process.env.BV_WEBGPU_ARGS !== undefined
+  ? process.env.BV_WEBGPU_ARGS.split(/\s+/).filter(Boolean)
+  : ["--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader"];
+// How long the probe's minimal page presents frames (the bv page lost its
+// device a few seconds after its start on such a browser).
+const PROBE_MS = 8000;
 
 fs.mkdirSync(shots, { recursive: true });
 let failures = 0;
@@ -47,9 +75,55 @@ const types = {
   ".js": "text/javascript; charset=utf-8",
   ".wasm": "application/wasm",
 };
+// The probe's minimal WebGPU page: an adapter, a device and a canvas of the
+// viewer's size cleared to a changing colour every frame for PROBE_MS; what
+// became of the device is left in `window.__probe`.
+const PROBE_PAGE = "__webgpu_probe.html";
+const PROBE_HTML = `<!DOCTYPE html>
+<html><body style="margin:0"><canvas id="c" width="${W}" height="${H}"></canvas>
+<script>
+window.__probe = (async () => {
+  if (!navigator.gpu) return { adapter: null, why: "no navigator.gpu" };
+  const adapter = await navigator.gpu.requestAdapter();
+  if (!adapter) return { adapter: null, why: "requestAdapter() gave none" };
+  const i = adapter.info || {};
+  const name = [i.vendor, i.architecture, i.description].filter(Boolean).join(" ");
+  const device = await adapter.requestDevice();
+  let lost = null;
+  device.lost.then((l) => { lost = l.reason + ": " + l.message; });
+  const canvas = document.getElementById("c");
+  const ctx = canvas.getContext("webgpu");
+  ctx.configure({ device, format: navigator.gpu.getPreferredCanvasFormat(), alphaMode: "opaque" });
+  const t0 = performance.now();
+  let frames = 0;
+  await new Promise((done) => {
+    const frame = () => {
+      const t = (performance.now() - t0) / 1000;
+      const enc = device.createCommandEncoder();
+      enc.beginRenderPass({ colorAttachments: [{ view: ctx.getCurrentTexture().createView(),
+        loadOp: "clear", storeOp: "store", clearValue: { r: 0.5 + 0.5 * Math.sin(3 * t), g: 0.3, b: 0.6, a: 1 } }] }).end();
+      device.queue.submit([enc.finish()]);
+      frames++;
+      if (performance.now() - t0 < ${PROBE_MS} && !lost) requestAnimationFrame(frame);
+      else done();
+    };
+    requestAnimationFrame(frame);
+  });
+  // A loss is reported asynchronously: give a late one a moment.
+  await device.queue.onSubmittedWorkDone().catch(() => {});
+  await new Promise((r) => setTimeout(r, 200));
+  return { adapter: name || "(unnamed)", frames, ms: Math.round(performance.now() - t0), lost };
+})().catch((e) => ({ adapter: null, why: String(e) }));
+</script></body></html>
+`;
+
 function serve() {
   const server = http.createServer((req, res) => {
     const url = new URL(req.url, "http://localhost");
+    if (url.pathname === `/${PROBE_PAGE}`) {
+      res.writeHead(200, { "content-type": types[".html"] }).end(PROBE_HTML);
+      return;
+    }
     const name = url.pathname === "/" ? "index.html" : url.pathname.slice(1);
     const file = path.join(dist, path.normalize(name));
     if (!file.startsWith(dist) || !fs.existsSync(file) || !fs.statSync(file).isFile()) {
@@ -195,6 +269,17 @@ async function open(context, url, what) {
       requestAnimationFrame(tick);
     };
     requestAnimationFrame(tick);
+    // The page's WebGPU devices, for the check that destroys them (wgpu
+    // keeps its own handle inside the module).
+    window.__bvDevices = [];
+    if (window.GPUAdapter) {
+      const request = GPUAdapter.prototype.requestDevice;
+      GPUAdapter.prototype.requestDevice = async function (...a) {
+        const device = await request.apply(this, a);
+        window.__bvDevices.push(device);
+        return device;
+      };
+    }
     window.__bvLog = [];
     const info = console.info.bind(console);
     console.info = (...a) => {
@@ -233,12 +318,51 @@ async function open(context, url, what) {
     await page.waitForTimeout(50);
   }
   const reloaded = log.some((l) => l.includes("reloading on WebGL2"));
+  // Why, in bv's words ("WebGPU was lost (Unknown: …)"), for the CI log.
+  const lost = lostReason(log);
   check(firstFrame !== null, `${what}: first frame${firstFrame !== null ? ` after ${firstFrame} ms` : ""}` +
-    (reloaded ? " (WebGPU lost: reloaded on WebGL2)" : ""));
+    (reloaded ? ` (${lost}: reloaded on WebGL2)` : ""));
   return { page, log, errors, firstFrame, reloaded };
 }
+// The reason a page gave for losing its WebGPU device, if it lost it.
+function lostReason(log) {
+  const l = log.find((t) => t.startsWith("bv: WebGPU was lost"));
+  return l ? l.slice("bv: ".length).replace(/; reloading on WebGL2$/, "") : null;
+}
+// The renderer a page draws with now (its last `bv: renderer` line: a page
+// that lost WebGPU says it again after its reload).
+function rendererOf(log) {
+  return [...log].reverse().find((l) => l.startsWith("bv: renderer")) || "(no renderer line)";
+}
+// Whether a page is on WebGPU now: its renderer is the browser's WebGPU and
+// it has not lost the device (a loss is noted before the reload).
+function onWebGpu(p) {
+  return /^bv: renderer BrowserWebGpu/.test(rendererOf(p.log)) && !lostReason(p.log);
+}
+// A screenshot waits for a frame of the page. On WebGPU in software the
+// environment view accumulates its samples in frames of a second and more
+// for the first tens of seconds of a page (SwiftShader is taken for a GPU:
+// the browser does not call it a fallback adapter), and a screenshot then
+// waits as long: first the page is let finish (the browser's frames come
+// freely again, up to IDLE_MS), so that the picture is the finished one.
+const IDLE_MS = 120_000;
+async function idle(page) {
+  const t0 = Date.now();
+  while (Date.now() - t0 < IDLE_MS) {
+    // (A page that reloads meanwhile, on a lost device, is not idle yet.)
+    const free = await page.evaluate(() => {
+      const now = performance.now();
+      return window.__bvFrames ? window.__bvFrames.filter((t) => t > now - 1000).length >= 30 : true;
+    }).catch(() => false);
+    if (free) break;
+    await page.waitForTimeout(250);
+  }
+  return Date.now() - t0;
+}
 async function shot(page, name) {
-  const buf = await page.screenshot({ path: path.join(shots, `${name}.png`) });
+  const waited = await idle(page);
+  if (waited > 10_000) console.log(`     (${name}: the page drew for ${(waited / 1000).toFixed(0)} s more before it was idle)`);
+  const buf = await page.screenshot({ path: path.join(shots, `${name}.png`), timeout: IDLE_MS });
   return decodePng(buf);
 }
 function notBlank(img, what, region) {
@@ -348,13 +472,15 @@ async function run() {
   const launch = (webgpu) => chromium.launch({
     executablePath,
     headless: true,
-    args: ["--no-sandbox", ...(webgpu ? ["--enable-unsafe-webgpu"] : [])],
+    args: ["--no-sandbox", ...(webgpu ? WEBGPU_ARGS : [])],
   });
   try {
     if (!webglOnly) {
       const browser = await launch(true);
+      console.log(`     WebGPU browser: ${WEBGPU_ARGS.join(" ")}`);
       const context = await browser.newContext({ viewport: { width: W, height: H } });
-      await webgpuChecks(context, base);
+      const keeps = await probeWebGpu(context, base);
+      await webgpuChecks(context, base, keeps);
       await browser.close();
     }
     const browser = await launch(false);
@@ -383,7 +509,39 @@ const MAX_FRAME_GAP = 1500;
 // than a frame of the dev build under software rendering).
 const MAX_STEP_MS = 400;
 
-async function webgpuChecks(context, base) {
+// Whether this browser keeps a WebGPU device that presents to a canvas, on
+// a page of a few lines without bv (PROBE_HTML); says which case applies.
+async function probeWebGpu(context, base) {
+  const page = await context.newPage();
+  await page.goto(base + PROBE_PAGE);
+  const r = await page.evaluate(() => window.__probe).catch((e) => ({ adapter: null, why: String(e) }));
+  await page.close();
+  let keeps = false;
+  if (!r.adapter) {
+    console.log(`     WebGPU probe: no WebGPU device for a minimal page (${r.why}): ` +
+      "the WebGPU page may draw on WebGL2");
+  } else if (r.lost) {
+    console.log(`     WebGPU probe: a minimal page on ${r.adapter} LOST its device after ${r.frames} frames ` +
+      `(${r.lost}): the browser does not keep WebGPU here, so the WebGPU page is only required to fall back ` +
+      "to WebGL2");
+  } else {
+    keeps = true;
+    console.log(`     WebGPU probe: a minimal page on ${r.adapter} kept its device for ${r.ms} ms ` +
+      `(${r.frames} frames presented): the WebGPU page must stay on WebGPU`);
+  }
+  return keeps;
+}
+
+// The checks of a page that must be on WebGPU where the browser keeps a
+// device (`keeps`): its renderer, and no loss (whose reason is printed).
+function checkWebGpu(p, what, keeps) {
+  if (!keeps) return;
+  const lost = lostReason(p.log);
+  check(onWebGpu(p), `${what}: on WebGPU (${rendererOf(p.log).slice("bv: ".length)}` +
+    `${lost ? `; ${lost}` : ""})`);
+}
+
+async function webgpuChecks(context, base, keeps) {
   const a = await open(context, base, "WebGPU page");
   const renderers = a.log.filter((l) => l.startsWith("bv: renderer"));
   console.log(`     ${renderers.join(" | then ")}`);
@@ -392,13 +550,17 @@ async function webgpuChecks(context, base) {
   // mesh and slices run bv-core's simd128 kernels, not the scalar fallback.
   const kernels = a.log.find((l) => l.startsWith("bv: batch kernels")) || "(no line)";
   check(kernels === "bv: batch kernels simd128 (4 lanes)", `WebGPU page: batch kernels on WebAssembly SIMD: ${kernels}`);
-  // Headless Chromium on SwiftShader destroys the WebGPU device at its first
-  // canvas present (plain JavaScript does the same): the page must notice
-  // and carry on with WebGL2.
-  check(!a.reloaded || /Gl/.test(renderers[renderers.length - 1] || ""),
-    "WebGPU page: a lost device falls back to WebGL2");
+  if (!keeps) {
+    // A browser that takes the device back (the probe's page lost it too):
+    // the page must notice and carry on with WebGL2.
+    check(!a.reloaded || /Gl/.test(renderers[renderers.length - 1] || ""),
+      `WebGPU page: a lost device falls back to WebGL2 (${lostReason(a.log) || "not lost"})`);
+  }
   await a.page.waitForTimeout(SETTLE_MS);
   const first = await shot(a.page, "webgpu-first");
+  // The browser keeps a device (the probe's page did): so must bv's page,
+  // once it has settled (its first work drawn: the screenshot waits for it).
+  checkWebGpu(a, "WebGPU page, settled", keeps);
   notBlank(first, "WebGPU page");
   noErrors(a, "WebGPU page");
 
@@ -436,16 +598,21 @@ async function webgpuChecks(context, base) {
   const after = await shot(b.page, "webgpu-link-opened");
   const d = difference(before, after);
   check(d < 0.02, `the link reproduces the scene (${(100 * d).toFixed(2)}% of the pixels differ)`);
+  checkWebGpu(b, "the copied link", keeps);
   noErrors(b, "the copied link");
   await b.page.close();
 
-  // Every view, maximised through a link made from the copied one. These
-  // pages ask for WebGL2 at once (`?webgl`): the WebGPU attempt and its
-  // reload were checked above and would only cost time here.
+  // Every view, maximised through a link made from the copied one: on
+  // WebGPU where the browser keeps a device, else asking for WebGL2 at once
+  // (`?webgl`; the WebGPU attempt and its reload were checked above and
+  // would only cost time here).
   const toml = linkToml(link);
   const gl = `${base}?webgl`;
   for (const view of viewIds()) {
-    const p = await open(context, linkOf(gl, withMaximised(toml, view)), `view ${view}`);
+    // The environment view maximised, at the scene's 1024 samples per
+    // pixel, draws for minutes on a software adapter: 64 show it as well.
+    const scene = view === "environment" ? toml.replace(/^target_spp = .*$/m, "target_spp = 64") : toml;
+    const p = await open(context, linkOf(keeps ? base : gl, withMaximised(scene, view)), `view ${view}`);
     await p.page.waitForTimeout(SETTLE_MS);
     // A view whose work still runs (the factorisation: a minute of steps in
     // the dev build under software rendering) is drawn once it is done.
@@ -459,9 +626,21 @@ async function webgpuChecks(context, base) {
       const share = brightShare(img, [370, 70, W - 20, H - 40]);
       check(share > 0.05, `view lit_sphere: a lit sphere is drawn (${(100 * share).toFixed(1)}% of the view lit)`);
     }
+    // The environment view draws only on WebGPU (WebGL2 gets a line of
+    // text saying it needs WebGPU): the objects in the environment, not
+    // a dark area with a caption.
+    if (view === "environment" && keeps) {
+      const area = [370, 70, W - 20, H - 40];
+      const share = brightShare(img, area, 20);
+      const c = stats(img, area).colours;
+      check(share > 0.05 && c > 1000,
+        `view environment: drawn on WebGPU (${(100 * share).toFixed(1)}% of the view lit, ${c} colours)`);
+    }
+    checkWebGpu(p, `view ${view}`, keeps);
     noErrors(p, `view ${view}`);
     await p.page.close();
   }
+  if (keeps) await forcedLoss(context, toml, base);
 
   // A scene file dropped on the page opens.
   {
@@ -518,6 +697,11 @@ async function webgpuChecks(context, base) {
     noErrors(p, `hostile fragment (${name})`);
     await p.page.close();
   }
+  // The first page was open all along (its device for a minute and more):
+  // what it draws with at the end.
+  console.log(`     WebGPU page at the end: ${rendererOf(a.log).slice("bv: ".length)}` +
+    `${lostReason(a.log) ? ` (${lostReason(a.log)})` : ""}`);
+  checkWebGpu(a, "WebGPU page at the end of the WebGPU checks", keeps);
   await a.page.close();
 
   // After the session check: these pages store sessions of their own.
@@ -525,6 +709,32 @@ async function webgpuChecks(context, base) {
   await downloadChecks(context, gl, toml);
   await openFileChecks(context, gl, toml);
   await fileChooserChecks(context, gl, toml);
+}
+
+// A device lost while the page draws: destroyed from the page itself (the
+// devices wgpu asked the browser for, kept by the init script of `open`),
+// the page notes the loss with its reason and reloads on WebGL2, with the
+// scene of its link, and draws there.
+async function forcedLoss(context, toml, base) {
+  const p = await open(context, linkOf(base, withMaximised(toml, "lit_sphere")), "a page whose device is destroyed");
+  checkWebGpu(p, "a page whose device is destroyed, before", true);
+  const destroyed = await p.page.evaluate(() => {
+    for (const d of window.__bvDevices) d.destroy();
+    return window.__bvDevices.length;
+  });
+  const gl = await waitLog(p, (l) => /^bv: renderer Gl/.test(l), 30_000);
+  const lost = lostReason(p.log);
+  check(destroyed > 0 && !!lost && !!gl,
+    `a destroyed device (${destroyed} destroyed) falls back to WebGL2: ${lost || "no loss noted"}; ` +
+    `then ${gl ? gl.slice("bv: ".length) : "no WebGL2 renderer in 30 s"}`);
+  // After the reload: the first frame on WebGL2, then the picture.
+  const frames = () => p.log.filter((l) => l === "bv: first frame").length;
+  for (const t0 = Date.now(); Date.now() - t0 < 30_000 && frames() < 2;) await p.page.waitForTimeout(50);
+  await p.page.waitForTimeout(SETTLE_MS);
+  const img = await shot(p.page, "webgpu-destroyed-then-webgl");
+  const share = brightShare(img, [370, 70, W - 20, H - 40]);
+  check(share > 0.05, `after the loss, the lit sphere is drawn on WebGL2 (${(100 * share).toFixed(1)}% of the view lit)`);
+  await p.page.close();
 }
 
 // Ctrl+O (and the Open… button) open the browser's file chooser; the file

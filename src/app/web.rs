@@ -16,10 +16,12 @@
 //! What the desktop writes to a file (*Save scene*, figures) becomes a
 //! download.
 //!
-//! If the browser takes the WebGPU device back (headless Chromium on a
-//! software adapter does so at the first present), the page notes it in the
-//! tab's session storage and reloads on WebGL2; `?webgl` in the address asks
-//! for WebGL2 from the start.
+//! If the browser takes the WebGPU device back (its GPU process restarts; or
+//! headless Chromium 156 without Vulkan in its GPU process, which then has no
+//! shared image to back a WebGPU canvas with and takes the device back at
+//! the first present, bv's or any page's: see `web/test.mjs`), the page says
+//! why on the console, notes it in the tab's session storage and reloads on
+//! WebGL2; `?webgl` in the address asks for WebGL2 from the start.
 //!
 //! What the page tells a test driver goes to the browser's console as
 //! `bv: …` lines (`console.info`), never as errors.
