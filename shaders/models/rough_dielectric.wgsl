@@ -7,6 +7,7 @@
 #define_import_path bv::models::rough_dielectric
 
 #import bv::params::{pf, prgb, pu}
+#import bv::sampling_lobe::{Lobe, ggx_lobe}
 #import bv::frame::log1p
 #import bv::fresnel::dielectric
 #import bv::microfacet::{ggx_d, beckmann_d, ggx_lambda, beckmann_lambda}
@@ -103,4 +104,12 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     return v * prgb(o + ROUGH_DIELECTRIC_TINT);
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe): GGX
+// visible normals reflected about h at the model's roughness, the reflected
+// lobe's shape (the transmitted light of the environment below is not
+// gathered by that renderer), with the least cosine share.
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    return ggx_lobe(0.1, pf(o + ROUGH_DIELECTRIC_ALPHA_X), pf(o + ROUGH_DIELECTRIC_ALPHA_Y));
 }

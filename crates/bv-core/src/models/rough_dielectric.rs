@@ -120,11 +120,14 @@ pub static INFO: ModelInfo = ModelInfo {
     params: PARAMS,
     aliases: &[ALPHA_ALIAS],
     build: Build::Static(build),
-    gpu: Some(GpuPort::new(
-        "bv::models::rough_dielectric",
-        "shaders/models/rough_dielectric.wgsl",
-        include_str!("../../../../shaders/models/rough_dielectric.wgsl"),
-    )),
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::rough_dielectric",
+            "shaders/models/rough_dielectric.wgsl",
+            include_str!("../../../../shaders/models/rough_dielectric.wgsl"),
+        )
+        .with_sampling_lobe(),
+    ),
 };
 
 /// Which Smith term.
