@@ -185,6 +185,41 @@ fn pairs() -> Vec<([f32; 3], [f32; 3])> {
     out
 }
 
+/// For a transmitting model, `pairs` and as many again on the whole sphere:
+/// light from either side, viewers on either side, and viewers near the
+/// peaks the model names (its refracted direction) and near the mirror
+/// direction on the light's side, by 1e-4 to 0.1 rad.
+fn sphere_pairs(
+    b: &dyn bv_core::Brdf,
+    pairs: &[([f32; 3], [f32; 3])],
+) -> Vec<([f32; 3], [f32; 3])> {
+    let mut g = rng(0x5eed_7a45);
+    let mut out = pairs.to_vec();
+    let mut push = |wi: DVec3, wo: DVec3| out.push((unit_f32(wi), unit_f32(wo)));
+    let flip = |w: DVec3| DVec3::new(w.x, w.y, -w.z);
+    for k in 0..2048 {
+        let mut wi = dir(uniform2(&mut g), 0.0, 1.0);
+        let mut wo = dir(uniform2(&mut g), 0.0, 1.0);
+        if k % 2 == 0 {
+            wi = flip(wi);
+        }
+        if k % 4 < 2 {
+            wo = flip(wo);
+        }
+        push(wi, wo);
+        let u = uniform2(&mut g);
+        let a = 10f64.powf(-4.0 + 3.0 * u.x);
+        for p in b.peaks(wi) {
+            push(wi, perturb(p, a, 2.0 * PI * u.y));
+        }
+        push(
+            wi,
+            perturb(DVec3::new(-wi.x, -wi.y, wi.z), a, 2.0 * PI * u.y),
+        );
+    }
+    out
+}
+
 #[derive(Clone, Copy, Debug)]
 enum Level {
     Min,
@@ -351,8 +386,13 @@ fn wgsl_ports_match_bv_core() {
                 Err(e) => panic!("{}: default set does not build: {e}", m.id),
             };
             tested += 1;
-            let gpu_values = eval.eval(spec, &pairs).unwrap();
-            for ((wi, wo), g) in pairs.iter().zip(&gpu_values) {
+            let set_pairs = if cpu.transmits() {
+                sphere_pairs(cpu.as_ref(), &pairs)
+            } else {
+                pairs.clone()
+            };
+            let gpu_values = eval.eval(spec, &set_pairs).unwrap();
+            for ((wi, wo), g) in set_pairs.iter().zip(&gpu_values) {
                 let c = cpu.eval(to_d(*wi), to_d(*wo));
                 for k in 0..3 {
                     let (gk, ck) = (f64::from(g[k]), c[k]);

@@ -74,6 +74,18 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         false
     }
 
+    /// For a model of an interface between two media: the relative index
+    /// `η_below / η_above` (the `eta` of `glass` and `rough-dielectric`).
+    /// Across such an interface a radiance BSDF is not symmetric: it obeys
+    /// the generalised reciprocity `f(wi, wo)/ηo² = f(wo, wi)/ηi²`, with ηi
+    /// and ηo the indices on the sides of `wi` and `wo` (Veach 1997, §5.2,
+    /// eq. 5.14), and the reciprocity check compares that form (see
+    /// [`crate::analysis::reciprocity`]). `None` (the default): the same
+    /// medium on both sides, where reciprocity is `f(wi, wo) = f(wo, wi)`.
+    fn interface_eta(&self) -> Option<f64> {
+        None
+    }
+
     /// Draws an outgoing direction for light from `wi`, given a uniform point
     /// `u ∈ [0,1)²`. `None` when no direction could be drawn. Default: cosine
     /// weighted, which suits diffuse-like models.
@@ -86,11 +98,13 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         sampling::cosine_hemisphere_pdf(wo)
     }
 
-    /// Outgoing directions (unit, upper hemisphere) near which `f(wi, ·)` has a
+    /// Outgoing directions (unit) near which `f(wi, ·)` has a
     /// narrow peak or a cusp *away from the mirror direction*, so that the
     /// albedo quadrature places panel breaks there (a Lafortune lobe about
     /// `C wi`, Hapke's opposition surge at `wi`). The mirror direction is
-    /// always treated as a peak. Default: none.
+    /// always treated as a peak. A transmitting model may name directions on
+    /// the far side of the surface from `wi` (the refracted direction), about
+    /// which the quadrature of the transmitted part is graded. Default: none.
     fn peaks(&self, _wi: DVec3) -> Vec<DVec3> {
         Vec::new()
     }

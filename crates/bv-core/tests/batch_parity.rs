@@ -111,6 +111,65 @@ fn pairs(seed: u64) -> PairBuf {
     PairBuf::from_pairs(&out)
 }
 
+/// The test's pairs for a transmitting model: [`pairs`], then the same
+/// kinds of pairs on the whole sphere: light from below, viewers across the
+/// surface and below it, grazing on either side, and near the model's peaks
+/// (the refracted direction, [`Brdf::peaks`]) and mirror directions on
+/// either side, by up to ~0.001 to 0.1 rad.
+fn sphere_pairs(brdf: &dyn Brdf, seed: u64) -> PairBuf {
+    let mut out = pairs(seed);
+    let mut rng = sampling::rng(seed ^ 0x5_9E7E);
+    let flip = |w: DVec3| DVec3::new(w.x, w.y, -w.z);
+    let uniform = |rng: &mut BvRng| {
+        let u = sampling::uniform2(rng);
+        let z = 2.0 * u.x - 1.0;
+        let s = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        DVec3::new(s * phi.cos(), s * phi.sin(), z)
+    };
+    for k in 0..1600 {
+        let wi = uniform(&mut rng);
+        let wo = uniform(&mut rng);
+        out.push(wi, wo);
+        let g = if k % 2 == 0 {
+            grazing(&mut rng)
+        } else {
+            flip(grazing(&mut rng))
+        };
+        out.push(g, wo);
+        out.push(wi, g);
+        let d: f64 = (rng.random_range(1e-3f64.ln()..=0.1f64.ln())).exp();
+        let t = DVec3::new(
+            rng.random_range(-d..d),
+            rng.random_range(-d..d),
+            rng.random_range(-d..d),
+        );
+        let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
+        out.push(wi, mirror);
+        out.push(wi, (mirror + t).normalize());
+        for p in brdf.peaks(wi) {
+            out.push(wi, p);
+            out.push(wi, (p + t).normalize());
+        }
+    }
+    for w in [DVec3::Z, -DVec3::Z] {
+        for th in [
+            0.0,
+            0.3,
+            1.0,
+            1.5,
+            PI / 2.0 - 1e-6,
+            PI / 2.0 + 1e-6,
+            2.0,
+            PI,
+        ] {
+            out.push(w, dir(th, 0.7));
+            out.push(dir(th, 0.7), w);
+        }
+    }
+    out
+}
+
 /// The first lane where the kernel and `eval` disagree beyond the tolerance,
 /// on any instruction set this CPU has (each path's own compiled copy of the
 /// kernel; the vector paths also see lane counts that leave a remainder).
@@ -176,6 +235,7 @@ const WITH_KERNEL: &[&str] = &[
     "lafortune",
     "mirror",
     "glass",
+    "rough-dielectric",
 ];
 
 #[test]
@@ -198,6 +258,11 @@ fn every_kernel_matches_the_scalar_reference() {
             if brdf.batch_kernel().is_none() {
                 continue;
             }
+            let dirs = if brdf.transmits() {
+                sphere_pairs(brdf.as_ref(), 7)
+            } else {
+                dirs.clone()
+            };
             if let Some(e) = first_mismatch(brdf.as_ref(), &dirs) {
                 panic!("{} {}: {e}", m.id, spec.to_json());
             }
@@ -264,6 +329,30 @@ fn every_cook_torrance_combination_is_checked() {
                         .unwrap()
                         .build()
                         .unwrap();
+                    if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
+                        panic!("{p}: {e}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_rough_dielectric_combination_is_checked() {
+    // Both distributions and geometries, sharp to very rough, indices on
+    // both sides of 1 and at the ends of the range, on the whole sphere.
+    for dist in ["ggx", "beckmann"] {
+        for geo in ["smith", "smith-correlated"] {
+            for (ax, ay) in [(0.001, 0.001), (0.3, 0.1), (2.0, 2.0)] {
+                for eta in [1.5, 0.6, 1.01, 10.0, 0.01] {
+                    let p = serde_json::json!({"distribution": dist, "geometry": geo,
+                        "alpha_x": ax, "alpha_y": ay, "eta": eta, "tint": [1.0, 0.5, 0.25]});
+                    let b = ModelSpec::from_json("rough-dielectric", &p)
+                        .unwrap()
+                        .build()
+                        .unwrap();
+                    let dirs = sphere_pairs(b.as_ref(), 12);
                     if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
                         panic!("{p}: {e}");
                     }

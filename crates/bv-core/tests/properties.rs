@@ -311,7 +311,11 @@ fn f_is_finite_and_non_negative() {
         let mut pairs = vec![(wi, wo), (wo, wi)];
         pairs.extend(directions::upper_pairs(24, seed));
         if b.transmits() {
-            pairs.extend(directions::transmission_pairs(8, seed));
+            // The whole sphere: across the surface both ways, and below it.
+            let cross = directions::transmission_pairs(8, seed);
+            pairs.extend(cross.iter().map(|&(a, c)| (c, a)));
+            pairs.extend(cross);
+            pairs.extend(directions::lower_pairs(8, seed));
         }
         for (a, c) in pairs {
             let f = b.eval(a, c);
@@ -337,13 +341,21 @@ fn reciprocal_where_claimed() {
         }
         let mut pairs = vec![(wi, wo)];
         pairs.extend(directions::upper_pairs(24, seed));
+        if b.transmits() {
+            pairs.extend(directions::transmission_pairs(12, seed));
+            pairs.extend(directions::lower_pairs(12, seed));
+        }
+        // Across an interface, the generalised form f(wi, wo)/ηo² =
+        // f(wo, wi)/ηi² (Veach 1997, §5.2); a model without one must be
+        // symmetric outright, on whatever side.
+        let eta = b.interface_eta();
+        let inv_eta2 = |w: DVec3| match eta {
+            Some(e) if w.z < 0.0 => 1.0 / (e * e),
+            _ => 1.0,
+        };
         for (a, c) in pairs {
-            if b.transmits() && (a.z <= 0.0) != (c.z <= 0.0) {
-                // Across the interface reciprocity carries an η² factor.
-                continue;
-            }
-            let f1 = b.eval(a, c);
-            let f2 = b.eval(c, a);
+            let f1 = b.eval(a, c) * inv_eta2(c);
+            let f2 = b.eval(c, a) * inv_eta2(a);
             let scale = f1.abs().max(f2.abs());
             prop_assert!(
                 (f1 - f2).abs().cmple(1e-6 * scale).all(),
@@ -372,10 +384,31 @@ fn sample_and_pdf_are_consistent() {
     ];
     for_every_model(
         256,
-        (any::<u64>(), upper_dir(), u, upper_dir()),
-        |m, (seed, wi, u, w)| {
+        (
+            any::<u64>(),
+            upper_dir(),
+            u,
+            upper_dir(),
+            any::<(bool, bool)>(),
+        ),
+        |m, (seed, wi, u, w, (wi_below, w_below))| {
             let (spec, b) = random_model(m, seed);
+            // A transmitting model samples light from either side, into
+            // either side.
+            let flip = |v: DVec3, below: bool| {
+                if below && b.transmits() {
+                    directions::below(v)
+                } else {
+                    v
+                }
+            };
+            let (wi, w) = (flip(wi, wi_below), flip(w, w_below));
             if let Some(wo) = b.sample(wi, DVec2::new(u.0, u.1)) {
+                prop_assert!(
+                    b.transmits() || wo.z >= 0.0,
+                    "sample({wi}, {u:?}) = {wo} is below the surface for {}",
+                    ctx(&spec)
+                );
                 prop_assert!(
                     wo.is_finite() && (wo.length() - 1.0).abs() < 1e-9,
                     "sample({wi}, {u:?}) = {wo} is not a unit vector for {}",
@@ -414,8 +447,23 @@ fn energy_conserving_where_claimed() {
                 return Ok(());
             }
             let grazing = [60.0, 85.0, 89.0, 89.9, 89.99].map(f64::to_radians);
-            for theta in [0.0, t].into_iter().chain(grazing) {
-                let e = albedo::rho_hd(b.as_ref(), theta, phi, 2048, seed);
+            // Light from below too for a transmitting model: ρR + ρT ≤ 1
+            // on both sides.
+            let sides: &[bool] = if b.transmits() {
+                &[false, true]
+            } else {
+                &[false]
+            };
+            for (theta, &below) in [0.0, t]
+                .into_iter()
+                .chain(grazing)
+                .flat_map(|t| sides.iter().map(move |s| (t, s)))
+            {
+                let mut wi = bv_core::frame::from_spherical(theta, phi);
+                if below {
+                    wi = directions::below(wi);
+                }
+                let e = albedo::rho_hd_dir(b.as_ref(), wi, 2048, seed);
                 prop_assert_eq!(
                     e.rejected,
                     0,
@@ -426,8 +474,9 @@ fn energy_conserving_where_claimed() {
                 let bound = Rgb::splat(1.0 + 1e-3) + 4.0 * e.std_error;
                 prop_assert!(
                     e.value.cmple(bound).all(),
-                    "ρhd(θi = {:.2}°, φi = {:.1}°) = {} ± {} > 1 for {}",
+                    "ρhd(θi = {:.2}°{}, φi = {:.1}°) = {} ± {} > 1 for {}",
                     theta.to_degrees(),
+                    if below { " from below" } else { "" },
                     phi.to_degrees(),
                     e.value,
                     e.std_error,

@@ -34,7 +34,7 @@
 use super::directions::stream_seed;
 use super::quadrature::{self, QuadratureOptions};
 use crate::sampling::{self, BvRng};
-use crate::{Brdf, Rgb, frame};
+use crate::{Brdf, DeltaKind, Rgb, frame};
 use glam::{DVec2, DVec3};
 use rand::Rng;
 use rayon::prelude::*;
@@ -45,7 +45,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 /// plus one).
 pub const REPLICAS: usize = 16;
 
-pub use super::estimate::{Estimate, Method};
+pub use super::estimate::{AlbedoParts, Estimate, Method};
 
 /// Mean of replica means, and their standard error.
 fn from_replicas(means: &[Rgb], samples: usize, rejected: usize, exact: Rgb) -> Estimate {
@@ -76,6 +76,18 @@ pub struct AlbedoCurve {
     pub theta_deg: Vec<f64>,
     /// ρhd at each θi.
     pub rho: Vec<Estimate>,
+    /// Whether the light comes from below the surface (a transmitting
+    /// model's inside): θi is then measured from −z.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub from_below: bool,
+    /// For a transmitting model, ρR at each θi (what leaves on the light's
+    /// side); empty otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reflected: Vec<Estimate>,
+    /// For a transmitting model, ρT at each θi (what crosses the surface);
+    /// `rho = reflected + transmitted`. Empty otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub transmitted: Vec<Estimate>,
 }
 
 /// The θi grid of [`rho_hd_curve`]: `n` angles `k · (π/2) / n`, `k = 0..n`
@@ -147,33 +159,52 @@ fn jittered(k: usize, rng: &mut BvRng, mut visit: impl FnMut(DVec2)) {
     }
 }
 
-/// One replica of ρhd: `k²` stratified samples from each technique.
-fn replica(brdf: &dyn Brdf, wi: DVec3, k: usize, rng: &mut BvRng, transmits: bool) -> (Rgb, usize) {
+/// One replica of ρhd: `k²` stratified samples from each technique; the
+/// sums of the samples that stay on `wi`'s side and of those that cross the
+/// surface, and the rejected count.
+fn replica(
+    brdf: &dyn Brdf,
+    wi: DVec3,
+    k: usize,
+    rng: &mut BvRng,
+    transmits: bool,
+) -> (Rgb, Rgb, usize) {
     let n = k * k;
-    let mut sum = Rgb::ZERO;
+    let mut sum = [Rgb::ZERO; 2];
     let mut rejected = 0;
-    let mut add = |w: Result<Rgb, ()>| match w {
-        Ok(v) => sum += v,
+    let mut add = |wo: DVec3, w: Result<Rgb, ()>| match w {
+        Ok(v) => sum[usize::from((wo.z > 0.0) != (wi.z > 0.0))] += v,
         Err(()) => rejected += 1,
     };
     let mut us = Vec::with_capacity(n);
     jittered(k, rng, |u| us.push(u));
     for &u in &us {
         if let Some(wo) = brdf.sample(wi, u) {
-            add(weight(brdf, wi, wo, transmits));
+            add(wo, weight(brdf, wi, wo, transmits));
         }
     }
     us.clear();
     jittered(k, rng, |u| us.push(u));
     for &u in &us {
-        add(weight(brdf, wi, cosine_direction(u, transmits), transmits));
+        let wo = cosine_direction(u, transmits);
+        add(wo, weight(brdf, wi, wo, transmits));
     }
-    (sum / (2 * n) as f64, rejected)
+    let m = (2 * n) as f64;
+    (sum[0] / m, sum[1] / m, rejected)
 }
 
 /// Total weight of the delta lobes for light from `wi` (exact, no error).
 fn delta_weight(brdf: &dyn Brdf, wi: DVec3) -> Rgb {
     brdf.deltas(wi).iter().map(|d| d.weight).sum()
+}
+
+/// Weight of the delta lobes of one kind for light from `wi`.
+fn delta_weight_of(brdf: &dyn Brdf, wi: DVec3, kind: DeltaKind) -> Rgb {
+    brdf.deltas(wi)
+        .iter()
+        .filter(|d| d.kind == kind)
+        .map(|d| d.weight)
+        .sum()
 }
 
 /// The side `k` of the per-technique grid for a requested total: the
@@ -190,18 +221,45 @@ fn grid_side(samples: usize) -> usize {
 /// ρhd for light from the unit direction `wi`, with about `samples`
 /// evaluations (rounded up to `2 · REPLICAS · k²`).
 pub fn rho_hd_dir(brdf: &dyn Brdf, wi: DVec3, samples: usize, seed: u64) -> Estimate {
+    rho_hd_parts_dir(brdf, wi, samples, seed).total
+}
+
+/// [`rho_hd_dir`] split into ρR (directions on `wi`'s side, with the
+/// reflected delta lobes) and ρT (across the surface, with the transmitted
+/// ones); each part's standard error comes from the same replicas, and
+/// `total` is their sum replica by replica.
+pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, samples: usize, seed: u64) -> AlbedoParts {
     let k = grid_side(samples);
     let n = k * k;
     let transmits = brdf.transmits();
-    let mut means = Vec::with_capacity(REPLICAS);
+    let mut refl = Vec::with_capacity(REPLICAS);
+    let mut trans = Vec::with_capacity(REPLICAS);
+    let mut total = Vec::with_capacity(REPLICAS);
     let mut rejected = 0;
     for r in 0..REPLICAS {
         let mut rng = sampling::rng(stream_seed(seed, r as u64));
-        let (m, bad) = replica(brdf, wi, k, &mut rng, transmits);
-        means.push(m);
+        let (a, b, bad) = replica(brdf, wi, k, &mut rng, transmits);
+        refl.push(a);
+        trans.push(b);
+        total.push(a + b);
         rejected += bad;
     }
-    from_replicas(&means, 2 * n * REPLICAS, rejected, delta_weight(brdf, wi))
+    let count = 2 * n * REPLICAS;
+    AlbedoParts {
+        total: from_replicas(&total, count, rejected, delta_weight(brdf, wi)),
+        reflected: from_replicas(
+            &refl,
+            count,
+            rejected,
+            delta_weight_of(brdf, wi, DeltaKind::Reflection),
+        ),
+        transmitted: from_replicas(
+            &trans,
+            count,
+            rejected,
+            delta_weight_of(brdf, wi, DeltaKind::Transmission),
+        ),
+    }
 }
 
 /// ρhd for light from polar angle `theta_i` and azimuth `phi_i` (radians).
@@ -272,6 +330,16 @@ pub fn rho_hd_auto(brdf: &dyn Brdf, theta_i: f64, phi_i: f64, opts: &AlbedoOptio
     }
 }
 
+/// ρR, ρT and their sum for light from the unit direction `wi` (on either
+/// side of the surface) with the method `opts` picks for `brdf`.
+pub fn rho_hd_parts_auto(brdf: &dyn Brdf, wi: DVec3, opts: &AlbedoOptions) -> AlbedoParts {
+    if opts.uses_quadrature(brdf) {
+        quadrature::rho_hd_parts_dir(brdf, wi, &opts.quadrature)
+    } else {
+        rho_hd_parts_dir(brdf, wi, opts.samples, opts.seed)
+    }
+}
+
 /// ρhh with the method `opts` picks for `brdf`.
 pub fn rho_hh_auto(brdf: &dyn Brdf, hh_samples: usize, opts: &AlbedoOptions) -> Estimate {
     if opts.uses_quadrature(brdf) {
@@ -300,22 +368,57 @@ pub fn rho_hd_angles(
     thetas: &[f64],
     opts: &AlbedoOptions,
 ) -> AlbedoCurve {
-    let rho = thetas
+    rho_hd_angles_side(brdf, phi_i, thetas, opts, false)
+}
+
+/// [`rho_hd_angles`] with the light above the surface, or, with
+/// `from_below`, below it (`wi` the mirror image through the surface of the
+/// direction at θi, φi). For a transmitting model the curve carries ρR and
+/// ρT at each angle besides their sum.
+pub fn rho_hd_angles_side(
+    brdf: &dyn Brdf,
+    phi_i: f64,
+    thetas: &[f64],
+    opts: &AlbedoOptions,
+    from_below: bool,
+) -> AlbedoCurve {
+    let parts: Vec<AlbedoParts> = thetas
         .par_iter()
         .enumerate()
         .map(|(k, &t)| {
-            rho_hd_auto(
-                brdf,
-                t,
-                phi_i,
-                &opts.with_seed(stream_seed(opts.seed, k as u64)),
-            )
+            let mut wi = frame::from_spherical(t, phi_i);
+            if from_below {
+                wi.z = -wi.z;
+            }
+            let o = opts.with_seed(stream_seed(opts.seed, k as u64));
+            if brdf.transmits() || from_below {
+                rho_hd_parts_auto(brdf, wi, &o)
+            } else {
+                let total = rho_hd_auto(brdf, t, phi_i, &o);
+                AlbedoParts {
+                    total,
+                    reflected: total,
+                    transmitted: total,
+                }
+            }
         })
         .collect();
+    let split = brdf.transmits();
     AlbedoCurve {
         phi_i_deg: phi_i.to_degrees(),
         theta_deg: thetas.iter().map(|t| t.to_degrees()).collect(),
-        rho,
+        rho: parts.iter().map(|p| p.total).collect(),
+        from_below,
+        reflected: if split {
+            parts.iter().map(|p| p.reflected).collect()
+        } else {
+            Vec::new()
+        },
+        transmitted: if split {
+            parts.iter().map(|p| p.transmitted).collect()
+        } else {
+            Vec::new()
+        },
     }
 }
 

@@ -114,6 +114,22 @@ pub fn transmission_pairs(count: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
         .collect()
 }
 
+/// The mirror image of a direction through the surface plane (`z → −z`).
+pub fn below(w: DVec3) -> DVec3 {
+    DVec3::new(w.x, w.y, -w.z)
+}
+
+/// `count` fixed-seed pairs with both directions below the surface: the
+/// mirror images of [`upper_pairs`] (their own seed stream), for the
+/// point-wise checks of transmitting models, whose light may come from
+/// inside.
+pub fn lower_pairs(count: usize, seed: u64) -> Vec<(DVec3, DVec3)> {
+    upper_pairs(count, stream_seed(seed, 0xB10))
+        .into_iter()
+        .map(|(a, b)| (below(a), below(b)))
+        .collect()
+}
+
 /// θ and φ of a direction in degrees, for reports.
 pub fn angles_deg(w: DVec3) -> [f64; 2] {
     let (t, p) = frame::to_spherical(w);

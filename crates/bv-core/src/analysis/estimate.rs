@@ -72,3 +72,41 @@ impl Estimate {
         (v[c], e[c], c)
     }
 }
+
+/// A directional albedo split by where the light leaves: `reflected` (ρR,
+/// back to the side it came from) and `transmitted` (ρT, through the
+/// surface; 0 for a reflection model), each with its own error, and their
+/// sum `total` (ρhd = ρR + ρT, which energy conservation bounds by 1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct AlbedoParts {
+    /// ρhd = ρR + ρT.
+    pub total: Estimate,
+    /// ρR.
+    pub reflected: Estimate,
+    /// ρT.
+    pub transmitted: Estimate,
+}
+
+impl AlbedoParts {
+    /// The parts of a deterministic (quadrature) estimate: the total's error
+    /// is the sum of the parts' error bounds.
+    pub fn new(reflected: Estimate, transmitted: Estimate) -> Self {
+        let method = match (reflected.method, transmitted.method) {
+            (Method::Quadrature { converged: a }, Method::Quadrature { converged: b }) => {
+                Method::Quadrature { converged: a && b }
+            }
+            (m, _) => m,
+        };
+        Self {
+            total: Estimate {
+                value: reflected.value + transmitted.value,
+                std_error: reflected.std_error + transmitted.std_error,
+                samples: reflected.samples + transmitted.samples,
+                rejected: reflected.rejected + transmitted.rejected,
+                method,
+            },
+            reflected,
+            transmitted,
+        }
+    }
+}

@@ -110,10 +110,11 @@ pub struct PairSample {
     pub wi_deg: [f64; 2],
     /// `[θ, φ]` of `wo` in degrees.
     pub wo_deg: [f64; 2],
-    /// `f(wi, wo)`.
+    /// `f(wi, wo)` (for reciprocity across an interface, divided by ηo²).
     pub f: Rgb,
-    /// The value it was compared with: `f(wo, wi)` for reciprocity, the rotated
-    /// pair's value for isotropy, `f` itself for positivity.
+    /// The value it was compared with: `f(wo, wi)` for reciprocity (across an
+    /// interface, divided by ηi²), the rotated pair's value for isotropy, `f`
+    /// itself for positivity.
     pub f_swapped: Rgb,
 }
 
@@ -150,9 +151,14 @@ pub struct Energy {
     /// ρhd at the near-grazing θi of [`CheckOptions::grazing_deg`], one per
     /// azimuth.
     pub grazing: Vec<AlbedoCurve>,
+    /// For a transmitting model, ρhd for light from below the surface (θi
+    /// from −z, the uniform grid and the grazing angles), one curve per
+    /// azimuth; each curve of a transmitting model carries ρR and ρT besides
+    /// ρhd = ρR + ρT. Empty for a reflection model.
+    pub below: Vec<AlbedoCurve>,
     /// The largest ρhd over the curves (by its largest channel).
     pub max: Estimate,
-    /// θi of the maximum (degrees).
+    /// θi of the maximum (degrees from +z: above 90° for light from below).
     pub argmax_theta_deg: f64,
     /// φi of the maximum (degrees).
     pub argmax_phi_deg: f64,
@@ -228,9 +234,16 @@ impl CheckOptions {
     /// a slow model is analysed.
     pub fn evaluations(&self, brdf: &dyn Brdf) -> (u64, u64) {
         let pairs = self.pairs as u64;
-        let lower = if brdf.transmits() { pairs / 2 } else { 0 };
-        // Positivity once, reciprocity and isotropy twice per pair.
-        let serial = pairs + lower + 2 * pairs + 2 * pairs;
+        // Transmitting models: pairs across the surface (both orders) and
+        // below it, for positivity and reciprocity.
+        let (cross, below) = if brdf.transmits() {
+            (pairs / 2, pairs / 2)
+        } else {
+            (0, 0)
+        };
+        // Positivity once (twice for the pairs below), reciprocity and
+        // isotropy twice per pair.
+        let serial = pairs + 2 * cross + 2 * below + 2 * (pairs + cross + below) + 2 * pairs;
         let aopts = albedo::AlbedoOptions {
             method: self.albedo_method,
             ..albedo::AlbedoOptions::default()
@@ -258,13 +271,25 @@ pub fn check(brdf: &dyn Brdf, opts: &CheckOptions) -> PropertyReport {
         isotropic: c.isotropic,
     };
     let pairs = directions::upper_pairs(opts.pairs, opts.seed);
-    let lower = if brdf.transmits() {
-        directions::transmission_pairs(opts.pairs / 2, opts.seed)
+    // A transmitting model is examined on the whole sphere: pairs across the
+    // surface in both orders and pairs with both directions below it (light
+    // from inside), for positivity and reciprocity (whose check applies the
+    // generalised form across an interface).
+    let (lower, sphere) = if brdf.transmits() {
+        let cross = directions::transmission_pairs(opts.pairs / 2, opts.seed);
+        let below = directions::lower_pairs(opts.pairs / 2, opts.seed);
+        let mut lower = cross.clone();
+        lower.extend(cross.iter().map(|&(a, b)| (b, a)));
+        lower.extend(below.iter().flat_map(|&(a, b)| [(a, b), (b, a)]));
+        let mut sphere = pairs.clone();
+        sphere.extend(cross);
+        sphere.extend(below);
+        (lower, sphere)
     } else {
-        Vec::new()
+        (Vec::new(), pairs.clone())
     };
     let positivity = positivity::check(brdf, &pairs, &lower);
-    let reciprocity = reciprocity::check(brdf, &pairs, opts.tolerance);
+    let reciprocity = reciprocity::check(brdf, &sphere, opts.tolerance);
     let isotropy = isotropy::check(brdf, &pairs, opts.tolerance, opts.seed);
     let isotropic = isotropy.isotropic && claims.isotropic;
     let energy = energy(brdf, opts, isotropic);
@@ -332,11 +357,31 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
             )
         })
         .collect();
+    let below: Vec<AlbedoCurve> = if brdf.transmits() {
+        let mut thetas = albedo::theta_grid(n_theta);
+        thetas.extend(&grazing_rad);
+        phis.iter()
+            .enumerate()
+            .map(|(k, &phi)| {
+                albedo::rho_hd_angles_side(
+                    brdf,
+                    phi,
+                    &thetas,
+                    &aopts.with_seed(directions::stream_seed(opts.seed, 3000 + k as u64)),
+                    true,
+                )
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     let mut max = None::<(Estimate, f64, f64)>;
     let mut max_excess_sigmas = f64::NEG_INFINITY;
     let mut conserves = true;
-    for curve in curves.iter().chain(&grazing) {
+    for curve in curves.iter().chain(&grazing).chain(&below) {
         for (e, &t) in curve.rho.iter().zip(&curve.theta_deg) {
+            // θi of light from below is reported from +z (90°..180°).
+            let t = if curve.from_below { 180.0 - t } else { t };
             let allow = e.allowance(opts.energy_sigmas);
             for ch in 0..3 {
                 let (v, s) = (e.value[ch], e.std_error[ch]);
@@ -384,12 +429,14 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
     let converged = curves
         .iter()
         .chain(&grazing)
+        .chain(&below)
         .flat_map(|c| &c.rho)
         .chain(std::iter::once(&rho_hh))
         .all(|e| !matches!(e.method, albedo::Method::Quadrature { converged: false }));
     Energy {
         curves,
         grazing,
+        below,
         max,
         argmax_theta_deg,
         argmax_phi_deg,
@@ -537,6 +584,48 @@ impl fmt::Display for PropertyReport {
             yes_no(c.energy_conserving).into(),
             e.conserves || !c.energy_conserving,
         ));
+        if e.transmits {
+            // ρR and ρT where ρhd peaks, and the worst case from inside.
+            let at = |c: &AlbedoCurve, t: f64| -> Option<(Estimate, Estimate)> {
+                let k = c.theta_deg.iter().position(|&x| {
+                    let x = if c.from_below { 180.0 - x } else { x };
+                    (x - t).abs() < 1e-9
+                })?;
+                Some((*c.reflected.get(k)?, *c.transmitted.get(k)?))
+            };
+            let parts = e
+                .curves
+                .iter()
+                .chain(&e.grazing)
+                .chain(&e.below)
+                .filter(|c| (c.phi_i_deg - e.argmax_phi_deg).abs() < 1e-9)
+                .find_map(|c| at(c, e.argmax_theta_deg));
+            let inside = e
+                .below
+                .iter()
+                .flat_map(|c| c.rho.iter())
+                .map(|x| x.max_channel().0)
+                .fold(f64::NEG_INFINITY, f64::max);
+            rows.push((
+                "".into(),
+                format!(
+                    "ρhd = ρR + ρT (reflected + transmitted){}; light from below: max ρhd {}",
+                    parts.map_or(String::new(), |(r, t)| format!(
+                        ", at the max ρR {} + ρT {}",
+                        est(&r),
+                        est(&t)
+                    )),
+                    if inside.is_finite() {
+                        num(inside)
+                    } else {
+                        "-".into()
+                    }
+                ),
+                "".into(),
+                "".into(),
+                true,
+            ));
+        }
         rows.push((
             "".into(),
             format!(
@@ -647,6 +736,7 @@ impl fmt::Display for PropertyReport {
             .curves
             .iter()
             .chain(&e.grazing)
+            .chain(&e.below)
             .flat_map(|c| c.rho.iter().map(|x| x.rejected))
             .sum::<usize>()
             + e.rho_hh.rejected;

@@ -33,9 +33,10 @@
 //! error. Transmitting models add the lower hemisphere in `(cos θo, φo)`.
 //! Delta lobes add their exact weights.
 
-use super::estimate::{Estimate, Method};
+use super::directions::below;
+use super::estimate::{AlbedoParts, Estimate, Method};
 use super::gauss_kronrod::{self, Segment};
-use crate::{Brdf, Rgb, frame};
+use crate::{Brdf, DeltaKind, Rgb, frame};
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -119,29 +120,90 @@ fn arc_half_width(cos_ti: f64, sin_ti: f64, theta_h: f64) -> f64 {
 /// ρhd for light from the unit direction `wi` by quadrature (see the module
 /// docs), with the delta lobes' weights added.
 pub fn rho_hd_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) -> Estimate {
-    let delta: Rgb = brdf.deltas(wi).iter().map(|d| d.weight).sum();
+    rho_hd_parts_dir(brdf, wi, opts).total
+}
+
+/// ρhd split into its reflected part ρR (directions on `wi`'s side) and its
+/// transmitted part ρT (the other side; 0 for a model that does not
+/// transmit), each with its delta lobes' weights and its error estimate;
+/// `total` is their sum. Light from below the surface (`wi.z < 0`) is
+/// integrated for a transmitting model as the mirror image of the model
+/// through the surface plane lit from above; for a reflection model it sees
+/// nothing.
+pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) -> AlbedoParts {
+    let transmits = brdf.transmits();
+    if transmits && wi.z < 0.0 {
+        return rho_hd_parts_dir(&Flipped(brdf), below(wi), opts);
+    }
+    let deltas = brdf.deltas(wi);
+    let delta = |kind: DeltaKind| -> Rgb {
+        deltas
+            .iter()
+            .filter(|d| d.kind == kind)
+            .map(|d| d.weight)
+            .sum()
+    };
+    let (delta_r, delta_t) = (delta(DeltaKind::Reflection), delta(DeltaKind::Transmission));
     let cos_ti = wi.z.clamp(-1.0, 1.0);
     if cos_ti <= 0.0 || !wi.is_finite() {
-        return quad_estimate(delta, Rgb::ZERO, 0, true);
+        return AlbedoParts::new(
+            quad_estimate(delta_r, Rgb::ZERO, 0, true),
+            quad_estimate(delta_t, Rgb::ZERO, 0, true),
+        );
     }
     let sin_ti = (1.0 - cos_ti * cos_ti).max(0.0).sqrt();
     let theta_i = cos_ti.acos();
     let phi_i = if sin_ti > 0.0 { wi.y.atan2(wi.x) } else { 0.0 };
-    let transmits = brdf.transmits();
-    let mut upper = reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts);
-    if transmits {
-        let lower = transmitted(brdf, wi, opts);
-        upper.value += lower.value;
-        upper.error += lower.error;
-        upper.evaluations += lower.evaluations;
-        upper.converged &= lower.converged;
-    }
-    quad_estimate(
-        upper.value + delta,
+    let upper = reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts);
+    let reflected = quad_estimate(
+        upper.value + delta_r,
         upper.error,
         upper.evaluations,
         upper.converged,
-    )
+    );
+    let transmitted = if transmits {
+        let lower = transmitted(brdf, wi, opts);
+        quad_estimate(
+            lower.value + delta_t,
+            lower.error,
+            lower.evaluations,
+            lower.converged,
+        )
+    } else {
+        quad_estimate(delta_t, Rgb::ZERO, 0, true)
+    };
+    AlbedoParts::new(reflected, transmitted)
+}
+
+/// The mirror image of a transmitting model through the surface plane
+/// (`z → −z` for every direction): light from below the original is light
+/// from above the image.
+#[derive(Debug)]
+struct Flipped<'a>(&'a dyn Brdf);
+
+impl Brdf for Flipped<'_> {
+    fn id(&self) -> &'static str {
+        self.0.id()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        self.0.eval(below(wi), below(wo))
+    }
+    fn claims(&self) -> crate::Claims {
+        self.0.claims()
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+    fn deltas(&self, wi: DVec3) -> Vec<crate::DeltaLobe> {
+        let mut d = self.0.deltas(below(wi));
+        for l in &mut d {
+            l.direction = below(l.direction);
+        }
+        d
+    }
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        self.0.peaks(below(wi)).into_iter().map(below).collect()
+    }
 }
 
 fn quad_estimate(value: Rgb, error: Rgb, samples: usize, converged: bool) -> Estimate {
@@ -256,30 +318,119 @@ fn reflected(
     r
 }
 
-/// The transmitted part, over `(μ = −cos θo, φo)` of the lower hemisphere:
-/// `∫∫ f μ dμ dφo`.
+/// The transmitted part, over the polar angle `θ'` of `wo` from −z and its
+/// azimuth φo: `wo = (sin θ' cos φo, sin θ' sin φo, −cos θ')`,
+/// `∫∫ f cos θ' sin θ' dφo dθ'`. θ' is graded geometrically (down to
+/// [`FINEST`]) about each peak the model names below the surface
+/// ([`Brdf::peaks`]: a rough dielectric's refracted direction) and φo about
+/// the peak's azimuth, as the reflected part is graded about its peaks, so a
+/// lobe as narrow as α = 0.001 is resolved; a peak at the pole is a cap that
+/// the grading at θ' = 0 resolves. For a model of an interface
+/// ([`Brdf::interface_eta`]) θ' also breaks where the generalised half
+/// vector `ηi wi + ηo wo` of Walter et al. 2007 (eq. 16) turns horizontal,
+/// `cos θ' = ηi cos θi / ηo`: a microfacet BTDF whose D does not vanish at
+/// the horizon (GGX) drops to 0 across that circle, and a panel edge there
+/// keeps the rule's error estimate honest.
 fn transmitted(
     brdf: &dyn Brdf,
     wi: DVec3,
     opts: &QuadratureOptions,
 ) -> gauss_kronrod::Integral<Rgb> {
-    let inner_tol = 0.1 * opts.abs_tol;
+    let peaks: Vec<(f64, f64)> = brdf
+        .peaks(wi)
+        .into_iter()
+        .filter(|p| p.is_finite() && p.z < 0.0)
+        .filter_map(|p| {
+            let p = p.try_normalize()?;
+            Some(((-p.z).clamp(-1.0, 1.0).acos(), p.y.atan2(p.x)))
+        })
+        .collect();
+    let mut breaks = vec![0.0, FRAC_PI_2];
+    for &(t, _) in &peaks {
+        graded_about(t, 0.0, FRAC_PI_2, &mut breaks);
+    }
+    if let Some(eta) = brdf.interface_eta() {
+        // wi is above here: ηi = 1, ηo = η.
+        let c = wi.z / eta;
+        if c.is_finite() && c > 0.0 && c < 1.0 {
+            breaks.push(c.acos());
+        }
+    }
+    breaks.retain(|&x| (0.0..=FRAC_PI_2).contains(&x));
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
+    let mut segs = Vec::with_capacity(breaks.len());
+    let last = breaks.len().saturating_sub(2);
+    for (k, w) in breaks.windows(2).enumerate() {
+        let grading = match (k == 0, k == last) {
+            (true, true) => gauss_kronrod::Grading::Both,
+            (true, false) => gauss_kronrod::Grading::Start,
+            (false, true) => gauss_kronrod::Grading::End,
+            (false, false) => gauss_kronrod::Grading::Linear,
+        };
+        segs.push(Segment {
+            a: w[0],
+            b: w[1],
+            grading,
+        });
+    }
+    let anisotropic = !brdf.claims().isotropic;
+    // The azimuth the inner integrals centre on: the peak's, or wi's
+    // opposite (where a refracted lobe lies).
+    let phi_c = peaks.first().map_or(wi.y.atan2(wi.x) + PI, |&(_, p)| p);
+    // Breaks at the peaks' azimuths (and the tangent axes of an anisotropic
+    // model), the panels on either side of φc graded towards it (their first
+    // Kronrod nodes lie within 1e-4 rad of it, inside any lobe of α ≥ 0.001),
+    // the rest left to bisection, as the reflected part's are.
+    let mut phi_breaks = vec![phi_c - PI, phi_c, phi_c + PI];
+    for &(_, p) in peaks.iter().skip(1) {
+        phi_breaks.push(wrap_near(p, phi_c));
+    }
+    if anisotropic {
+        for a in [0.0, FRAC_PI_2, PI, -FRAC_PI_2] {
+            phi_breaks.push(wrap_near(a, phi_c));
+        }
+    }
+    phi_breaks.retain(|&x| x >= phi_c - PI && x <= phi_c + PI);
+    phi_breaks.sort_by(f64::total_cmp);
+    phi_breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
+    let inner_segs: Vec<Segment> = phi_breaks
+        .windows(2)
+        .map(|w| Segment {
+            a: w[0],
+            b: w[1],
+            grading: if w[1] == phi_c {
+                gauss_kronrod::Grading::End
+            } else if w[0] == phi_c {
+                gauss_kronrod::Grading::Start
+            } else {
+                gauss_kronrod::Grading::Linear
+            },
+        })
+        .collect();
+    let inner_tol = 0.2 * opts.abs_tol / FRAC_PI_2;
     let mut inner_evals = 0usize;
-    let mut outer = |mu: f64| -> (Rgb, Rgb) {
-        let s = (1.0 - mu * mu).max(0.0).sqrt();
+    let mut outer = |theta: f64| -> (Rgb, Rgb) {
+        let (st, ct) = theta.sin_cos();
+        if ct <= 0.0 {
+            return (Rgb::ZERO, Rgb::ZERO);
+        }
         let mut inner = |phi: f64| -> (Rgb, Rgb) {
             let (sp, cp) = phi.sin_cos();
-            let wo = DVec3::new(s * cp, s * sp, -mu);
-            (brdf.eval(wi, wo) * mu, Rgb::ZERO)
+            let wo = DVec3::new(st * cp, st * sp, -ct);
+            (brdf.eval(wi, wo) * (ct * st), Rgb::ZERO)
         };
-        let br: Vec<f64> = (0..=4).map(|k| -PI + FRAC_PI_2 * k as f64).collect();
-        let segs = gauss_kronrod::segments(&br, false, false);
-        let r =
-            gauss_kronrod::integrate(&mut inner, &segs, inner_tol, 0.0, opts.inner_panels, false);
+        let r = gauss_kronrod::integrate(
+            &mut inner,
+            &inner_segs,
+            inner_tol,
+            0.0,
+            opts.inner_panels,
+            false,
+        );
         inner_evals += r.evaluations;
         (r.value, r.error)
     };
-    let segs = gauss_kronrod::segments(&[0.0, 0.5, 1.0], true, true);
     let mut r = gauss_kronrod::integrate(
         &mut outer,
         &segs,

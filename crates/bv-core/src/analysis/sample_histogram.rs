@@ -46,6 +46,11 @@ pub struct HistogramOptions {
     /// Cells whose expected count is below this are pooled (5 is the rule of
     /// thumb for Pearson's test).
     pub min_expected: f64,
+    /// Bin the whole sphere instead of the upper hemisphere (for a
+    /// transmitting model's sampler): the `n_theta` rows then split
+    /// `z ∈ [−1, 1]` into bands of equal solid angle, row 0 the cap about +z
+    /// and the last the cap about −z. Default: the upper hemisphere.
+    pub whole_sphere: bool,
 }
 
 impl Default for HistogramOptions {
@@ -58,6 +63,7 @@ impl Default for HistogramOptions {
             max_points: 2_000,
             quadrature_order: 6,
             min_expected: 5.0,
+            whole_sphere: false,
         }
     }
 }
@@ -88,20 +94,29 @@ pub struct SampleHistogram {
     pub points: Vec<DVec3>,
     /// Pearson's test over the bins and the "no direction" cell.
     pub chi2: ChiSquare,
+    /// Whether the bins cover the whole sphere ([`HistogramOptions::whole_sphere`]).
+    pub whole_sphere: bool,
 }
 
 impl SampleHistogram {
-    /// The bin `(t, p)` of a direction above the horizon.
+    /// The bin `(t, p)` of a direction above the horizon (anywhere but on
+    /// the horizon for a whole-sphere histogram).
     pub fn bin_of(&self, w: DVec3) -> Option<(usize, usize)> {
-        bin_of(w, self.n_theta, self.n_phi)
+        bin_of(w, self.n_theta, self.n_phi, self.whole_sphere)
     }
 }
 
-fn bin_of(w: DVec3, n_theta: usize, n_phi: usize) -> Option<(usize, usize)> {
-    if w.z.is_nan() || w.z <= 0.0 || !w.is_finite() {
+/// Height in `z` of a row of bins: 1, or 2 on the whole sphere.
+fn z_span(whole_sphere: bool) -> f64 {
+    if whole_sphere { 2.0 } else { 1.0 }
+}
+
+fn bin_of(w: DVec3, n_theta: usize, n_phi: usize, whole_sphere: bool) -> Option<(usize, usize)> {
+    if w.z.is_nan() || (w.z <= 0.0 && !whole_sphere) || w.z == 0.0 || !w.is_finite() {
         return None;
     }
-    let t = (((1.0 - w.z.min(1.0)) * n_theta as f64) as usize).min(n_theta - 1);
+    let t =
+        (((1.0 - w.z.min(1.0)) / z_span(whole_sphere) * n_theta as f64) as usize).min(n_theta - 1);
     let phi = w.y.atan2(w.x).rem_euclid(2.0 * PI);
     let p = ((phi / (2.0 * PI) * n_phi as f64) as usize).min(n_phi - 1);
     Some((t, p))
@@ -206,7 +221,7 @@ impl HistogramJob {
                 let u = sampling::uniform2(&mut self.rng);
                 match brdf
                     .sample(self.wo, u)
-                    .and_then(|w| bin_of(w, n_theta, n_phi).map(|b| (w, b)))
+                    .and_then(|w| bin_of(w, n_theta, n_phi, self.opts.whole_sphere).map(|b| (w, b)))
                 {
                     Some((w, (t, p))) => {
                         self.observed[t * n_phi + p] += 1;
@@ -238,7 +253,7 @@ impl HistogramJob {
     /// `∫_bin pdf dω = ∫∫ pdf dz dφ` (dω = dz dφ) over bin `(t, p)`,
     /// Gauss–Legendre in each.
     fn bin_mass(&self, brdf: &dyn Brdf, t: usize, p: usize) -> f64 {
-        let dz = 1.0 / self.opts.n_theta as f64;
+        let dz = z_span(self.opts.whole_sphere) / self.opts.n_theta as f64;
         let dphi = 2.0 * PI / self.opts.n_phi as f64;
         let z_hi = 1.0 - t as f64 * dz;
         let phi_lo = p as f64 * dphi;
@@ -289,6 +304,7 @@ impl HistogramJob {
             pdf_mass,
             points: std::mem::take(&mut self.points),
             chi2,
+            whole_sphere: self.opts.whole_sphere,
         }
     }
 }

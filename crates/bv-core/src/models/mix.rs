@@ -244,8 +244,12 @@ impl Brdf for Mix {
         // energy, ρ = Σ w_j ρ_j ≤ Σ w_j max ρ_j ≤ 1 when every part conserves and
         // Σ w_j ≤ 1; otherwise not claimed.
         let all = |f: fn(&Claims) -> bool| self.parts.iter().all(|p| f(&p.brdf.claims()));
+        // Across an interface each part obeys f(wi, wo)/ηo² = f(wo, wi)/ηi²
+        // with its own η: the sum does with one η only if they agree.
+        let mut etas = self.parts.iter().filter_map(|p| p.brdf.interface_eta());
+        let one_interface = etas.next().is_none_or(|first| etas.all(|e| e == first));
         Claims {
-            reciprocal: all(|c| c.reciprocal),
+            reciprocal: one_interface && all(|c| c.reciprocal),
             energy_conserving: self.total <= 1.0 && all(|c| c.energy_conserving),
             isotropic: all(|c| c.isotropic),
         }
@@ -268,6 +272,14 @@ impl Brdf for Mix {
 
     fn transmits(&self) -> bool {
         self.parts.iter().any(|p| p.brdf.transmits())
+    }
+
+    /// The interface the parts model, when those that model one agree on
+    /// its index (then the generalised reciprocity holds for the sum).
+    fn interface_eta(&self) -> Option<f64> {
+        let mut etas = self.parts.iter().filter_map(|p| p.brdf.interface_eta());
+        let first = etas.next()?;
+        etas.all(|e| e == first).then_some(first)
     }
 
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
@@ -566,6 +578,22 @@ mod tests {
         assert!(c(vec![(0.5, lambert(1.0)), (0.5, lambert(0.2))]).energy_conserving);
         // Σw > 1 with albedo-1 parts: not claimed.
         assert!(!c(vec![(0.6, lambert(1.0)), (0.6, lambert(1.0))]).energy_conserving);
+        // Two interfaces of different η: no single generalised reciprocity.
+        let rough = |eta: f64| -> Box<dyn Brdf> {
+            ModelSpec::from_json("rough-dielectric", &serde_json::json!({"eta": eta}))
+                .unwrap()
+                .build()
+                .unwrap()
+        };
+        let same = Mix::from_parts(vec![
+            (0.5, rough(1.5)),
+            (0.5, rough(1.5)),
+            (0.2, lambert(0.5)),
+        ])
+        .unwrap();
+        assert!(same.claims().reciprocal && same.interface_eta() == Some(1.5));
+        let two = Mix::from_parts(vec![(0.5, rough(1.5)), (0.5, rough(1.3))]).unwrap();
+        assert!(!two.claims().reciprocal && two.interface_eta().is_none());
         let odd = c(vec![(0.5, lambert(1.0)), (0.1, Box::new(Odd))]);
         assert!(!odd.reciprocal && !odd.energy_conserving && odd.isotropic);
         // A zero-weight component does not count.

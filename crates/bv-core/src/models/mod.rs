@@ -22,6 +22,7 @@ pub mod mix;
 pub mod modified_phong;
 pub mod oren_nayar;
 pub mod phong;
+pub mod rough_dielectric;
 pub mod ward;
 
 #[cfg(test)]
@@ -43,6 +44,7 @@ pub static BUILT_IN: &[&ModelInfo] = &[
     &disney::INFO,
     &mirror::INFO,
     &glass::INFO,
+    &rough_dielectric::INFO,
     &merl::INFO,
     &mix::INFO,
 ];
