@@ -129,8 +129,10 @@ pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
                 if row.reset {
                     t = Incident::default().theta_deg;
                 }
-                row.track
-                    .on_hover_text("Polar angle of the light from the normal");
+                row.track.on_hover_text(
+                    "Polar angle of the light from the normal; beyond 90° the light is \
+                     below the surface (for a model that transmits)",
+                );
             });
             ui.horizontal(|ui| {
                 let row = params_ui::slider_row(
@@ -219,8 +221,15 @@ pub fn hemisphere_widget(
     let right = Vec2::new(-yaw.sin(), yaw.cos());
     let toward = Vec2::new(yaw.cos(), yaw.sin());
     let ground_to_screen = |g: Vec2| Vec2::new(g.dot(right), g.dot(toward));
+    // A light below the surface (issue 33) is drawn where it shows through
+    // the disc, at 180° − θ from the centre (the downward normal), and a
+    // drag keeps it on its side; the θ slider crosses the horizon.
+    let below = inc.below();
+    let disc_theta = |theta_deg: f64| {
+        if below { 180.0 - theta_deg } else { theta_deg }
+    };
     let to_screen = |theta_deg: f64, phi_deg: f64| {
-        let r = (theta_deg / 90.0) as f32 * radius;
+        let r = (disc_theta(theta_deg) / 90.0) as f32 * radius;
         let a = phi_deg.to_radians() as f32;
         c + ground_to_screen(Vec2::new(r * a.cos(), r * a.sin()))
     };
@@ -229,7 +238,7 @@ pub fn hemisphere_widget(
     {
         let d = pos - c;
         let g = right * d.x + toward * d.y;
-        let theta = (d.length() / radius * 90.0) as f64;
+        let theta = disc_theta((d.length() / radius * 90.0).min(90.0) as f64);
         let phi = g.y.atan2(g.x).to_degrees() as f64;
         let new = Incident {
             theta_deg: theta,
@@ -278,17 +287,32 @@ pub fn hemisphere_widget(
     let m = to_screen(inc.theta_deg, inc.phi_deg + 180.0);
     painter.circle_stroke(m, 4.0, Stroke::new(1.5, views::mirror_color(dark)));
     painter.line_segment([c, p], Stroke::new(1.5, light));
-    painter.circle_filled(
-        p,
-        if response.hovered() || response.dragged() {
-            7.0
-        } else {
-            6.0
-        },
-        light,
-    );
-    painter.circle_stroke(p, 6.0, Stroke::new(1.0, Color32::BLACK.gamma_multiply(0.6)));
-    response.on_hover_text("Drag to move the light: the centre is the normal, the rim the horizon")
+    let r_dot = if response.hovered() || response.dragged() {
+        7.0
+    } else {
+        6.0
+    };
+    if below {
+        // Hollow: seen through the surface, from below.
+        painter.circle_stroke(p, r_dot, Stroke::new(2.0, light));
+        painter.text(
+            rect.left_top() + Vec2::new(2.0, 2.0),
+            Align2::LEFT_TOP,
+            "below",
+            FontId::proportional(11.0),
+            light,
+        );
+    } else {
+        painter.circle_filled(p, r_dot, light);
+        painter.circle_stroke(p, 6.0, Stroke::new(1.0, Color32::BLACK.gamma_multiply(0.6)));
+    }
+    response.on_hover_text(if below {
+        "The light is below the surface (hollow dot, seen through it): drag to move it \
+         there; the centre is the downward normal, the rim the horizon. The θi slider \
+         brings it back above."
+    } else {
+        "Drag to move the light: the centre is the normal, the rim the horizon"
+    })
 }
 
 /// The selected BRDF's description and parameter widgets.

@@ -945,7 +945,7 @@ fn central_presenting(
     });
     ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {
         ui.set_clip_rect(rect.intersect(ui.clip_rect()));
-        view.ui(ui, scene, out);
+        crate::views::show(view.as_mut(), ui, scene, out);
     });
 }
 
@@ -1102,7 +1102,7 @@ fn view_frame(
                 view.toolbar(ui, scene, out);
             });
             ui.separator();
-            view.ui(ui, scene, out);
+            crate::views::show(view, ui, scene, out);
         });
 }
 

@@ -69,7 +69,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "VIEW", required_unless_present = "deck")]
     pub view: Option<String>,
 
-    /// Polar angle of the light, degrees (0..89.5).
+    /// Polar angle of the light, degrees: 0..89.5 above the surface, 90.5..180
+    /// below it (light inside a transmitting model's medium; the horizon band
+    /// is refused).
     #[arg(long = "theta-i", value_name = "DEG", allow_negative_numbers = true)]
     pub theta_i: Option<f64>,
 
@@ -205,6 +207,9 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
                 "--theta-i {t}: out of range 0..={}°",
                 Incident::MAX_THETA_DEG
             );
+        }
+        if Incident::in_horizon_gap(t) {
+            bail!("--theta-i {t}: {}", Incident::horizon_reason(t));
         }
         inc.theta_deg = t;
     }

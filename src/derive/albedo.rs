@@ -1,6 +1,11 @@
 //! Directional albedo curves: `ρhd(θi) = ∫ f cos θo dωo` (plus the weights
 //! of delta lobes) against θi, with error bands, and the bihemispherical
-//! albedo ρhh. They are `bv_core::analysis::albedo`'s, the estimators
+//! albedo ρhh. For a transmitting model the curve covers light from both
+//! sides (θi 0°..88° above, 92°..180° below) and carries its parts: ρR (what
+//! leaves on the light's side) and ρT (what crosses the surface), whose sum
+//! is ρhd; below 1 for a non-absorbing dielectric, the sum shows what a
+//! single-scattering microfacet BSDF loses (the white furnace test; Walter
+//! et al. 2007 §5.2, Heitz 2016 for the missing multiple scattering). They are `bv_core::analysis::albedo`'s, the estimators
 //! `bv check` reports: deterministic Gauss–Kronrod quadrature for analytic
 //! models (band: its error estimate), Monte Carlo for measured ones (band:
 //! ±3 standard errors).
@@ -11,14 +16,18 @@
 
 use super::jobs::{self, Shown, Slots, Steps, Waker};
 use crate::session::frame::{Scene, SceneBrdf};
-use bv_core::analysis::albedo::{AlbedoOptions, Estimate, rho_hd_auto, rho_hh_auto, theta_grid};
+use bv_core::analysis::albedo::{
+    AlbedoOptions, AlbedoParts, Estimate, rho_hd_auto, rho_hd_parts_auto, rho_hh_auto, theta_grid,
+};
 use bv_core::analysis::directions::stream_seed;
 use bv_core::{Brdf, mean_rgb};
 use rayon::prelude::*;
+use std::f64::consts::PI;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-/// θi samples: 0°, 2°, …, 88° (90° is left out: no light arrives there).
+/// θi samples above the surface: 0°, 2°, …, 88° (90° is left out: no light
+/// arrives there). A transmitting model has as many below: 92°, …, 180°.
 pub const N_THETA: usize = 45;
 /// Evaluations per θi.
 pub const SAMPLES: usize = 4096;
@@ -43,10 +52,15 @@ fn options(seed: u64) -> AlbedoOptions {
 /// One finished curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlbedoData {
-    /// θi in degrees.
+    /// θi in degrees, ascending (above 90° the light is below the surface,
+    /// for a transmitting model).
     pub theta_deg: Vec<f64>,
-    /// ρhd at each θi.
+    /// ρhd at each θi (ρR + ρT for a transmitting model).
     pub rho: Vec<Estimate>,
+    /// For a transmitting model, ρR at each θi; empty otherwise.
+    pub reflected: Vec<Estimate>,
+    /// For a transmitting model, ρT at each θi; empty otherwise.
+    pub transmitted: Vec<Estimate>,
     /// ρhh.
     pub rho_hh: Estimate,
 }
@@ -58,8 +72,11 @@ pub struct AlbedoData {
 pub struct AlbedoJob {
     phi_i: f64,
     thetas: Vec<f64>,
-    rho: Vec<Estimate>,
+    rho: Vec<AlbedoParts>,
     per_step: usize,
+    /// Whether the BRDF transmits: decided at the first step (the job is
+    /// made before it sees the BRDF); `None` until then.
+    transmits: Option<bool>,
 }
 
 impl AlbedoJob {
@@ -71,36 +88,74 @@ impl AlbedoJob {
             thetas: theta_grid(N_THETA),
             rho: Vec::with_capacity(N_THETA),
             per_step: per_step.max(1),
+            transmits: None,
         }
     }
 
-    /// Steps finished ([`STEPS`] in all).
+    /// Steps finished (of [`Self::steps`]).
     pub fn done(&self) -> usize {
         self.rho.len()
+    }
+
+    /// Steps in all: one per θi and one for ρhh ([`STEPS`] for a
+    /// reflection-only model, [`N_THETA`] more for a transmitting one).
+    pub fn steps(&self) -> usize {
+        self.thetas.len() + 1
     }
 
     /// Computes the next θi of `brdf` (or, once all are done, ρhh) and
     /// returns the curve once it is complete. `brdf` must be the same at
     /// every step.
     pub fn step(&mut self, brdf: &dyn Brdf) -> Option<AlbedoData> {
+        let transmits = *self.transmits.get_or_insert_with(|| {
+            let t = brdf.transmits();
+            if t {
+                // Light from below: the mirror images of the angles above
+                // through the surface, ascending (92°, …, 180°).
+                let below: Vec<f64> = self.thetas.iter().rev().map(|t| PI - t).collect();
+                self.thetas.extend(below);
+            }
+            t
+        });
         let k0 = self.rho.len();
         if k0 < self.thetas.len() {
             let k1 = (k0 + self.per_step).min(self.thetas.len());
             let phi_i = self.phi_i;
-            let part: Vec<Estimate> = self.thetas[k0..k1]
+            let part: Vec<AlbedoParts> = self.thetas[k0..k1]
                 .par_iter()
                 .enumerate()
                 .map(|(j, &t)| {
-                    rho_hd_auto(brdf, t, phi_i, &options(stream_seed(SEED, (k0 + j) as u64)))
+                    let o = options(stream_seed(SEED, (k0 + j) as u64));
+                    if transmits {
+                        // θi above 90° is a light inside the medium (issue 33).
+                        rho_hd_parts_auto(brdf, bv_core::frame::from_spherical(t, phi_i), &o)
+                    } else {
+                        let total = rho_hd_auto(brdf, t, phi_i, &o);
+                        AlbedoParts {
+                            total,
+                            reflected: total,
+                            transmitted: total,
+                        }
+                    }
                 })
                 .collect();
             self.rho.extend(part);
             return None;
         }
         let rho_hh = rho_hh_auto(brdf, RHH_SAMPLES, &options(SEED));
+        let parts = std::mem::take(&mut self.rho);
+        let split = |f: fn(&AlbedoParts) -> Estimate| {
+            if transmits {
+                parts.iter().map(f).collect()
+            } else {
+                Vec::new()
+            }
+        };
         Some(AlbedoData {
             theta_deg: self.thetas.iter().map(|t| t.to_degrees()).collect(),
-            rho: std::mem::take(&mut self.rho),
+            rho: parts.iter().map(|p| p.total).collect(),
+            reflected: split(|p| p.reflected),
+            transmitted: split(|p| p.transmitted),
             rho_hh,
         })
     }
@@ -108,7 +163,7 @@ impl AlbedoJob {
 
 impl AlbedoData {
     /// Computes the curve of `brdf` for light at azimuth `phi_i` (radians),
-    /// counting finished steps in `progress` ([`STEPS`] in all); `None` when
+    /// counting finished steps in `progress` ([`AlbedoJob::steps`] in all); `None` when
     /// `cancel` was raised.
     pub fn compute(
         brdf: &dyn Brdf,
@@ -136,6 +191,21 @@ impl AlbedoData {
         (mean_rgb(e.value), mean_rgb(e.allowance(BAND_SIGMAS)))
     }
 
+    /// Whether the curve carries ρR and ρT (a transmitting model).
+    pub fn has_parts(&self) -> bool {
+        !self.transmitted.is_empty() && self.transmitted.len() == self.rho.len()
+    }
+
+    /// The (θi in degrees, channel mean) points of one series: the total
+    /// ρhd, or a part ([`Self::reflected`], [`Self::transmitted`]).
+    pub fn series(&self, of: &[Estimate]) -> Vec<[f64; 2]> {
+        self.theta_deg
+            .iter()
+            .zip(of)
+            .map(|(t, e)| [*t, mean_rgb(e.value)])
+            .collect()
+    }
+
     /// Whether some channel exceeds 1 by more than its error band somewhere.
     pub fn exceeds_one(&self) -> bool {
         self.rho.iter().any(|e| {
@@ -151,7 +221,8 @@ impl AlbedoData {
     }
 }
 
-/// Steps of a computation (one per θi, one for ρhh).
+/// Steps of a computation of a reflection-only model (one per θi, one for
+/// ρhh; see [`AlbedoJob::steps`]).
 pub const STEPS: usize = N_THETA + 1;
 
 /// What a curve is keyed by: the BRDF's build revision (a turned surface
@@ -170,7 +241,7 @@ impl Steps<Arc<AlbedoData>> for Run {
     }
 
     fn progress(&self) -> Option<(usize, usize)> {
-        Some((self.job.done(), STEPS))
+        Some((self.job.done(), self.job.steps()))
     }
 }
 

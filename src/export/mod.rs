@@ -104,6 +104,14 @@ pub fn start_view(
     runtime.sync(state);
     check_brdfs(state, &runtime)?;
     let mut view = (entry.make)();
+    // A figure does not carry a note in its pixels: a light below the
+    // surface with only reflecting models is an error here (issue 33).
+    if !view.shows_light_below()
+        && let Some(note) =
+            crate::views::light_below_note(&figure_scene(state, &runtime, frame.transparent))
+    {
+        bail!("{} view: {note}", entry.id);
+    }
     let img = off.start_render(frame, |ui| {
         let scene = figure_scene(state, &runtime, frame.transparent);
         // No fill: the image is cleared to the panels' colour
@@ -208,5 +216,10 @@ pub fn view_svg(
     runtime.sync(state);
     let scene = figure_scene(state, &runtime, transparent);
     let mut view = (entry.make)();
+    // Nothing to draw with the light below and only reflecting models (the
+    // PNG of the same view reports why).
+    if !view.shows_light_below() && crate::views::light_below_note(&scene).is_some() {
+        return None;
+    }
     view.svg(&scene, size, is_dark(state))
 }

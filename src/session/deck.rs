@@ -680,12 +680,12 @@ mod tests {
         // The second entry's inline scene has an angle out of range.
         let text = format!(
             "{HEAD}{good}[[scene]]\ntitle = \"Phong\"\ncaption = \"c\"\nview = \"lobe\"\n\
-             [scene.state]\nincident = {{ theta_deg = 120.0, phi_deg = 0.0 }}\n"
+             [scene.state]\nincident = {{ theta_deg = 190.0, phi_deg = 0.0 }}\n"
         );
         let (i, title, key, reason) = entry_error(&text);
         assert_eq!((i, title.as_deref()), (1, Some("Phong")));
         assert_eq!(key, "state.incident.theta_deg");
-        assert!(reason.contains("120"), "{reason}");
+        assert!(reason.contains("190"), "{reason}");
         let msg = parse(&text).unwrap_err().to_string();
         assert!(
             msg.contains("scene[1] (\"Phong\")") && msg.contains("state.incident.theta_deg"),

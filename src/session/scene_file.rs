@@ -448,6 +448,12 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         Incident::MAX_THETA_DEG,
         "°",
     )?;
+    if Incident::in_horizon_gap(s.incident.theta_deg) {
+        return bad(
+            "incident.theta_deg",
+            Incident::horizon_reason(s.incident.theta_deg),
+        );
+    }
     range("incident.phi_deg", s.incident.phi_deg, -360.0, 360.0, "°")?;
     range("display.turn_deg", s.display.turn_deg, -360.0, 360.0, "°")?;
     range(
@@ -682,8 +688,17 @@ mod tests {
     #[test]
     fn bad_values_name_the_key() {
         let text = to_toml(&sample()).unwrap();
-        let e = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 120.0")).unwrap_err();
+        let e = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 190.0")).unwrap_err();
         assert!(e.to_string().contains("incident.theta_deg"), "{e}");
+        // The horizon is refused with the reason; a light below loads (issue 33).
+        let e = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 90.0")).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.contains("incident.theta_deg") && m.contains("horizon"),
+            "{m}"
+        );
+        let below = from_toml(&text.replace("theta_deg = 33.25", "theta_deg = 120.0")).unwrap();
+        assert_eq!(below.state.incident.theta_deg, 120.0);
         let e = from_toml(&text.replace("turn_deg = 37.5", "turn_deg = 1e9")).unwrap_err();
         assert!(e.to_string().contains("display.turn_deg"), "{e}");
         let e = from_toml(&text.replace("factor_terms = 2", "factor_terms = 0")).unwrap_err();

@@ -58,7 +58,9 @@ pub struct BrdfEntry {
 /// show and what a lecturer quotes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Incident {
-    /// Polar angle from the normal, 0..90°.
+    /// Polar angle from the normal, 0..180°: above 90° the light is below
+    /// the surface (inside the medium of a transmitting model), and the
+    /// horizon band [`Incident::in_horizon_gap`] is excluded.
     pub theta_deg: f64,
     /// Azimuth from the tangent towards the bitangent, −180..180°.
     pub phi_deg: f64,
@@ -74,9 +76,42 @@ impl Default for Incident {
 }
 
 impl Incident {
-    /// Largest polar angle the sliders and drags allow: the horizon itself is
-    /// excluded because every reflection model is 0 there.
-    pub const MAX_THETA_DEG: f64 = 89.5;
+    /// Largest polar angle the sliders, drags, scene files and `bv render`
+    /// allow: straight from below (issue 33, light inside a transmitting
+    /// model's medium).
+    pub const MAX_THETA_DEG: f64 = 180.0;
+
+    /// Largest polar angle above the surface: the horizon itself is excluded
+    /// because every reflection model is 0 there and a refracted ray is not
+    /// defined (the light grazes the interface).
+    pub const MAX_ABOVE_DEG: f64 = 89.5;
+
+    /// Smallest polar angle below the surface, the mirror of
+    /// [`Self::MAX_ABOVE_DEG`].
+    pub const MIN_BELOW_DEG: f64 = 90.5;
+
+    /// Whether `theta_deg` lies in the excluded band around the horizon,
+    /// (89.5°, 90.5°).
+    pub fn in_horizon_gap(theta_deg: f64) -> bool {
+        theta_deg > Self::MAX_ABOVE_DEG && theta_deg < Self::MIN_BELOW_DEG
+    }
+
+    /// Why a θ in the horizon band is refused (scene files, decks,
+    /// `bv render --theta-i`).
+    pub fn horizon_reason(theta_deg: f64) -> String {
+        format!(
+            "{}° is at the horizon: the light must be above the surface (≤ {}°) or \
+             below it (≥ {}°, for a model that transmits)",
+            bv_core::error::fmt_num(theta_deg),
+            Self::MAX_ABOVE_DEG,
+            Self::MIN_BELOW_DEG
+        )
+    }
+
+    /// Whether the light is below the surface (θi > 90°).
+    pub fn below(&self) -> bool {
+        self.theta_deg > 90.0
+    }
 
     /// The unit direction towards the light.
     pub fn direction(&self) -> glam::DVec3 {
@@ -84,9 +119,21 @@ impl Incident {
     }
 
     /// The same direction with θ clamped to the slider range and φ wrapped.
+    /// A θ in the horizon band goes to the nearer of its edges (exactly 90°
+    /// to 89.5°, above the surface, as it always did): a defined light,
+    /// never one in the surface.
     pub fn clamped(self) -> Self {
         let theta = if self.theta_deg.is_finite() {
-            self.theta_deg.clamp(0.0, Self::MAX_THETA_DEG)
+            let t = self.theta_deg.clamp(0.0, Self::MAX_THETA_DEG);
+            if Self::in_horizon_gap(t) {
+                if t <= 90.0 {
+                    Self::MAX_ABOVE_DEG
+                } else {
+                    Self::MIN_BELOW_DEG
+                }
+            } else {
+                t
+            }
         } else {
             0.0
         };
@@ -109,8 +156,8 @@ impl Incident {
         }
     }
 
-    /// The incident direction pointing at `w` (any vector with a positive z
-    /// after clamping; the horizon is clamped to [`Self::MAX_THETA_DEG`]).
+    /// The incident direction pointing at `w` (any non-zero vector, above or
+    /// below the surface; the horizon band is clamped to its nearer edge).
     pub fn from_direction(w: glam::DVec3) -> Self {
         let (theta, phi) = bv_core::frame::to_spherical(w.normalize_or(glam::DVec3::Z));
         Self {
@@ -581,7 +628,8 @@ mod tests {
         assert_eq!(s.selected, Some(4));
         assert_eq!(s.solo, None);
         assert_eq!(s.next_id, 5);
-        assert_eq!(s.incident.theta_deg, Incident::MAX_THETA_DEG);
+        // 120° is a light below the surface (issue 33): kept.
+        assert_eq!(s.incident.theta_deg, 120.0);
         assert!((s.incident.phi_deg - (-90.0)).abs() < 1e-9);
     }
 
@@ -616,8 +664,45 @@ mod tests {
         let back = Incident::from_direction(i.direction());
         assert!((back.theta_deg - 30.0).abs() < 1e-9);
         assert!((back.phi_deg + 45.0).abs() < 1e-9);
-        // Below the horizon clamps to the slider's limit.
+        // Below the surface is a light from below (issue 33).
         let low = Incident::from_direction(glam::DVec3::new(1.0, 0.0, -0.2));
-        assert_eq!(low.theta_deg, Incident::MAX_THETA_DEG);
+        assert!((low.theta_deg - (90.0 + 0.2f64.atan().to_degrees())).abs() < 1e-9);
+        assert!(low.below());
+        // The horizon goes to the edge of the excluded band on its side.
+        let flat = Incident::from_direction(glam::DVec3::new(1.0, 0.0, 0.0));
+        assert_eq!(flat.theta_deg, Incident::MAX_ABOVE_DEG);
+        let just_below = Incident::from_direction(glam::DVec3::new(1.0, 0.0, -1e-4));
+        assert_eq!(just_below.theta_deg, Incident::MIN_BELOW_DEG);
+    }
+
+    #[test]
+    fn incident_clamps_to_the_whole_sphere_without_the_horizon() {
+        let c = |t: f64| {
+            Incident {
+                theta_deg: t,
+                phi_deg: 0.0,
+            }
+            .clamped()
+            .theta_deg
+        };
+        assert_eq!(c(-5.0), 0.0);
+        assert_eq!(c(45.0), 45.0);
+        assert_eq!(c(89.7), 89.5);
+        assert_eq!(c(90.0), 89.5);
+        assert_eq!(c(90.2), 90.5);
+        assert_eq!(c(135.0), 135.0);
+        assert_eq!(c(180.0), 180.0);
+        assert_eq!(c(400.0), 180.0);
+        assert_eq!(c(f64::NAN), 0.0);
+        // Every clamped light is a finite unit direction, never in the surface.
+        for t in [0.0, 89.5, 90.0, 90.5, 179.9, 180.0] {
+            let w = Incident {
+                theta_deg: t,
+                phi_deg: 30.0,
+            }
+            .clamped()
+            .direction();
+            assert!(w.is_finite() && (w.length() - 1.0).abs() < 1e-12 && w.z != 0.0);
+        }
     }
 }

@@ -4,6 +4,12 @@
 //! the numbers. The curves are [`crate::derive::albedo`]'s: a slider drag
 //! shows the last finished curve (dashed) and a progress bar, and starts no
 //! work until the pointer is released; figures compute them before drawing.
+//!
+//! A transmitting model (issue 33) is plotted over θi 0°..180° (light from
+//! below beyond 90°, the surface marked): ρR dashed, ρT dotted and their sum
+//! solid in its colour. For a non-absorbing dielectric the sum would be 1
+//! with every bounce counted; what it lacks is the energy a single-scattering
+//! microfacet BSDF loses (the white furnace test).
 
 use super::BrdfColor as _;
 use super::chart::{self, Band, Chart, Marker, Palette, Series};
@@ -44,8 +50,9 @@ impl AlbedoView {
                 Some(ctx) => {
                     let s = albedo::curve(&super::waker(ctx), scene, b);
                     if s.busy || s.stale || s.done.is_none() {
-                        total += albedo::STEPS;
-                        done += s.progress.map_or(0, |p| p.0.min(albedo::STEPS));
+                        let (d, t) = s.progress.unwrap_or((0, albedo::STEPS));
+                        total += t;
+                        done += d.min(t);
                     }
                     match s.value() {
                         Some(v) => v,
@@ -99,7 +106,75 @@ fn y_top(shown: &[Shown]) -> f64 {
         .flat_map(|s| (0..s.data.rho.len()).map(|k| s.data.mean_and_band(k)))
         .map(|(v, b)| v + b)
         .fold(0.0, f64::max);
-    (m * 1.08).max(1.1)
+    // Room above ρ = 1 for the legend of a transmitting model's three
+    // lines (its sum runs close under 1 at every θi).
+    let floor = if shown.iter().any(|s| s.data.has_parts()) {
+        1.4
+    } else {
+        1.1
+    };
+    (m * 1.08).max(floor)
+}
+
+/// The largest θi of the plot: 180° when a curve covers light from below
+/// (a transmitting model), else 90°.
+fn x_max(shown: &[Shown]) -> f64 {
+    if shown.iter().any(|s| s.data.has_parts()) {
+        180.0
+    } else {
+        90.0
+    }
+}
+
+/// How one series of a curve is drawn.
+#[derive(Clone, Copy, PartialEq)]
+enum Part {
+    /// ρhd (= ρR + ρT for a transmitting model): solid, with its band.
+    Total,
+    /// ρR: dashed.
+    Reflected,
+    /// ρT: dotted.
+    Transmitted,
+}
+
+impl Part {
+    fn dash(self) -> Option<f32> {
+        match self {
+            Part::Total => None,
+            Part::Reflected => Some(10.0),
+            Part::Transmitted => Some(3.0),
+        }
+    }
+}
+
+/// The series of one curve: (part, label, points split at the surface so
+/// that no line crosses the horizon, where no light arrives).
+fn series_of(s: &Shown) -> Vec<(Part, String, Vec<Vec<[f64; 2]>>)> {
+    let split = |pts: Vec<[f64; 2]>| -> Vec<Vec<[f64; 2]>> {
+        let (above, below): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
+            pts.into_iter().partition(|p| p[0] < 90.0);
+        [above, below]
+            .into_iter()
+            .filter(|v| !v.is_empty())
+            .collect()
+    };
+    let total: Vec<[f64; 2]> = (0..s.data.rho.len())
+        .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
+        .collect();
+    let mut out = vec![(Part::Total, legend_label(s), split(total))];
+    if s.data.has_parts() {
+        out.push((
+            Part::Reflected,
+            format!("{} ρR (reflected)", s.brdf.label),
+            split(s.data.series(&s.data.reflected)),
+        ));
+        out.push((
+            Part::Transmitted,
+            format!("{} ρT (transmitted)", s.brdf.label),
+            split(s.data.series(&s.data.transmitted)),
+        ));
+    }
+    out
 }
 
 /// The plot corner whose legend box covers the fewest curve points, given
@@ -112,21 +187,26 @@ fn legend_corner(shown: &[Shown], top: f64, size: egui::Vec2) -> Corner {
         .map(|s| legend_label(s).chars().count())
         .max()
         .unwrap_or(0);
-    let w = ((chars as f32 * 6.5 + 30.0) / size.x.max(1.0)).min(1.0) as f64 * 90.0;
-    let h = ((shown.len() as f32 * 18.0 + 12.0) / size.y.max(1.0)).min(1.0) as f64 * top;
+    let xm = x_max(shown);
+    let lines: usize = shown.iter().map(|s| series_of(s).len()).sum();
+    let w = ((chars as f32 * 6.5 + 30.0) / size.x.max(1.0)).min(1.0) as f64 * xm;
+    let h = ((lines as f32 * 18.0 + 12.0) / size.y.max(1.0)).min(1.0) as f64 * top;
     let boxes = [
-        (Corner::RightBottom, 90.0 - w, 90.0, 0.0, h),
-        (Corner::RightTop, 90.0 - w, 90.0, top - h, top),
+        (Corner::RightBottom, xm - w, xm, 0.0, h),
+        (Corner::RightTop, xm - w, xm, top - h, top),
         (Corner::LeftBottom, 0.0, w, 0.0, h),
         (Corner::LeftTop, 0.0, w, top - h, top),
     ];
+    // Every drawn point, ρR and ρT included.
+    let points: Vec<[f64; 2]> = shown
+        .iter()
+        .flat_map(series_of)
+        .flat_map(|(_, _, pieces)| pieces.into_iter().flatten())
+        .collect();
     let covered = |(x0, x1, y0, y1): (f64, f64, f64, f64)| {
-        shown
+        points
             .iter()
-            .flat_map(|s| {
-                (0..s.data.rho.len()).map(move |k| (s.data.theta_deg[k], s.data.mean_and_band(k).0))
-            })
-            .filter(|&(x, y)| (x0..=x1).contains(&x) && (y0..=y1).contains(&y))
+            .filter(|p| (x0..=x1).contains(&p[0]) && (y0..=y1).contains(&p[1]))
             .count()
     };
     boxes
@@ -159,7 +239,7 @@ impl View for AlbedoView {
                 crate::session::views::ALBEDO.id,
             ))),
             size,
-            shown.len(),
+            shown.iter().map(|s| series_of(s).len()).sum(),
             legend_corner(&shown, top, size),
         )
         .width(size.x.max(50.0))
@@ -168,13 +248,25 @@ impl View for AlbedoView {
         .y_axis_label(Y_LABEL)
         .y_axis_min_width(36.0)
         .include_x(0.0)
-        .include_x(90.0)
+        .include_x(x_max(&shown))
         .include_y(0.0)
         .include_y(top)
         .allow_scroll(false)
         .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
         let theta_i = scene.incident.theta_deg;
+        let surface = x_max(&shown) > 90.0;
+        let surface_col = super::strong_text(ui).gamma_multiply(0.6);
         plot.show(ui, |pui| {
+            if surface {
+                // The surface: light from above on the left, from below on
+                // the right.
+                pui.vline(
+                    VLine::new("", 90.0)
+                        .color(surface_col)
+                        .width(scene.stroke(1.0))
+                        .allow_hover(false),
+                );
+            }
             pui.hline(
                 HLine::new("", 1.0)
                     .color(super::mirror_color(dark))
@@ -196,20 +288,30 @@ impl View for AlbedoView {
                     lo.push(v - b);
                     hi.push(v + b);
                 }
-                pui.add(
-                    FilledArea::new("", &s.data.theta_deg, &lo, &hi)
-                        .fill_color(s.brdf.color().gamma_multiply(0.3)),
-                );
-                let pts: Vec<[f64; 2]> = (0..n)
-                    .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
-                    .collect();
-                let mut line = Line::new(legend_label(s), PlotPoints::from(pts))
-                    .color(s.brdf.color())
-                    .width(scene.stroke(if s.brdf.selected { 2.5 } else { 1.8 }));
-                if s.stale {
-                    line = line.style(LineStyle::Dashed { length: 8.0 });
+                // The band on either side of the surface separately.
+                let cut = s.data.theta_deg.partition_point(|t| *t < 90.0);
+                for r in [0..cut, cut..n] {
+                    if r.is_empty() {
+                        continue;
+                    }
+                    pui.add(
+                        FilledArea::new("", &s.data.theta_deg[r.clone()], &lo[r.clone()], &hi[r])
+                            .fill_color(s.brdf.color().gamma_multiply(0.3)),
+                    );
                 }
-                pui.line(line);
+                for (part, label, pieces) in series_of(s) {
+                    for pts in pieces {
+                        let mut line = Line::new(label.clone(), PlotPoints::from(pts))
+                            .color(s.brdf.color())
+                            .width(scene.stroke(if s.brdf.selected { 2.5 } else { 1.8 }));
+                        // Stale: every part dashed alike (the parts are few
+                        // and short-lived while a drag ends).
+                        if let Some(d) = part.dash().or(s.stale.then_some(8.0)) {
+                            line = line.style(LineStyle::Dashed { length: d });
+                        }
+                        pui.line(line);
+                    }
+                }
             }
         });
     }
@@ -221,12 +323,13 @@ impl View for AlbedoView {
     fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
         let shown = self.update(scene, None);
         let top = y_top(&shown);
+        let xm = x_max(&shown);
         let mut c = Chart {
             x_label: X_LABEL.into(),
             y_label: Y_LABEL.into(),
-            x_range: (0.0, 90.0),
+            x_range: (0.0, xm),
             y_range: (0.0, top),
-            x_ticks: chart::angle_ticks(0.0, 90.0),
+            x_ticks: chart::angle_ticks(0.0, xm),
             y_ticks: chart::labelled(chart::nice_ticks(0.0, top, 8)),
             ..Default::default()
         };
@@ -242,22 +345,41 @@ impl View for AlbedoView {
             dashed: false,
             label: "θi".into(),
         });
+        if xm > 90.0 {
+            c.vlines.push(Marker {
+                at: 90.0,
+                color: super::mirror_color(dark),
+                dashed: false,
+                label: "surface".into(),
+            });
+        }
         for s in &shown {
             let n = s.data.rho.len();
             let mb: Vec<(f64, f64)> = (0..n).map(|k| s.data.mean_and_band(k)).collect();
-            c.bands.push(Band {
-                color: s.brdf.color().gamma_multiply(0.3),
-                xs: s.data.theta_deg.clone(),
-                lo: mb.iter().map(|(v, b)| v - b).collect(),
-                hi: mb.iter().map(|(v, b)| v + b).collect(),
-            });
-            c.series.push(Series {
-                label: legend_label(s),
-                color: s.brdf.color(),
-                points: (0..n).map(|k| [s.data.theta_deg[k], mb[k].0]).collect(),
-                width: if s.brdf.selected { 2.5 } else { 1.8 },
-                dash: None,
-            });
+            let cut = s.data.theta_deg.partition_point(|t| *t < 90.0);
+            for r in [0..cut, cut..n] {
+                if r.is_empty() {
+                    continue;
+                }
+                c.bands.push(Band {
+                    color: s.brdf.color().gamma_multiply(0.3),
+                    xs: s.data.theta_deg[r.clone()].to_vec(),
+                    lo: mb[r.clone()].iter().map(|(v, b)| v - b).collect(),
+                    hi: mb[r].iter().map(|(v, b)| v + b).collect(),
+                });
+            }
+            for (part, label, pieces) in series_of(s) {
+                for (j, pts) in pieces.into_iter().enumerate() {
+                    c.series.push(Series {
+                        // One legend entry per part.
+                        label: if j == 0 { label.clone() } else { String::new() },
+                        color: s.brdf.color(),
+                        points: pts,
+                        width: if s.brdf.selected { 2.5 } else { 1.8 },
+                        dash: part.dash(),
+                    });
+                }
+            }
         }
         Some(c.to_svg(size, Palette::new(dark, scene.transparent)))
     }

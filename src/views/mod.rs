@@ -82,6 +82,46 @@ pub trait View: Any {
     fn svg(&mut self, _scene: &Scene<'_>, _size: [f32; 2], _dark: bool) -> Option<String> {
         None
     }
+
+    /// Whether the view has something to show with the light below the
+    /// surface when no drawn BRDF transmits (the Snell view draws either
+    /// side of its interface). Default: no, and [`show`] puts
+    /// [`light_below_note`] in its place.
+    fn shows_light_below(&self) -> bool {
+        false
+    }
+}
+
+/// Why a view shows nothing of the scene: the light is below the surface
+/// (θi > 90°, issue 33) and every drawn BRDF reflects only (0 for light from
+/// below by convention). `None` when the view can draw.
+pub fn light_below_note(scene: &Scene<'_>) -> Option<String> {
+    if !scene.incident.below()
+        || scene.brdfs.is_empty()
+        || scene.brdfs.iter().any(|b| b.brdf.transmits())
+    {
+        return None;
+    }
+    Some(format!(
+        "The light is below the surface (θi = {:.1}°) and no drawn BRDF transmits: a \
+         reflection-only model scatters nothing of light from below. Bring the light above \
+         90° with the θi slider, or add a model that transmits (rough-dielectric).",
+        scene.incident.theta_deg
+    ))
+}
+
+/// Draws `view`, or in its place the note of [`light_below_note`] where the
+/// view has nothing to show (never a blank or a plot of zeros).
+pub fn show(view: &mut dyn View, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+    if !view.shows_light_below()
+        && let Some(note) = light_below_note(scene)
+    {
+        ui.centered_and_justified(|ui| {
+            ui.label(egui::RichText::new(note).size(16.0).color(strong_text(ui)));
+        });
+        return;
+    }
+    view.ui(ui, scene, out);
 }
 
 /// A registered view: its name (from the session's list of views) and its

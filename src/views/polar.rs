@@ -7,11 +7,12 @@
 use super::BrdfColor as _;
 use super::curves;
 use super::{Scene, View, factor_overlay, sh_overlay};
+use crate::derive::interface::InterfaceMarks;
 use crate::derive::slices::{self, Sample};
 use crate::session::command::Command;
 use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoint, PlotPoints, Text};
-use std::f64::consts::FRAC_PI_2;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Samples per curve (half circle); 0.25° steps keep a Phong lobe of exponent
 /// 10⁴ (≈ 1° wide) smooth.
@@ -70,12 +71,13 @@ impl SwapReadout {
         }
     }
 
-    /// Whether the light can be put at `wo` (above the surface, within the
-    /// slider's range).
+    /// Whether the light can be put at `wo` (anywhere but the horizon band;
+    /// below the surface only where the plot shows directions below, i.e.
+    /// for a transmitting model).
     pub fn can_swap(&self) -> bool {
-        self.wo.z > 0.0
-            && bv_core::frame::to_spherical(self.wo).0.to_degrees()
-                <= crate::session::state::Incident::MAX_THETA_DEG + 1e-9
+        use crate::session::state::Incident;
+        let t = bv_core::frame::to_spherical(self.wo).0.to_degrees();
+        t.is_finite() && !Incident::in_horizon_gap(t) && t <= Incident::MAX_THETA_DEG
     }
 }
 
@@ -94,7 +96,7 @@ fn swap_ui(ui: &mut Ui, swap: Option<&SwapReadout>, out: &mut Vec<Command>) {
         let r = ui
             .add_enabled(s.can_swap(), egui::Button::new("swap ωi and ωo").small())
             .on_hover_text("Move the light to this outgoing direction")
-            .on_disabled_hover_text("The light cannot go below the surface or to the horizon");
+            .on_disabled_hover_text("The light cannot go to the horizon");
         if r.clicked() {
             out.push(Command::SetIncident(
                 crate::session::state::Incident::from_direction(s.wo),
@@ -287,6 +289,7 @@ impl View for PolarView {
 
         let span: i32 = if transmits { 180 } else { 90 };
         let brdfs = &scene.brdfs;
+        let marks = interface_marks(scene, outer, dark);
         let response = plot.show(ui, |pui| {
             // Rings with the value they stand for, and spokes every 15°.
             // On the log scale the rings stand at round values of f.
@@ -348,6 +351,41 @@ impl View for PolarView {
                 .width(scene.stroke(1.5))
                 .allow_hover(false),
             );
+            // Snell's window, the critical angle and the refracted ray.
+            for m in &marks {
+                match m {
+                    Mark::Fill { points, color } => pui.polygon(
+                        egui_plot::Polygon::new("", PlotPoints::from(points.clone()))
+                            .fill_color(*color)
+                            .stroke(egui::Stroke::NONE)
+                            .allow_hover(false),
+                    ),
+                    Mark::Line {
+                        points,
+                        color,
+                        width,
+                        dash,
+                    } => {
+                        let mut l = Line::new("", PlotPoints::from(points.clone()))
+                            .color(*color)
+                            .width(scene.stroke(*width))
+                            .allow_hover(false);
+                        if let Some(d) = dash {
+                            l = l.style(LineStyle::Dashed { length: *d });
+                        }
+                        pui.line(l);
+                    }
+                    Mark::Text { at, text, color } => pui.text(
+                        Text::new(
+                            "",
+                            PlotPoint::new(at[0], at[1]),
+                            RichText::new(text.clone()).size(13.0),
+                        )
+                        .color(*color)
+                        .allow_hover(false),
+                    ),
+                }
+            }
             // Light (left) and mirror direction (right).
             let li = slices::incident_signed_angle(theta_i);
             let lp = [outer * 1.2 * li.sin(), outer * 1.2 * li.cos()];
@@ -541,6 +579,168 @@ fn polar_curves(scene: &Scene<'_>) -> (Vec<PolarCurve>, f64) {
     (curves, outer)
 }
 
+/// One mark of the interface overlay in plot coordinates, drawn alike by
+/// egui and the SVG export.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Mark {
+    /// A filled polygon (Snell's window).
+    Fill {
+        /// Corners.
+        points: Vec<[f64; 2]>,
+        /// Fill colour.
+        color: Color32,
+    },
+    /// A line.
+    Line {
+        /// Points.
+        points: Vec<[f64; 2]>,
+        /// Colour.
+        color: Color32,
+        /// Width in points.
+        width: f32,
+        /// Dash length, if dashed.
+        dash: Option<f32>,
+    },
+    /// A label centred on a point.
+    Text {
+        /// Anchor point.
+        at: [f64; 2],
+        /// The text.
+        text: String,
+        /// Colour.
+        color: Color32,
+    },
+}
+
+/// The point at radius `r` along the signed in-plane angle `a`.
+fn polar_point(r: f64, a: f64) -> [f64; 2] {
+    [r * a.sin(), r * a.cos()]
+}
+
+/// The model whose interface the overlay marks: the selected BRDF if it
+/// transmits and reports an index, else the first drawn one that does.
+fn interface_eta(scene: &Scene<'_>) -> Option<(String, f64)> {
+    let with_eta = |b: &&crate::session::frame::SceneBrdf| {
+        b.brdf.transmits() && b.brdf.interface_eta().is_some()
+    };
+    let b = scene
+        .brdfs
+        .iter()
+        .filter(with_eta)
+        .find(|b| b.selected)
+        .or_else(|| scene.brdfs.iter().find(with_eta))?;
+    Some((b.label.clone(), b.brdf.interface_eta()?))
+}
+
+/// The interface overlay of a transmitting model (issue 33): Snell's window
+/// shaded and bounded by the critical angle on the denser side, the
+/// refracted direction ωt with θt, or "TIR" when the light is beyond the
+/// critical angle inside the denser medium. Empty for reflection-only
+/// scenes, which keep the plot they always had. The numbers are
+/// [`InterfaceMarks`]'s (`bv_core::optics`).
+pub fn interface_marks(scene: &Scene<'_>, outer: f64, dark: bool) -> Vec<Mark> {
+    let Some((label, eta)) = interface_eta(scene) else {
+        return Vec::new();
+    };
+    let theta_i = scene.incident.theta_deg.to_radians();
+    let Some(m) = InterfaceMarks::new(theta_i, eta) else {
+        return Vec::new();
+    };
+    let refr = if dark {
+        Color32::from_rgb(110, 190, 255)
+    } else {
+        Color32::from_rgb(20, 100, 200)
+    };
+    let window = Color32::from_rgba_unmultiplied(255, 220, 90, if dark { 40 } else { 55 });
+    let window_line = if dark {
+        Color32::from_rgb(230, 200, 80)
+    } else {
+        Color32::from_rgb(170, 130, 0)
+    };
+    let tir = if dark {
+        Color32::from_rgb(255, 120, 120)
+    } else {
+        Color32::from_rgb(190, 30, 30)
+    };
+    let mut out = Vec::new();
+    if let (Some(c), Some([a0, a1])) = (m.critical, m.window_edges()) {
+        // The window as a wedge around the dense side's normal.
+        let n = 48;
+        let mut pts = vec![[0.0, 0.0]];
+        pts.extend((0..=n).map(|k| {
+            let a = m.window_axis - c + 2.0 * c * k as f64 / n as f64;
+            polar_point(outer, a)
+        }));
+        out.push(Mark::Fill {
+            points: pts,
+            color: window,
+        });
+        for a in [a0, a1] {
+            out.push(Mark::Line {
+                points: vec![[0.0, 0.0], polar_point(outer * 1.05, a)],
+                color: window_line,
+                width: 1.5,
+                dash: Some(4.0),
+            });
+        }
+        // Named outside the rings (where no curve runs) past the window's
+        // axis, where neither the light nor the mirror direction is (they
+        // sit at ∓θi, near the edges when θi is near 180° − θc); beside an
+        // edge when the light itself is near the axis.
+        let light_near_axis = (PI - theta_i).abs() < 0.35 || theta_i < 0.35;
+        let place = if !light_near_axis {
+            m.window_axis
+        } else if m.light_below == m.dense_below {
+            a1
+        } else {
+            a0
+        };
+        let at = polar_point(outer * 1.22, place);
+        out.push(Mark::Text {
+            at,
+            text: format!("θc {:.1}°", c.to_degrees()),
+            color: window_line,
+        });
+        out.push(Mark::Text {
+            at: [at[0], at[1] + outer * 0.09 * at[1].signum()],
+            text: "Snell's window".into(),
+            color: window_line,
+        });
+    }
+    match (m.refracted, m.theta_t) {
+        (Some(a), Some(t)) => {
+            let tip = polar_point(outer * 1.12, a);
+            out.push(Mark::Line {
+                points: vec![[0.0, 0.0], tip],
+                color: refr,
+                width: 2.0,
+                dash: Some(9.0),
+            });
+            out.push(Mark::Text {
+                at: [tip[0] * 1.1, tip[1] * 1.1],
+                text: format!("ωt θt {:.1}°", t.to_degrees()),
+                color: refr,
+            });
+        }
+        _ if m.tir => {
+            // Of the mean surface: a rough one still refracts through the
+            // microfacets tilted towards the light.
+            out.push(Mark::Text {
+                at: [-outer * 1.25, -outer * 0.16],
+                text: "no refracted ray: TIR beyond θc".into(),
+                color: tir,
+            });
+        }
+        _ => {}
+    }
+    out.push(Mark::Text {
+        at: [-outer * 1.25, -outer * 0.06],
+        text: format!("η {eta:.3} ({label})"),
+        color: window_line,
+    });
+    out
+}
+
 /// The ring radii (plot units) and the values they stand for.
 fn rings(outer: f64, log: bool) -> Vec<(f64, f64)> {
     (1..=4)
@@ -634,6 +834,32 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
         1.5,
         None,
     );
+    for m in interface_marks(scene, outer, dark) {
+        match m {
+            Mark::Fill { points, color } => {
+                let p: Vec<[f32; 2]> = points.iter().map(|p| at(*p)).collect();
+                svg.polygon(&p, color);
+            }
+            Mark::Line {
+                points,
+                color,
+                width,
+                dash,
+            } => {
+                let p: Vec<[f32; 2]> = points.iter().map(|p| at(*p)).collect();
+                svg.polyline(&p, color, width, dash);
+            }
+            Mark::Text { at: p, text, color } => svg.text(
+                at(p),
+                &text,
+                12.0,
+                color,
+                Anchor::Middle,
+                Baseline::Middle,
+                None,
+            ),
+        }
+    }
     let light = super::light_color(dark);
     let mirror = super::mirror_color(dark);
     let li = slices::incident_signed_angle(theta_i);

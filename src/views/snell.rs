@@ -123,7 +123,20 @@ pub fn theta_of_pointer(v: DVec2, from_below: bool) -> Option<f64> {
         return None;
     }
     let t = v.x.abs().atan2(y).to_degrees();
-    Some(t.clamp(0.0, Incident::MAX_THETA_DEG))
+    Some(t.clamp(0.0, Incident::MAX_ABOVE_DEG))
+}
+
+/// The scene light's angle from the normal on its own side (radians): the
+/// diagram draws the light on the side its toggle chooses, so a light below
+/// the surface (θi > 90°, issue 33) is read as `180° − θi` from the downward
+/// normal.
+fn side_angle(theta_deg: f64) -> f64 {
+    let t = if theta_deg > 90.0 {
+        180.0 - theta_deg
+    } else {
+        theta_deg
+    };
+    t.to_radians()
 }
 
 /// Colours of the figure.
@@ -759,8 +772,7 @@ impl View for SnellView {
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
         let interface = self.interface(scene);
-        let Some(fig) = snell_figure(scene.incident.theta_deg.to_radians(), &interface, dark)
-        else {
+        let Some(fig) = snell_figure(side_angle(scene.incident.theta_deg), &interface, dark) else {
             ui.label(
                 RichText::new(format!("η = {} is not a refractive index", interface.eta)).weak(),
             );
@@ -798,9 +810,13 @@ impl View for SnellView {
         self
     }
 
+    fn shows_light_below(&self) -> bool {
+        true
+    }
+
     fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
         let interface = self.interface(scene);
-        let fig = snell_figure(scene.incident.theta_deg.to_radians(), &interface, dark)?;
+        let fig = snell_figure(side_angle(scene.incident.theta_deg), &interface, dark)?;
         let bg = super::chart::Palette::new(dark, scene.transparent).background;
         Some(to_svg(&fig, size, bg))
     }
@@ -831,7 +847,7 @@ mod tests {
         // The far side clamps to the slider's largest angle.
         assert_eq!(
             theta_of_pointer(DVec2::new(0.1, -1.0), false),
-            Some(Incident::MAX_THETA_DEG)
+            Some(Incident::MAX_ABOVE_DEG)
         );
         assert_eq!(theta_of_pointer(DVec2::ZERO, false), None);
     }

@@ -181,6 +181,7 @@ macro_rules! shipped {
 
 shipped![
     "aluminium.toml",
+    "calm-water.toml",
     "chromium.toml",
     "copper.toml",
     "ct1982-bronze.toml",
@@ -196,6 +197,7 @@ shipped![
     "ct1982-tin.toml",
     "ct1982-tungsten.toml",
     "diamond.toml",
+    "frosted-glass.toml",
     "fused-silica.toml",
     "glass.toml",
     "gold.toml",
@@ -205,12 +207,14 @@ shipped![
     "mercury.toml",
     "molybdenum.toml",
     "nickel.toml",
+    "polished-diamond.toml",
     "sapphire.toml",
     "silver.toml",
     "tantalum.toml",
     "tungsten.toml",
     "water-from-below.toml",
     "water.toml",
+    "window-glass.toml",
 ];
 
 /// The compiled-in presets, parsed (in [`SHIPPED`] order). A shipped preset
@@ -352,6 +356,29 @@ mod tests {
         names.sort();
         names.dedup();
         assert_eq!(names.len(), l.presets.len());
+    }
+
+    #[test]
+    fn rough_dielectric_presets_are_the_issue_33_materials() {
+        // (name, η, α): window glass and water nearly smooth, frosted glass
+        // rough, diamond's high index.
+        let want = [
+            ("Window glass", 1.52, 0.02),
+            ("Frosted glass", 1.52, 0.3),
+            ("Calm water", 1.333, 0.02),
+            ("Polished diamond", 2.42, 0.02),
+        ];
+        let l = shipped();
+        for (name, eta, alpha) in want {
+            let p = l.presets.iter().find(|p| p.name == name).unwrap();
+            assert_eq!(p.category, "dielectric");
+            let b = p.spec.build().unwrap();
+            assert!(b.transmits(), "{name}");
+            assert_eq!(b.interface_eta(), Some(eta), "{name}");
+            let a = p.spec.params().float("alpha_x").unwrap();
+            assert!((a - alpha).abs() < 1e-12, "{name}: α {a}");
+            assert_eq!(p.spec.params().float("alpha_y").unwrap(), a);
+        }
     }
 
     #[test]

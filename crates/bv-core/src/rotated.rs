@@ -109,6 +109,11 @@ impl Brdf for Rotated {
         self.inner.transmits()
     }
 
+    /// A turn about the normal keeps the two media and their indices.
+    fn interface_eta(&self) -> Option<f64> {
+        self.inner.interface_eta()
+    }
+
     fn sample(&self, wi: DVec3, u: DVec2) -> Option<DVec3> {
         self.inner
             .sample(self.to_inner(wi), u)

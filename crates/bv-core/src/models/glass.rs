@@ -94,6 +94,14 @@ impl Brdf for Glass {
         true
     }
 
+    /// `eta` is the index below over the one above, as for
+    /// `rough-dielectric`: the views mark its refracted ray, critical angle
+    /// and Snell's window, and the reciprocity check uses the generalised
+    /// form (Veach 1997, eq. 5.14).
+    fn interface_eta(&self) -> Option<f64> {
+        Some(self.eta)
+    }
+
     fn deltas(&self, wi: DVec3) -> Vec<DeltaLobe> {
         let reflection = |w: f64| DeltaLobe {
             direction: frame::reflect(wi),
@@ -203,6 +211,12 @@ mod tests {
             let prod = back[1].radiance_scale.x * l[1].radiance_scale.x;
             assert!((prod - l[1].weight.x.powi(2)).abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn reports_its_interface_index() {
+        assert_eq!(glass(1.5).interface_eta(), Some(1.5));
+        assert_eq!(glass(0.75).interface_eta(), Some(0.75));
     }
 
     #[test]
