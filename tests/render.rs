@@ -279,7 +279,7 @@ fn bad_requests_fail_with_a_clear_message() {
                 "--view",
                 "polar",
                 "--theta-i",
-                "120",
+                "190",
                 "--out",
                 "x.png",
             ],

@@ -85,7 +85,7 @@ fn a_bad_deck_names_the_entry_and_the_key() {
     std::fs::write(
         &path,
         "format = \"bv-deck\"\nversion = 1\n[[scene]]\ntitle = \"Phong\"\ncaption = \"c\"\n\
-         view = \"lobe\"\n[scene.state]\nincident = { theta_deg = 95.0, phi_deg = 0.0 }\n",
+         view = \"lobe\"\n[scene.state]\nincident = { theta_deg = 190.0, phi_deg = 0.0 }\n",
     )
     .unwrap();
     let run = Command::new(bin())

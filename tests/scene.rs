@@ -118,9 +118,13 @@ fn corrupt_files_are_refused_with_a_clear_error() {
     let e = err_of(&good.replace("theta_deg = 61.125", "theta_deg = \"steep\""));
     assert!(e.contains("theta_deg") && e.contains("line"), "{e}");
     // Out of range: the key and the range.
-    let e = err_of(&good.replace("theta_deg = 61.125", "theta_deg = 95.0"));
+    let e = err_of(&good.replace("theta_deg = 61.125", "theta_deg = 190.0"));
+    assert!(e.contains("incident.theta_deg") && e.contains("180"), "{e}");
+    // The horizon: the key and both sides' limits (issue 33: the light may
+    // be below the surface, but not in it).
+    let e = err_of(&good.replace("theta_deg = 61.125", "theta_deg = 90.0"));
     assert!(
-        e.contains("incident.theta_deg") && e.contains("89.5"),
+        e.contains("incident.theta_deg") && e.contains("89.5") && e.contains("90.5"),
         "{e}"
     );
     // An unknown model, a bad parameter: the entry and the core's reason.

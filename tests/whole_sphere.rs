@@ -150,7 +150,10 @@ fn the_light_below_with_only_reflecting_models_gives_a_note_not_a_blank() {
     let (s, rt) = state("cook-torrance", serde_json::json!({"alpha": 0.2}), 120.0);
     let scene = build_scene(&s, &rt, false);
     let note = bv::views::light_below_note(&scene).unwrap();
-    assert!(note.contains("120.0") && note.contains("below"), "{note}");
+    assert!(
+        note.contains("120.0") && note.contains("below") && note.contains("transmits"),
+        "{note}"
+    );
     // A transmitting model has something to show from below.
     let (s, rt) = state("rough-dielectric", rd(1.5), 120.0);
     assert!(bv::views::light_below_note(&build_scene(&s, &rt, false)).is_none());

@@ -103,9 +103,8 @@ pub fn light_below_note(scene: &Scene<'_>) -> Option<String> {
         return None;
     }
     Some(format!(
-        "The light is below the surface (θi = {:.1}°) and no drawn BRDF transmits: a \
-         reflection-only model scatters nothing of light from below. Bring the light above \
-         90° with the θi slider, or add a model that transmits (rough-dielectric).",
+        "Light below the surface (θi = {:.1}°): no drawn BRDF transmits, so nothing \
+         scatters. Bring θi under 90° or add a model that transmits.",
         scene.incident.theta_deg
     ))
 }
@@ -116,9 +115,10 @@ pub fn show(view: &mut dyn View, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<C
     if !view.shows_light_below()
         && let Some(note) = light_below_note(scene)
     {
-        ui.centered_and_justified(|ui| {
-            ui.label(egui::RichText::new(note).size(16.0).color(strong_text(ui)));
-        });
+        // Wrapped at the view's width, from the top: readable in the
+        // smallest cell of the grid.
+        ui.add_space(8.0);
+        ui.add(egui::Label::new(egui::RichText::new(note).color(strong_text(ui))).wrap());
         return;
     }
     view.ui(ui, scene, out);
