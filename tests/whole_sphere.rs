@@ -141,7 +141,16 @@ fn reflection_only_models_get_no_marks() {
         ("cook-torrance", serde_json::json!({"alpha": 0.2})),
         ("lambert", serde_json::json!({})),
     ] {
-        assert!(marks(model, params, 30.0).is_empty(), "{model}");
+        assert!(marks(model, params.clone(), 30.0).is_empty(), "{model}");
+        let (s, rt) = state(model, params, 30.0);
+        let svg = bv::views::polar::polar_svg(&build_scene(&s, &rt, false), [800.0, 600.0], true);
+        assert!(!svg.contains("θc") && !svg.contains("Snell"), "{model}");
+    }
+    // The SVG export draws the same marks as the window.
+    let (s, rt) = state("rough-dielectric", rd(1.5), 30.0);
+    let svg = bv::views::polar::polar_svg(&build_scene(&s, &rt, false), [800.0, 600.0], true);
+    for t in ["θc 41.8°", "Snell&apos;s window", "ωt θt 19.5°"] {
+        assert!(svg.contains(t), "{t}");
     }
 }
 

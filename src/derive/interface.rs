@@ -52,7 +52,7 @@ impl InterfaceMarks {
     /// `None` for an index that is not finite and positive (no marks rather
     /// than NaN in a view).
     pub fn new(theta_i: f64, eta: f64) -> Option<Self> {
-        if !(eta.is_finite() && eta > 0.0) || !theta_i.is_finite() {
+        if !(eta.is_finite() && eta > 0.0 && theta_i.is_finite()) {
             return None;
         }
         let theta_i = theta_i.clamp(0.0, PI);

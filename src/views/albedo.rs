@@ -147,9 +147,13 @@ impl Part {
     }
 }
 
+/// One series of a curve: its part, its legend label, and its points in
+/// pieces split at the surface.
+type PartSeries = (Part, String, Vec<Vec<[f64; 2]>>);
+
 /// The series of one curve: (part, label, points split at the surface so
 /// that no line crosses the horizon, where no light arrives).
-fn series_of(s: &Shown) -> Vec<(Part, String, Vec<Vec<[f64; 2]>>)> {
+fn series_of(s: &Shown) -> Vec<PartSeries> {
     let split = |pts: Vec<[f64; 2]>| -> Vec<Vec<[f64; 2]>> {
         let (above, below): (Vec<[f64; 2]>, Vec<[f64; 2]>) =
             pts.into_iter().partition(|p| p[0] < 90.0);
