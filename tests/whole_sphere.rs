@@ -409,3 +409,32 @@ fn render_takes_a_light_below_and_refuses_the_horizon() {
     assert!(png.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn slice_takes_a_light_below_for_a_transmitting_model_only() {
+    let out = bv(&[
+        "slice",
+        "--model",
+        "rough-dielectric",
+        "--param",
+        "alpha=0.2",
+        "--theta-i",
+        "150",
+        "--samples",
+        "8",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(!text.contains("NaN") && !text.contains("inf"), "{text}");
+    let out = bv(&["slice", "--model", "lambert", "--theta-i", "150"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--theta-i 150") && err.contains("transmits"),
+        "{err}"
+    );
+}

@@ -56,7 +56,8 @@ pub struct SliceArgs {
     #[arg(long, value_enum, default_value = "theta-o")]
     pub curve: Curve,
 
-    /// Polar angle of the light, degrees (theta-o; albedo ignores it).
+    /// Polar angle of the light, degrees (theta-o; albedo ignores it): 0..90,
+    /// up to 180 (light below the surface) for a model that transmits.
     #[arg(
         long = "theta-i",
         value_name = "DEG",
@@ -91,8 +92,18 @@ pub struct SliceArgs {
 pub fn table(a: &SliceArgs) -> Result<(Vec<&'static str>, Vec<Vec<f64>>)> {
     let spec = a.model.spec()?;
     let brdf = spec.build()?;
-    if !(a.theta_i.is_finite() && (0.0..=90.0).contains(&a.theta_i)) {
-        bail!("--theta-i {}: out of range 0..=90°", fmt_num(a.theta_i));
+    // A transmitting model may be lit from below (issue 33): θi up to 180°.
+    let max_theta = if brdf.transmits() { 180.0 } else { 90.0 };
+    if !(a.theta_i.is_finite() && (0.0..=max_theta).contains(&a.theta_i)) {
+        bail!(
+            "--theta-i {}: out of range 0..={max_theta}°{}",
+            fmt_num(a.theta_i),
+            if brdf.transmits() {
+                ""
+            } else {
+                " (a light below the surface needs a model that transmits)"
+            }
+        );
     }
     if !a.phi_i.is_finite() {
         bail!("--phi-i {}: not a finite angle", fmt_num(a.phi_i));
