@@ -438,3 +438,79 @@ fn slice_takes_a_light_below_for_a_transmitting_model_only() {
         "{err}"
     );
 }
+
+/// Segments of the 3D lobe's guide lines that lie along `dir` (beyond the
+/// origin).
+fn segments_along(
+    model: &str,
+    params: serde_json::Value,
+    theta_deg: f64,
+    dir: glam::DVec3,
+) -> usize {
+    let (s, rt) = state(model, params, theta_deg);
+    let scene = build_scene(&s, &rt, false);
+    let mut view = bv::views::lobe3d::Lobe3dView::default();
+    let frame = view.frame(
+        &scene,
+        eframe::egui::vec2(400.0, 300.0),
+        [0.0, 0.0, 0.0, 1.0],
+        true,
+    );
+    let d = dir.as_vec3();
+    frame
+        .lines
+        .iter()
+        .filter(|l| {
+            let (a, b) = (glam::Vec3::from(l.a), glam::Vec3::from(l.b));
+            a.length() > 0.01
+                && b.length() > 0.01
+                && a.cross(d).length() < 1e-4
+                && b.cross(d).length() < 1e-4
+                && a.dot(d) > 0.0
+        })
+        .count()
+}
+
+#[test]
+fn the_3d_lobe_draws_the_refracted_ray_by_snell() {
+    // Light from above at 30° into glass and from inside at 30° from −z:
+    // the dashed ray lies along Snell's direction, written here from the
+    // angles (sin θt = sin θi · ηi/ηt, leaving on the far side, away from
+    // the light's azimuth).
+    let phi = 20f64.to_radians();
+    let snell = |theta_t: f64, down: bool| {
+        let (s, c) = theta_t.sin_cos();
+        glam::DVec3::new(-s * phi.cos(), -s * phi.sin(), if down { -c } else { c })
+    };
+    let down = snell((30f64.to_radians().sin() / 1.5).asin(), true);
+    assert!(segments_along("rough-dielectric", rd(1.5), 30.0, down) > 2);
+    let up = snell((1.5 * 30f64.to_radians().sin()).asin(), false);
+    assert!(segments_along("rough-dielectric", rd(1.5), 150.0, up) > 2);
+    // Beyond the critical angle from inside no ray: the same guide lines
+    // as a reflecting model's.
+    let lines = |model: &str, params: serde_json::Value| {
+        let (s, rt) = state(model, params, 135.0);
+        let scene = build_scene(&s, &rt, false);
+        let mut view = bv::views::lobe3d::Lobe3dView::default();
+        let f = view.frame(
+            &scene,
+            eframe::egui::vec2(400.0, 300.0),
+            [0.0, 0.0, 0.0, 1.0],
+            true,
+        );
+        f.lines.len()
+    };
+    assert_eq!(
+        lines("rough-dielectric", rd(1.5)),
+        lines("cook-torrance", serde_json::json!({"alpha": 0.2}))
+    );
+    assert_eq!(
+        segments_along(
+            "cook-torrance",
+            serde_json::json!({"alpha": 0.2}),
+            30.0,
+            down
+        ),
+        0
+    );
+}

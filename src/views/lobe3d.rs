@@ -345,6 +345,30 @@ impl Lobe3dView {
             },
         });
         let mut lines = guide_lines(scene.incident, dark);
+        // The refracted ray of the selected (or first) interface model:
+        // Snell's law in vector form (bv_core::frame::refract), dashed in
+        // the polar view's colour for ωt; none under total internal
+        // reflection.
+        let eta = super::interface_model(scene).map(|m| m.1);
+        if let Some(t) = eta.and_then(|e| bv_core::frame::refract(scene.wi(), e)) {
+            let refr = if dark {
+                Color32::from_rgb(110, 190, 255)
+            } else {
+                Color32::from_rgb(20, 100, 200)
+            };
+            dashed(
+                &mut lines,
+                Vec3::ZERO,
+                // Shorter than the mirror ray: the default camera frames
+                // the upper hemisphere, and the lower one ends sooner on
+                // the screen.
+                t.as_vec3() * REFRACTED_LENGTH,
+                0.06,
+                0.045,
+                rgba(refr, 0.95),
+                2.0,
+            );
+        }
         for b in &scene.brdfs {
             if let Some(c) = self.cache.get(&b.id) {
                 delta_spikes(&c.mesh, b.color(), &mut lines);
@@ -546,6 +570,8 @@ fn guide_lines(incident: Incident, dark: bool) -> Vec<LineSeg> {
 const INCIDENT_LENGTH: f32 = 1.55;
 /// Length of the drawn mirror direction.
 const MIRROR_LENGTH: f32 = 1.4;
+/// Length of the drawn refracted direction.
+const REFRACTED_LENGTH: f32 = 1.15;
 
 /// Axis colours (n, t, b).
 fn axis_colors(dark: bool) -> (Color32, Color32, Color32) {

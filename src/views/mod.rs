@@ -92,6 +92,21 @@ pub trait View: Any {
     }
 }
 
+/// The interface whose optics the views mark (refracted ray, critical
+/// angle, Snell's window): the selected BRDF if it transmits and reports an
+/// index ([`bv_core::Brdf::interface_eta`]), else the first drawn one that
+/// does; its label and `η`.
+pub fn interface_model(scene: &Scene<'_>) -> Option<(String, f64)> {
+    let with_eta = |b: &&SceneBrdf| b.brdf.transmits() && b.brdf.interface_eta().is_some();
+    let b = scene
+        .brdfs
+        .iter()
+        .filter(with_eta)
+        .find(|b| b.selected)
+        .or_else(|| scene.brdfs.iter().find(with_eta))?;
+    Some((b.label.clone(), b.brdf.interface_eta()?))
+}
+
 /// Why a view shows nothing of the scene: the light is below the surface
 /// (θi > 90°, issue 33) and every drawn BRDF reflects only (0 for light from
 /// below by convention). `None` when the view can draw.

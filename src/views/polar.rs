@@ -617,21 +617,6 @@ fn polar_point(r: f64, a: f64) -> [f64; 2] {
     [r * a.sin(), r * a.cos()]
 }
 
-/// The model whose interface the overlay marks: the selected BRDF if it
-/// transmits and reports an index, else the first drawn one that does.
-fn interface_eta(scene: &Scene<'_>) -> Option<(String, f64)> {
-    let with_eta = |b: &&crate::session::frame::SceneBrdf| {
-        b.brdf.transmits() && b.brdf.interface_eta().is_some()
-    };
-    let b = scene
-        .brdfs
-        .iter()
-        .filter(with_eta)
-        .find(|b| b.selected)
-        .or_else(|| scene.brdfs.iter().find(with_eta))?;
-    Some((b.label.clone(), b.brdf.interface_eta()?))
-}
-
 /// The interface overlay of a transmitting model (issue 33): Snell's window
 /// shaded and bounded by the critical angle on the denser side, the
 /// refracted direction ωt with θt, or "TIR" when the light is beyond the
@@ -639,7 +624,7 @@ fn interface_eta(scene: &Scene<'_>) -> Option<(String, f64)> {
 /// scenes, which keep the plot they always had. The numbers are
 /// [`InterfaceMarks`]'s (`bv_core::optics`).
 pub fn interface_marks(scene: &Scene<'_>, outer: f64, dark: bool) -> Vec<Mark> {
-    let Some((label, eta)) = interface_eta(scene) else {
+    let Some((label, eta)) = super::interface_model(scene) else {
         return Vec::new();
     };
     let theta_i = scene.incident.theta_deg.to_radians();
