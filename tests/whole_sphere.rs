@@ -514,3 +514,48 @@ fn the_3d_lobe_draws_the_refracted_ray_by_snell() {
         0
     );
 }
+
+/// The sampling view's histogram for a scene, computed now (as a figure).
+fn histogram(
+    model: &str,
+    params: serde_json::Value,
+    theta_deg: f64,
+) -> bv_core::analysis::sample_histogram::SampleHistogram {
+    let (s, rt) = state(model, params, theta_deg);
+    let mut scene = build_scene(&s, &rt, false);
+    scene.figure = true;
+    let b = scene.brdfs[0].clone();
+    let shown = bv::derive::sampling::histogram(&bv::derive::Waker::none(), &scene, &b);
+    let (outcome, _) = shown.value().unwrap();
+    outcome.as_ref().clone().unwrap()
+}
+
+#[test]
+fn the_sampling_histogram_covers_both_hemispheres_of_a_transmitting_model() {
+    use bv::derive::sampling::{N_PHI, N_THETA, SIGNIFICANCE};
+    // Light above and below: draws on both sides, χ² over the whole sphere
+    // passes for the model's own sampler (Walter 2007 §5.3).
+    for ti in [30.0, 150.0] {
+        let h = histogram(
+            "rough-dielectric",
+            serde_json::json!({"alpha": 0.3, "eta": 1.5}),
+            ti,
+        );
+        assert!(h.whole_sphere);
+        assert_eq!(h.n_theta, 2 * N_THETA);
+        assert_eq!(h.observed.len(), 2 * N_THETA * N_PHI);
+        let upper: u64 = h.observed[..N_THETA * N_PHI].iter().sum();
+        let lower: u64 = h.observed[N_THETA * N_PHI..].iter().sum();
+        assert!(upper > 0 && lower > 0, "{ti}: {upper} above, {lower} below");
+        assert!(
+            h.chi2.p_value >= SIGNIFICANCE,
+            "{ti}: p = {}",
+            h.chi2.p_value
+        );
+        assert!(h.points.iter().any(|w| w.z < 0.0) && h.points.iter().any(|w| w.z > 0.0));
+    }
+    // A reflecting model keeps its hemisphere.
+    let h = histogram("cook-torrance", serde_json::json!({"alpha": 0.3}), 30.0);
+    assert!(!h.whole_sphere);
+    assert_eq!(h.n_theta, N_THETA);
+}

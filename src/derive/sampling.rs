@@ -1,6 +1,7 @@
 //! Sampling histograms: the directions ωo that a BRDF's own sampler draws
 //! (`Brdf::sample`) for the current light, binned over equal-solid-angle
-//! cells of the outgoing hemisphere (`bv_core::analysis::sample_histogram`),
+//! cells of the outgoing hemisphere, or of the whole sphere for a model that
+//! transmits (`bv_core::analysis::sample_histogram`),
 //! beside what the sampler's density (`Brdf::pdf`) integrates to over each
 //! bin, with Pearson's χ² verdict (the test PBRT-v4 and Mitsuba run on every
 //! sampler). Computed as a job in steps of a few thousand evaluations (a
@@ -31,12 +32,22 @@ pub type Key = (u64, u64, u64);
 
 /// The histogram options this view uses.
 pub fn options() -> HistogramOptions {
+    options_for(false)
+}
+
+/// The options for a reflection-only model (the upper hemisphere) or, with
+/// `whole_sphere`, for a transmitting one (issue 33): twice the rows over
+/// `z ∈ [−1, 1]`, so that each hemisphere keeps the [`N_THETA`] rings of
+/// the same solid angle as a reflection-only model's, rows `N_THETA..` below
+/// the surface (nearest the horizon first).
+pub fn options_for(whole_sphere: bool) -> HistogramOptions {
     HistogramOptions {
-        n_theta: N_THETA,
+        n_theta: if whole_sphere { 2 * N_THETA } else { N_THETA },
         n_phi: N_PHI,
         samples: SAMPLES,
         seed: 1,
         max_points: POINTS,
+        whole_sphere,
         ..HistogramOptions::default()
     }
 }
@@ -53,7 +64,7 @@ const WORK_PER_STEP: usize = 8192;
 fn step(job: &mut Option<HistogramJob>, brdf: &dyn bv_core::Brdf, wi: DVec3) -> Option<Outcome> {
     let j = match job {
         Some(j) => j,
-        None => match HistogramJob::new(wi, &options()) {
+        None => match HistogramJob::new(wi, &options_for(brdf.transmits())) {
             Ok(j) => job.insert(j),
             Err(e) => return Some(Arc::new(Err(e.to_string()))),
         },

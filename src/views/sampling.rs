@@ -4,7 +4,9 @@
 //! bins of the outgoing hemisphere and what the sampler's density
 //! (`Brdf::pdf`) integrates to over each bin, with Pearson's χ² verdict (the
 //! test PBRT-v4 and Mitsuba run on every sampler). A sampler whose density
-//! does not describe what it draws gets a tiny p-value.
+//! does not describe what it draws gets a tiny p-value. For a model that
+//! transmits the bins cover the whole sphere, one χ² over both, and a second
+//! row of discs shows the hemisphere below the surface (issue 33).
 //!
 //! All three panels use Lambert's azimuthal equal-area disc (centre: the
 //! normal, rim: the horizon), on which the bins of
@@ -71,12 +73,56 @@ fn sector(mesh: &mut Mesh, c: Pos2, r: f32, t: usize, p: usize, color: Color32) 
     }
 }
 
+/// Which hemisphere a disc shows. The lower one is seen through the
+/// surface (x and y as on the upper disc, the rim its horizon, the centre
+/// −z), as the light disc shows a light below.
+#[derive(Clone, Copy, PartialEq)]
+enum Side {
+    Above,
+    Below,
+}
+
+impl Side {
+    /// The histogram row drawn as ring `t` of this side's disc (ring 0 at
+    /// the centre): below the surface the rows run from the horizon down to
+    /// −z (`derive::sampling::options_for`).
+    fn row(self, t: usize) -> usize {
+        match self {
+            Side::Above => t,
+            Side::Below => 2 * N_THETA - 1 - t,
+        }
+    }
+
+    /// Whether `w` is on this side.
+    fn holds(self, w: DVec3) -> bool {
+        match self {
+            Side::Above => w.z > 0.0,
+            Side::Below => w.z < 0.0,
+        }
+    }
+
+    /// `w` as the upper-hemisphere direction the disc maps.
+    fn folded(self, w: DVec3) -> DVec3 {
+        match self {
+            Side::Above => w,
+            Side::Below => DVec3::new(w.x, w.y, -w.z),
+        }
+    }
+}
+
 /// A histogram disc: each bin coloured by `value / scale` (viridis).
-fn histogram_disc(painter: &egui::Painter, c: Pos2, r: f32, values: &[f64], scale: f64) {
+fn histogram_disc(
+    painter: &egui::Painter,
+    c: Pos2,
+    r: f32,
+    values: &[f64],
+    scale: f64,
+    side: Side,
+) {
     let mut mesh = Mesh::default();
     for t in 0..N_THETA {
         for p in 0..N_PHI {
-            let v = values.get(t * N_PHI + p).copied().unwrap_or(0.0);
+            let v = values.get(side.row(t) * N_PHI + p).copied().unwrap_or(0.0);
             let x = if scale > 0.0 { (v / scale) as f32 } else { 0.0 };
             sector(&mut mesh, c, r, t, p, colormap::viridis(x.clamp(0.0, 1.0)));
         }
@@ -147,26 +193,47 @@ impl View for SamplingView {
             font.clone(),
             text,
         );
-        // Three discs in a row, titles above, the verdict below.
+        // Three discs in a row (two rows for a transmitting model: above and
+        // below the surface), titles above, the verdict below.
+        let sides: &[Side] = if h.whole_sphere {
+            &[Side::Above, Side::Below]
+        } else {
+            &[Side::Above]
+        };
+        let rows = sides.len() as f32;
         let top = 48.0;
         let bottom = 52.0;
         let gap = 16.0;
+        // Room for a row's caption between the rows.
+        let row_gap = if h.whole_sphere { 34.0 } else { 0.0 };
         let side = ((area.width() - 4.0 * gap) / 3.0)
-            .min(area.height() - top - bottom)
+            .min((area.height() - top - bottom - row_gap * (rows - 1.0)) / rows)
             .max(20.0);
         // Centre the discs and the verdict in a tall area.
-        let top = top + ((area.height() - top - bottom - side) * 0.4).max(0.0);
+        let top = top
+            + ((area.height() - top - bottom - rows * side - (rows - 1.0) * row_gap) * 0.4)
+                .max(0.0);
         let row_w = 3.0 * side + 2.0 * gap;
         let left = area.left() + ((area.width() - row_w) * 0.5).max(gap);
-        let discs: Vec<Rect> = (0..3)
-            .map(|k| {
-                Rect::from_min_size(
-                    Pos2::new(left + k as f32 * (side + gap), area.top() + top),
-                    Vec2::splat(side),
-                )
+        let discs: Vec<(Rect, Side)> = sides
+            .iter()
+            .enumerate()
+            .flat_map(|(row, &s)| {
+                (0..3).map(move |k| {
+                    (
+                        Rect::from_min_size(
+                            Pos2::new(
+                                left + k as f32 * (side + gap),
+                                area.top() + top + row as f32 * (side + row_gap),
+                            ),
+                            Vec2::splat(side),
+                        ),
+                        s,
+                    )
+                })
             })
             .collect();
-        self.disc_rects = discs.clone();
+        self.disc_rects = discs.iter().map(|d| d.0).collect();
         let r = side * 0.5;
         let grid = super::grid_color(dark);
         let titles = [
@@ -182,12 +249,19 @@ impl View for SamplingView {
             .copied()
             .filter(|v| v.is_finite())
             .fold(0.0, f64::max);
-        for (k, disc) in discs.iter().enumerate() {
+        let wi = scene.wi();
+        for (n, (disc, s)) in discs.iter().enumerate() {
+            let (k, s) = (n % 3, *s);
             let c = disc.center();
+            let title = match (h.whole_sphere, s, k) {
+                (true, Side::Above, 0) => "draws above the surface".to_string(),
+                (true, Side::Below, 0) => "draws below (seen through it)".to_string(),
+                _ => titles[k].clone(),
+            };
             painter.text(
                 Pos2::new(c.x, disc.top() - 4.0),
                 Align2::CENTER_BOTTOM,
-                &titles[k],
+                title,
                 small.clone(),
                 text,
             );
@@ -195,37 +269,37 @@ impl View for SamplingView {
                 0 => {
                     painter.circle_filled(c, r, super::grid_color(!dark).gamma_multiply(0.15));
                 }
-                1 => histogram_disc(&painter, c, r, &observed, scale),
-                _ => histogram_disc(&painter, c, r, &h.expected, scale),
+                1 => histogram_disc(&painter, c, r, &observed, scale, s),
+                _ => histogram_disc(&painter, c, r, &h.expected, scale, s),
             }
             painter.circle_stroke(c, r, Stroke::new(1.5, text.gamma_multiply(0.7)));
             for deg in [30.0f64, 60.0] {
                 let rr = (1.0 - deg.to_radians().cos()).sqrt() as f32 * r;
                 painter.circle_stroke(c, rr, Stroke::new(1.0, grid));
             }
-            let wi = scene.wi();
             let to_screen = |w: DVec3| {
-                let p = hemisphere_to_disc(w);
+                let p = hemisphere_to_disc(s.folded(w));
                 on_disc(c, r, p.x, p.y)
             };
             if k == 0 {
                 let color = Color32::from_rgb(b.rgb[0], b.rgb[1], b.rgb[2]);
-                for w in &h.points {
+                for w in h.points.iter().filter(|w| s.holds(**w)) {
                     painter.circle_filled(to_screen(*w), 1.6, color);
                 }
             }
-            let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
-            painter.circle_stroke(
-                to_screen(mirror),
-                5.0,
-                Stroke::new(1.5, super::mirror_color(dark)),
-            );
-            if wi.z > 0.0 {
+            // The light and its mirror direction on the disc of their side.
+            if s.holds(wi) {
+                let mirror = DVec3::new(-wi.x, -wi.y, wi.z);
+                painter.circle_stroke(
+                    to_screen(mirror),
+                    5.0,
+                    Stroke::new(1.5, super::mirror_color(dark)),
+                );
                 painter.circle_filled(to_screen(wi), 5.0, super::light_color(dark));
                 painter.circle_stroke(to_screen(wi), 5.0, Stroke::new(1.0, Color32::BLACK));
             }
         }
-        let y = discs[0].bottom() + 8.0;
+        let y = discs.last().map_or(area.top(), |d| d.0.bottom()) + 8.0;
         let verdict_color = if h.chi2.p_value >= SIGNIFICANCE {
             text
         } else {
@@ -242,9 +316,11 @@ impl View for SamplingView {
             Pos2::new(area.left() + 6.0, y + 18.0),
             Align2::LEFT_TOP,
             format!(
-                "∫ pdf dω over the hemisphere {}; {} draws gave no direction above the horizon ({} expected); colour: count / {}; dot: ωi, ring: its mirror direction",
+                "∫ pdf dω over the {} {}; {} draws gave no direction{} ({} expected); colour: count / {}; dot: ωi, ring: its mirror direction",
+                if h.whole_sphere { "sphere" } else { "hemisphere" },
                 bv_core::text::fmt_value(h.pdf_mass),
                 h.failed,
+                if h.whole_sphere { "" } else { " above the horizon" },
                 bv_core::text::fmt_value(h.expected_failed),
                 bv_core::text::fmt_value(scale),
             ),
