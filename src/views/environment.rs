@@ -884,6 +884,12 @@ impl View for EnvironmentView {
         }
     }
 
+    /// Independent of the scene's light (issue 33: it draws with the light
+    /// below the surface too).
+    fn shows_light_below(&self) -> bool {
+        true
+    }
+
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }

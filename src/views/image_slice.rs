@@ -531,6 +531,12 @@ impl View for ImageSliceView {
         });
     }
 
+    /// Independent of the scene's light (issue 33: it draws with the light
+    /// below the surface too).
+    fn shows_light_below(&self) -> bool {
+        true
+    }
+
     fn as_any(&self) -> &dyn std::any::Any {
         self
     }
