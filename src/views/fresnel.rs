@@ -438,11 +438,18 @@ pub fn figure_of(scene: &Scene<'_>, dark: bool) -> FresnelFigure {
         fig.chart = c;
         return fig;
     };
+    // A light below the surface (issue 33) meets the interface at 180° − θi
+    // from the downward normal: read it on the curve from inside.
+    let (at, label) = if scene.incident.below() {
+        (180.0 - scene.incident.theta_deg, "θi (inside)")
+    } else {
+        (scene.incident.theta_deg, "θi")
+    };
     c.vlines.push(Marker {
-        at: scene.incident.theta_deg,
+        at,
         color: super::light_color(dark),
         dashed: false,
-        label: "θi".into(),
+        label: label.into(),
     });
     let strong = super::strong_text_color(dark);
     let with_term = scene
