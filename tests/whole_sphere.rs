@@ -486,10 +486,10 @@ fn the_3d_lobe_draws_the_refracted_ray_by_snell() {
     assert!(segments_along("rough-dielectric", rd(1.5), 30.0, down) > 2);
     let up = snell((1.5 * 30f64.to_radians().sin()).asin(), false);
     assert!(segments_along("rough-dielectric", rd(1.5), 150.0, up) > 2);
-    // Beyond the critical angle from inside no ray: the same guide lines
-    // as a reflecting model's.
-    let lines = |model: &str, params: serde_json::Value| {
-        let (s, rt) = state(model, params, 135.0);
+    // Beyond the critical angle from inside no ray: no segment in the
+    // refracted ray's colour (dark theme: rgb 110 190 255, opacity 0.95).
+    let refr_segments = |model: &str, params: serde_json::Value, ti: f64| {
+        let (s, rt) = state(model, params, ti);
         let scene = build_scene(&s, &rt, false);
         let mut view = bv::views::lobe3d::Lobe3dView::default();
         let f = view.frame(
@@ -498,11 +498,17 @@ fn the_3d_lobe_draws_the_refracted_ray_by_snell() {
             [0.0, 0.0, 0.0, 1.0],
             true,
         );
-        f.lines.len()
+        let want = [110.0 / 255.0, 190.0 / 255.0, 1.0, 0.95];
+        f.lines
+            .iter()
+            .filter(|l| l.color.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-3))
+            .count()
     };
+    assert!(refr_segments("rough-dielectric", rd(1.5), 150.0) > 2);
+    assert_eq!(refr_segments("rough-dielectric", rd(1.5), 135.0), 0);
     assert_eq!(
-        lines("rough-dielectric", rd(1.5)),
-        lines("cook-torrance", serde_json::json!({"alpha": 0.2}))
+        refr_segments("cook-torrance", serde_json::json!({"alpha": 0.2}), 30.0),
+        0
     );
     assert_eq!(
         segments_along(

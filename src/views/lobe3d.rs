@@ -344,7 +344,8 @@ impl Lobe3dView {
                 unlit: true,
             },
         });
-        let mut lines = guide_lines(scene.incident, dark);
+        let lower = scene.brdfs.iter().any(|b| b.brdf.transmits());
+        let mut lines = guide_lines(scene.incident, dark, lower);
         // The refracted ray of the selected (or first) interface model:
         // Snell's law in vector form (bv_core::frame::refract), dashed in
         // the polar view's colour for ωt; none under total internal
@@ -470,8 +471,10 @@ fn arrow_head(
     }
 }
 
-/// Grid, ground rings, axes, incident ray and mirror direction.
-fn guide_lines(incident: Incident, dark: bool) -> Vec<LineSeg> {
+/// Grid, ground rings, axes, incident ray and mirror direction; with
+/// `lower`, the grid of the lower hemisphere too, fainter (a transmitting
+/// model's lobe reaches below the surface, issue 33).
+fn guide_lines(incident: Incident, dark: bool, lower: bool) -> Vec<LineSeg> {
     use std::f32::consts::{FRAC_PI_2, TAU};
     let mut out = Vec::new();
     let grid = rgba(super::grid_color(dark), if dark { 0.22 } else { 0.28 });
@@ -483,6 +486,23 @@ fn guide_lines(incident: Incident, dark: bool) -> Vec<LineSeg> {
             let th = t * FRAC_PI_2;
             Vec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos())
         });
+    }
+    if lower {
+        let faint = rgba(super::grid_color(dark), if dark { 0.12 } else { 0.16 });
+        for k in 0..12 {
+            let phi = TAU * k as f32 / 12.0;
+            polyline(&mut out, 24, faint, 1.0, |t| {
+                let th = FRAC_PI_2 + t * FRAC_PI_2;
+                Vec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos())
+            });
+        }
+        for th_deg in [120.0f32, 150.0] {
+            let th = th_deg.to_radians();
+            polyline(&mut out, 96, faint, 1.0, |t| {
+                let phi = t * TAU;
+                Vec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos())
+            });
+        }
     }
     for th_deg in [30.0f32, 60.0] {
         let th = th_deg.to_radians();
