@@ -1,16 +1,17 @@
 //! The property badges of the panel: for every loaded BRDF, whether it is
 //! reciprocal, energy-conserving, positive and isotropic, each with the
 //! number behind the verdict; clicking a badge opens the numbers behind it.
-//! The reports and their words are [`crate::derive::properties`]'.
+//! The reports and their words are [`crate::derive::properties`]': a
+//! preview first (marked "…"), then `bv check`'s own numbers.
 
-use crate::derive::properties::{self, Badge, Property, badge, evidence};
+use crate::derive::properties::{self, Badge, Property, Stage, badge, evidence};
 use crate::session::runtime::Runtime;
 use crate::session::state::AppState;
 use eframe::egui::{self, Color32, RichText, Role, Ui, WidgetInfo};
 
 /// One badge: its word, a painted tick or cross (egui's default fonts have
 /// no check-mark glyph), and the number; clickable.
-fn badge_widget(ui: &mut Ui, b: &Badge, color: Color32, stale: bool) -> egui::Response {
+fn badge_widget(ui: &mut Ui, b: &Badge, color: Color32, provisional: bool) -> egui::Response {
     let font = egui::TextStyle::Small.resolve(ui.style());
     let word = b.property.word();
     let rest = b
@@ -18,7 +19,7 @@ fn badge_widget(ui: &mut Ui, b: &Badge, color: Color32, stale: bool) -> egui::Re
         .strip_prefix(word)
         .map(|t| t.trim_start_matches([' ', '✓', '✗']))
         .unwrap_or(&b.text);
-    let rest = if stale {
+    let rest = if provisional {
         format!("{rest} …")
     } else {
         rest.to_string()
@@ -111,16 +112,32 @@ pub fn row(ui: &mut Ui, name: &str, id: u64, runtime: &Runtime) {
                         None => {
                             let r = ui
                                 .label(RichText::new(format!("{} …", p.word())).small().weak())
-                                .on_hover_text("computing (bv check with fewer pairs)");
+                                .on_hover_text("computing (a preview: bv check with fewer pairs)");
                             let label = format!("{name}: {} …", p.word());
                             r.widget_info(move || WidgetInfo::labeled(Role::Label, true, &label));
                         }
-                        Some((report, stale)) => {
-                            let b = badge(report, p);
+                        Some(shown) => {
+                            let b = badge(&shown.report, p);
                             let color = if b.ok { good } else { bad };
-                            let r = badge_widget(ui, &b, color, *stale)
-                                .on_hover_text("Show the numbers behind it");
-                            let label = format!("{name}: {}", b.text);
+                            // A preview or an older build's report: "…"
+                            // until bv check's own run of this build is in
+                            // (a preview that stays, for a model too slow
+                            // for bv check, says why on hover).
+                            let provisional = shown.stale
+                                || (shown.stage == Stage::Preview && shown.no_check.is_none());
+                            let hover = match (&shown.no_check, shown.stage) {
+                                (Some(why), _) => format!("preview only: {why}"),
+                                (None, Stage::Preview) => {
+                                    "preview; bv check's own numbers follow".to_string()
+                                }
+                                (None, Stage::Check) => "Show the numbers behind it".to_string(),
+                            };
+                            let r = badge_widget(ui, &b, color, provisional).on_hover_text(hover);
+                            let label = format!(
+                                "{name}: {}{}",
+                                b.text,
+                                if provisional { " …" } else { "" }
+                            );
                             r.widget_info(move || WidgetInfo::labeled(Role::Button, true, &label));
                             if r.clicked() {
                                 ui.ctx()
@@ -149,7 +166,7 @@ pub fn evidence_window(ctx: &egui::Context, state: &AppState) {
         return;
     };
     let name = crate::session::naming::display_name(state, entry);
-    let report = properties::slots().latest(id).map(|d| d.value.clone());
+    let shown = properties::latest(id);
     let mut open = true;
     egui::Window::new(format!("{name}: {}", property.word()))
         .id(egui::Id::unique("bv badge evidence window"))
@@ -157,13 +174,17 @@ pub fn evidence_window(ctx: &egui::Context, state: &AppState) {
         .resizable(false)
         .collapsible(false)
         .default_width(380.0)
-        .show(ctx, |ui| match &report {
-            Some(r) => {
-                let b = badge(r, property);
+        .show(ctx, |ui| match &shown {
+            Some(shown) => {
+                let b = badge(&shown.report, property);
                 let verdict = if b.ok { "holds" } else { "violated" };
                 ui.label(RichText::new(format!("{}: {verdict}", property.word())).strong());
-                for line in evidence(r, property) {
+                for line in evidence(&shown.report, property) {
                     ui.label(RichText::new(line).small());
+                }
+                ui.label(RichText::new(shown.stage.describe()).small().weak());
+                if let Some(why) = &shown.no_check {
+                    ui.label(RichText::new(why).small().weak());
                 }
             }
             None => {

@@ -20,9 +20,8 @@ use bv_core::Brdf;
 use bv_core::text::fmt_duration;
 use std::time::Duration;
 
-/// Budget of `bv check`'s evaluations: with the compile and the probe, the
-/// check of any file of up to 1 MB ends within 10 s.
-pub const CHECK: Duration = Duration::from_secs(7);
+/// Budget of `bv check`'s evaluations (the panel's badges use the same).
+pub const CHECK: Duration = bv_core::analysis::CHECK_BUDGET;
 /// Budget of `slice`, `tabulate` and `bench`.
 pub const LONG: Duration = Duration::from_secs(60);
 

@@ -1,22 +1,32 @@
 //! Property reports: for a BRDF, whether it is reciprocal,
 //! energy-conserving, positive and isotropic, each with the number behind
-//! the verdict ("reciprocal ✓ 3e-16", "energy ✗ ρhd max 1.23 at θi 89.9°"),
-//! and the evidence lines behind each. They are `bv_core::analysis::check`'s
-//! verdicts, the ones `bv check` prints, computed with fewer direction pairs
-//! and a coarser θi grid (the near-grazing angles kept: that is where the
-//! classical Phong of the lecture exceeds 1), as a job cached by the BRDF's
-//! build revision; the panel's badges show them.
+//! the verdict ("reciprocal ✓ 3e-16", "energy ✗ ρhd max 1.23 ± 0.001 at θi
+//! 89.9°"), and the evidence lines behind each. They are
+//! `bv_core::analysis::check`'s verdicts, the ones `bv check` prints, as
+//! jobs cached by the BRDF's build revision, in two stages:
+//! 1. a **preview** with fewer direction pairs and a coarser θi grid (the
+//!    near-grazing angles kept: that is where the classical Phong of the
+//!    lecture exceeds 1), so that a badge follows a slider within a fraction
+//!    of a second;
+//! 2. then **`bv check`'s own run** ([`check_options`]), which replaces it:
+//!    a settled badge shows the very numbers and errors `bv check` prints.
+//!    The preview's largest ρhd is the maximum of noisier estimates, biased
+//!    upwards (a user file's 0.71 where `bv check` finds 0.497 ± 0.041), so
+//!    it is marked as a preview until the check's run is in.
+//!
+//! A model that `bv check` would refuse as too slow for its budget
+//! ([`bv_core::analysis::CHECK_BUDGET`]) keeps its preview, which says so.
 
 use super::jobs::{self, Slots, Waker};
 use crate::session::runtime::Built;
-use bv_core::analysis::{self, CheckOptions, PairSample, PropertyReport};
+use bv_core::analysis::{self, CHECK_BUDGET, CheckOptions, PropertyReport, fmt_estimate};
+use bv_core::text::fmt_duration;
 use std::sync::Arc;
 
-/// The check the panel runs: `bv check`'s estimators and thresholds with a
-/// tenth of its direction pairs, a θi step of 3° instead of 1° (plus the same
-/// near-grazing angles) and smaller Monte Carlo and NDF budgets, so that a
-/// badge follows a parameter change within a fraction of a second.
-pub fn options() -> CheckOptions {
+/// The preview the panel runs first: `bv check`'s estimators and thresholds
+/// with a tenth of its direction pairs, a θi step of 3° instead of 1° (plus
+/// the same near-grazing angles) and smaller Monte Carlo and NDF budgets.
+pub fn preview_options() -> CheckOptions {
     CheckOptions {
         pairs: 2000,
         theta_count: 30,
@@ -26,6 +36,12 @@ pub fn options() -> CheckOptions {
         ndf_max_evals: 200_000,
         ..CheckOptions::default()
     }
+}
+
+/// What `bv check` runs (its default `--albedo auto`), and so what a
+/// settled badge shows.
+pub fn check_options() -> CheckOptions {
+    CheckOptions::default()
 }
 
 /// One of the four properties a badge shows.
@@ -99,13 +115,15 @@ pub fn badge(report: &PropertyReport, property: Property) -> Badge {
         ),
         Property::Energy => {
             let e = &report.energy;
-            let max = e.max.max_channel().0;
             let at = if e.conserves {
                 String::new()
             } else {
                 format!(" at θi {}°", trim_deg(e.argmax_theta_deg))
             };
-            (e.conserves, format!("ρhd max {}{at}", short(max)))
+            (
+                e.conserves,
+                format!("ρhd max {}{at}", fmt_estimate(&e.max)),
+            )
         }
         Property::Positive => (
             report.positivity.ok,
@@ -168,11 +186,9 @@ pub fn evidence(report: &PropertyReport, property: Property) -> Vec<String> {
         }
         Property::Energy => {
             let e = &report.energy;
-            let (m, err, _) = e.max.max_channel();
             lines.push(format!(
-                "max ρhd = {} ± {} at θi = {}°, φi = {}°",
-                v(m),
-                v(err),
+                "max ρhd = {} at θi = {}°, φi = {}°",
+                fmt_estimate(&e.max),
                 trim_deg(e.argmax_theta_deg),
                 trim_deg(e.argmax_phi_deg)
             ));
@@ -202,8 +218,7 @@ pub fn evidence(report: &PropertyReport, property: Property) -> Vec<String> {
                 )
             };
             lines.push(method);
-            let (hh, hh_err, _) = e.rho_hh.max_channel();
-            lines.push(format!("ρhh = {} ± {}", v(hh), v(hh_err)));
+            lines.push(format!("ρhh = {}", fmt_estimate(&e.rho_hh)));
             if e.has_deltas {
                 lines.push("delta lobes included in ρhd".into());
             }
@@ -243,33 +258,183 @@ pub fn evidence(report: &PropertyReport, property: Property) -> Vec<String> {
             lines.push(claimed(report.claims.isotropic));
         }
     }
-    let o = options();
-    lines.push(format!(
-        "panel check: {} pairs, {} θi (bv check: {} pairs, {} θi)",
-        o.pairs,
-        o.theta_count,
-        CheckOptions::default().pairs,
-        CheckOptions::default().theta_count
-    ));
     lines
 }
 
-/// The reports of every BRDF (slot: BRDF id, key: its build revision).
+/// Which run a shown report comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stage {
+    /// The quick run with [`preview_options`].
+    Preview,
+    /// `bv check`'s own run ([`check_options`]).
+    Check,
+}
+
+impl Stage {
+    /// The options of this run.
+    pub fn options(self) -> CheckOptions {
+        match self {
+            Stage::Preview => preview_options(),
+            Stage::Check => check_options(),
+        }
+    }
+
+    /// The evidence windows' last line: which run the numbers come from.
+    pub fn describe(self) -> String {
+        let (p, c) = (preview_options(), check_options());
+        match self {
+            Stage::Preview => format!(
+                "preview: {} pairs, {} θi (bv check's own run, {} pairs, {} θi, follows)",
+                p.pairs, p.theta_count, c.pairs, c.theta_count
+            ),
+            Stage::Check => format!(
+                "bv check's own run: {} pairs, {} θi; the numbers it prints",
+                c.pairs, c.theta_count
+            ),
+        }
+    }
+}
+
+/// A report for the panel to show.
+#[derive(Debug, Clone)]
+pub struct Shown {
+    /// The report.
+    pub report: Arc<PropertyReport>,
+    /// Which run it comes from.
+    pub stage: Stage,
+    /// It is of an older build of the BRDF (a newer one is computing).
+    pub stale: bool,
+    /// Why `bv check`'s run will not follow the preview (the model is too
+    /// slow for its budget), as a sentence.
+    pub no_check: Option<String>,
+}
+
+/// The reports of `bv check`'s own runs (slot: BRDF id, key: build
+/// revision).
 pub fn slots() -> Arc<Slots<u64, Arc<PropertyReport>>> {
     jobs::slots("property report")
 }
 
-/// The report of `built` for BRDF `id`: the latest finished one (perhaps of
-/// an older revision, then `stale`), starting its computation when needed.
-pub fn report(waker: &Waker, id: u64, built: &Built) -> Option<(Arc<PropertyReport>, bool)> {
+/// The previews (slot: BRDF id, key: build revision).
+pub fn previews() -> Arc<Slots<u64, Arc<PropertyReport>>> {
+    jobs::slots("property report preview")
+}
+
+/// Why `bv check` would refuse `built`'s model as too slow, if it would.
+fn too_slow(built: &Built) -> Option<String> {
+    let brdf = built.brdf.as_deref()?;
+    let threads = rayon::current_num_threads();
+    let t = check_options().estimated_time(brdf, threads)?;
+    (t > CHECK_BUDGET).then(|| {
+        format!(
+            "bv check would refuse this model: about {} of evaluations, over its budget of {}",
+            fmt_duration(t),
+            fmt_duration(CHECK_BUDGET)
+        )
+    })
+}
+
+/// The report to show for `built` (BRDF `id`): `bv check`'s run of this
+/// build when it is in; else this build's preview, starting `bv check`'s
+/// run once the preview is in (so that a slider being dragged costs
+/// previews only); else the latest report of an older build (`stale`).
+/// Starts what is needed; `None` while nothing was ever computed.
+pub fn report(waker: &Waker, id: u64, built: &Built) -> Option<Shown> {
     let brdf = built.brdf.clone()?;
-    let done = slots().request(
+    let rev = built.revision;
+    if let Some(d) = slots().get(id, &rev) {
+        return Some(Shown {
+            report: d.value.clone(),
+            stage: Stage::Check,
+            stale: false,
+            no_check: None,
+        });
+    }
+    let b = brdf.clone();
+    let preview = previews().request(
         id,
-        built.revision,
-        jobs::once(move || Arc::new(analysis::check(brdf.as_ref(), &options()))),
+        rev,
+        jobs::once(move || Arc::new(analysis::check(b.as_ref(), &preview_options()))),
         waker,
-    )?;
-    Some((done.value.clone(), done.key != built.revision))
+    );
+    match preview {
+        Some(p) if p.key == rev => {
+            let no_check = too_slow(built);
+            if no_check.is_none() {
+                let checked = slots().request(
+                    id,
+                    rev,
+                    jobs::once(move || Arc::new(analysis::check(brdf.as_ref(), &check_options()))),
+                    waker,
+                );
+                if let Some(d) = checked.filter(|d| d.key == rev) {
+                    return Some(Shown {
+                        report: d.value.clone(),
+                        stage: Stage::Check,
+                        stale: false,
+                        no_check: None,
+                    });
+                }
+            }
+            Some(Shown {
+                report: p.value.clone(),
+                stage: Stage::Preview,
+                stale: false,
+                no_check,
+            })
+        }
+        older => {
+            // An older build's: `bv check`'s run if there is one, else its
+            // preview.
+            let (d, stage) = match slots().latest(id) {
+                Some(d) => (d, Stage::Check),
+                None => (older?, Stage::Preview),
+            };
+            Some(Shown {
+                report: d.value.clone(),
+                stage,
+                stale: true,
+                no_check: None,
+            })
+        }
+    }
+}
+
+/// The report last shown for BRDF `id` (for its evidence window), without
+/// starting anything: `bv check`'s run of the newest build if it is in,
+/// else the newest preview.
+pub fn latest(id: u64) -> Option<Shown> {
+    let check = slots().latest(id);
+    let preview = previews().latest(id);
+    let (d, stage) = match (check, preview) {
+        (Some(c), Some(p)) if p.key != c.key => (p, Stage::Preview),
+        (Some(c), _) => (c, Stage::Check),
+        (None, Some(p)) => (p, Stage::Preview),
+        (None, None) => return None,
+    };
+    Some(Shown {
+        report: d.value.clone(),
+        stage,
+        stale: false,
+        no_check: None,
+    })
+}
+
+/// Waits until neither the previews nor `bv check`'s runs have work
+/// running or waiting, or `timeout` passes; true when idle.
+pub fn wait_idle(timeout: std::time::Duration) -> bool {
+    use std::time::{Duration, Instant};
+    let t0 = Instant::now();
+    let (a, b) = (previews(), slots());
+    loop {
+        if a.wait_idle(Duration::ZERO) && b.wait_idle(Duration::ZERO) {
+            return true;
+        }
+        if t0.elapsed() > timeout {
+            return false;
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    }
 }
 
 #[cfg(test)]
@@ -287,7 +452,7 @@ mod tests {
 
     #[test]
     fn panel_options_are_cheaper_than_bv_check() {
-        let (p, d) = (options(), CheckOptions::default());
+        let (p, d) = (preview_options(), check_options());
         assert!(p.pairs < d.pairs && p.theta_count < d.theta_count);
         // The angles where ρhd of a 1/cos θi lobe blows up are kept.
         assert_eq!(p.grazing_deg, d.grazing_deg);

@@ -27,6 +27,14 @@ use albedo::{AlbedoCurve, Estimate};
 use glam::DVec3;
 use serde::Serialize;
 use std::fmt;
+use std::time::Duration;
+
+/// How long `bv check` may spend evaluating a model whose evaluations are
+/// timed ([`Brdf::eval_cost`]: user files): with the compile and the probe,
+/// the check of any file of up to 1 MB ends within 10 s. A model that
+/// [`CheckOptions::estimated_time`] puts beyond it is refused by `bv check`,
+/// and the panel's badges keep their preview for it.
+pub const CHECK_BUDGET: Duration = Duration::from_secs(7);
 
 /// What [`check`] measures and how hard it tries. The defaults run in well
 /// under 2 s in a release build for every model of the catalogue on one core
@@ -260,6 +268,18 @@ impl CheckOptions {
         let parallel = azimuths * angles * self.samples_per_angle as u64 + self.hh_samples as u64;
         (serial, parallel)
     }
+
+    /// About how long [`check`] takes on `threads` threads at `brdf`'s
+    /// measured cost per evaluation ([`Brdf::eval_cost`]): the
+    /// [`evaluations`](Self::evaluations) times that cost. `None` for a model
+    /// whose cost is not measured (the catalogue's, a fraction of a
+    /// microsecond each).
+    pub fn estimated_time(&self, brdf: &dyn Brdf, threads: usize) -> Option<Duration> {
+        let cost = brdf.eval_cost()?.as_secs_f64();
+        let (serial, parallel) = self.evaluations(brdf);
+        let secs = cost * (serial as f64 + parallel as f64 / threads.max(1) as f64);
+        Some(Duration::from_secs_f64(secs.clamp(0.0, 1e9)))
+    }
 }
 
 /// Runs every property check on `brdf`.
@@ -482,10 +502,14 @@ fn num(x: f64) -> String {
 use crate::text::fmt_deg as deg;
 
 /// An estimate of the largest channel with its error.
-fn est(e: &Estimate) -> String {
+/// An estimate as `bv check` prints it: the largest channel's value and
+/// its error, "0.4970 ± 0.04100" (the panel's badges print the same).
+pub fn fmt_estimate(e: &Estimate) -> String {
     let (v, s, _) = e.max_channel();
     format!("{} ± {}", num(v), num(s))
 }
+
+use fmt_estimate as est;
 
 impl fmt::Display for PropertyReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
