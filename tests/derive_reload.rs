@@ -54,7 +54,10 @@ fn draw_all(off: &mut Offscreen, state: &AppState, frame: Frame) -> f64 {
     };
     let t0 = Instant::now();
     while properties::report(&Waker::none(), id, &built).is_none_or(|s| s.stale) {
-        assert!(t0.elapsed() < Duration::from_secs(300), "no property report");
+        assert!(
+            t0.elapsed() < Duration::from_secs(300),
+            "no property report"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     let curve = albedo::slots().latest(id).unwrap();
@@ -88,7 +91,10 @@ fn a_saved_file_refreshes_every_derived_result() {
         transparent: false,
     };
     let mut reloader = Reloader::default();
-    assert!(reloader.update(&mut s).is_empty(), "watching starts quietly");
+    assert!(
+        reloader.update(&mut s).is_empty(),
+        "watching starts quietly"
+    );
 
     let before = draw_all(&mut off, &s, frame);
     assert!((before - 0.4).abs() < 1e-3, "ρhd(0) = k = 0.4: {before}");
@@ -99,7 +105,10 @@ fn a_saved_file_refreshes_every_derived_result() {
     let t0 = Instant::now();
     loop {
         let events = reloader.update(&mut s);
-        if let Some(e) = events.iter().find(|e| matches!(e, ReloadEvent::Failed { .. })) {
+        if let Some(e) = events
+            .iter()
+            .find(|e| matches!(e, ReloadEvent::Failed { .. }))
+        {
             panic!("{e:?}");
         }
         if !events.is_empty() {

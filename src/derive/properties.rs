@@ -19,7 +19,9 @@
 
 use super::jobs::{self, Slots, Waker};
 use crate::session::runtime::Built;
-use bv_core::analysis::{self, CHECK_BUDGET, CheckOptions, PropertyReport, fmt_estimate};
+use bv_core::analysis::{
+    self, CHECK_BUDGET, CheckOptions, PairSample, PropertyReport, fmt_estimate,
+};
 use bv_core::text::fmt_duration;
 use std::sync::Arc;
 
@@ -120,10 +122,7 @@ pub fn badge(report: &PropertyReport, property: Property) -> Badge {
             } else {
                 format!(" at θi {}°", trim_deg(e.argmax_theta_deg))
             };
-            (
-                e.conserves,
-                format!("ρhd max {}{at}", fmt_estimate(&e.max)),
-            )
+            (e.conserves, format!("ρhd max {}{at}", fmt_estimate(&e.max)))
         }
         Property::Positive => (
             report.positivity.ok,
