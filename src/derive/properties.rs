@@ -420,9 +420,12 @@ pub fn latest(id: u64) -> Option<Shown> {
 }
 
 /// Waits until neither the previews nor `bv check`'s runs have work
-/// running or waiting, or `timeout` passes; true when idle.
+/// running or waiting, or `timeout` passes; true when idle. For tests and
+/// headless callers: it blocks the thread, which the browser cannot do.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn wait_idle(timeout: std::time::Duration) -> bool {
-    use std::time::{Duration, Instant};
+    use crate::session::platform::Instant;
+    use std::time::Duration;
     let t0 = Instant::now();
     let (a, b) = (previews(), slots());
     loop {
