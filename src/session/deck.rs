@@ -11,6 +11,8 @@
 //! title = "Lambert: ideal diffuse"       # the slide's title, one line
 //! caption = "f = ρ/π in every direction" # one line under it
 //! view = "polar"                         # the view shown (maximised)
+//! seed = "Ideal Diffuse Reflection"      # optional: the lecture slide(s) it
+//!                                        # shows, a heading or a list of them
 //! file = "scenes/lambert.toml"           # a scene file, relative to the deck
 //!
 //! [[scene]]
@@ -148,6 +150,10 @@ pub struct Slide {
     pub title: String,
     /// One line under the title.
     pub caption: String,
+    /// The headings of the lecture's slides this scene shows (the deck's
+    /// `seed` key: one heading or a list), so that a deck's coverage of its
+    /// lecture can be checked; empty when the deck does not say.
+    pub seed: Vec<String>,
     /// The id of the view shown (see `session::views`).
     pub view: String,
     /// The scene; its `maximised` is [`Slide::view`].
@@ -165,6 +171,7 @@ impl Slide {
         Some(Self {
             title: title.to_string(),
             caption: caption.to_string(),
+            seed: Vec::new(),
             view,
             state: state.sanitised(),
             source: Source::Inline,
@@ -200,7 +207,10 @@ pub fn load(path: &Path, builds: Builds) -> Result<Loaded, DeckError> {
 }
 
 const HEADER_KEYS: &[&str] = &["format", "generator", "version", "title", "scene"];
-const ENTRY_KEYS: &[&str] = &["title", "caption", "view", "file", "state"];
+const ENTRY_KEYS: &[&str] = &["title", "caption", "view", "seed", "file", "state"];
+
+/// Most headings one scene's `seed` names.
+pub const MAX_SEED_HEADINGS: usize = 16;
 
 /// Parses deck text; `file` entries and relative paths of inline scenes are
 /// taken relative to `base` (the current directory when `None`).
@@ -337,6 +347,10 @@ fn entry(
         return Err(bad("title", "empty: every slide has a title".into()));
     }
     let caption = text_key("caption")?;
+    let seed = match t.get("seed") {
+        None => Vec::new(),
+        Some(v) => seed_headings(v).map_err(|r| bad("seed", r))?,
+    };
     let view_name = text_key("view")?;
     let Some(view) = super::views::find(&view_name) else {
         return Err(bad(
@@ -414,6 +428,7 @@ fn entry(
     Ok(Slide {
         title: title_text,
         caption,
+        seed,
         view: view.id.to_string(),
         state,
         source,
@@ -434,6 +449,36 @@ fn one_line(v: &toml::Value) -> Result<String, String> {
             quote(&v.to_string())
         )),
     }
+}
+
+/// A `seed` value: one heading, or a non-empty list of at most
+/// [`MAX_SEED_HEADINGS`] distinct headings, each one non-empty line.
+fn seed_headings(v: &toml::Value) -> Result<Vec<String>, String> {
+    let items: Vec<&toml::Value> = match v {
+        toml::Value::Array(a) if a.is_empty() => {
+            return Err("an empty list (leave `seed` out, or name a heading)".into());
+        }
+        toml::Value::Array(a) if a.len() > MAX_SEED_HEADINGS => {
+            return Err(format!(
+                "{} headings; a scene names at most {MAX_SEED_HEADINGS}",
+                a.len()
+            ));
+        }
+        toml::Value::Array(a) => a.iter().collect(),
+        other => vec![other],
+    };
+    let mut out: Vec<String> = Vec::with_capacity(items.len());
+    for item in items {
+        let h = one_line(item)?.trim().to_string();
+        if h.is_empty() {
+            return Err("an empty heading".into());
+        }
+        if out.contains(&h) {
+            return Err(format!("\"{}\" twice", quote(&h)));
+        }
+        out.push(h);
+    }
+    Ok(out)
 }
 
 fn resolve(base: Option<&Path>, rel: &str) -> PathBuf {
@@ -468,6 +513,8 @@ struct EntryOut<'a> {
     caption: &'a str,
     view: &'a str,
     #[serde(skip_serializing_if = "Option::is_none")]
+    seed: Option<toml::Value>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     file: Option<&'a str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     state: Option<toml::Table>,
@@ -501,6 +548,13 @@ pub fn to_toml_for(path: &Path, deck: &Deck) -> Result<String, DeckError> {
             title: &s.title,
             caption: &s.caption,
             view: &s.view,
+            seed: match s.seed.as_slice() {
+                [] => None,
+                [one] => Some(toml::Value::String(one.clone())),
+                many => Some(toml::Value::Array(
+                    many.iter().cloned().map(toml::Value::String).collect(),
+                )),
+            },
             file: match &s.source {
                 Source::File { path, .. } => Some(path),
                 Source::Inline => None,
@@ -609,11 +663,18 @@ mod tests {
     }
 
     fn sample() -> Deck {
+        let mut lambert =
+            Slide::inline("Lambert", "f = ρ/π", "polar", state("lambert", 30.0)).unwrap();
+        lambert.seed = vec!["Ideal Diffuse Reflection".into()];
+        let mut phong =
+            Slide::inline("Phong", "a cosine lobe", "lobe3d", state("phong", 60.0)).unwrap();
+        phong.seed = vec!["Classical Phong Model".into(), "Reflectance Models".into()];
         Deck {
             title: Some("Reflectance".into()),
             slides: vec![
-                Slide::inline("Lambert", "f = ρ/π", "polar", state("lambert", 30.0)).unwrap(),
-                Slide::inline("Phong", "a cosine lobe", "lobe3d", state("phong", 60.0)).unwrap(),
+                lambert,
+                phong,
+                Slide::inline("Mirror", "δ", "polar", state("mirror", 45.0)).unwrap(),
             ],
         }
     }
@@ -637,6 +698,14 @@ mod tests {
         assert_eq!(back.deck.slides[1].view, "lobe");
         assert_eq!(back.deck.slides[1].state.maximised.as_deref(), Some("lobe"));
         assert_eq!(back.deck.slides[1].state.incident.theta_deg, 60.0);
+        // One heading is written as a string, several as a list, none not at all.
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("seed = \"Ideal Diffuse Reflection\"\n"), "{text}");
+        assert!(
+            text.contains("seed = [\"Classical Phong Model\", \"Reflectance Models\"]"),
+            "{text}"
+        );
+        assert_eq!(text.matches("seed =").count(), 2, "{text}");
         // A file bv wrote is refused when cut short.
         let text = std::fs::read_to_string(&path).unwrap();
         let cut = &text[..text.len() - END_MARKER.len() - 2];
@@ -722,6 +791,34 @@ mod tests {
                 "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\ncolour = 1\n[scene.state]\n",
                 "colour",
                 "unknown",
+            ),
+            (
+                "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nseed = []\n[scene.state]\n",
+                "seed",
+                "empty list",
+            ),
+            (
+                "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nseed = 3\n[scene.state]\n",
+                "seed",
+                "expected a string",
+            ),
+            (
+                "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nseed = [\"X\", \" \"]\n\
+                 [scene.state]\n",
+                "seed",
+                "empty heading",
+            ),
+            (
+                "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nseed = [\"X\", \"X\"]\n\
+                 [scene.state]\n",
+                "seed",
+                "twice",
+            ),
+            (
+                "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nseed = \"a\\nb\"\n\
+                 [scene.state]\n",
+                "seed",
+                "one line",
             ),
             (
                 "title = \"A\"\ncaption = \"c\"\nview = \"polar\"\nfile = \"x.toml\"\n[scene.state]\n",

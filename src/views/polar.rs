@@ -680,15 +680,11 @@ pub fn interface_marks(scene: &Scene<'_>, outer: f64, dark: bool) -> Vec<Mark> {
         } else {
             a0
         };
-        let at = polar_point(outer * 1.22, place);
+        // One label: two stacked ones overlapped each other and the ring's
+        // angle label at presentation mode's text size.
         out.push(Mark::Text {
-            at,
-            text: format!("θc {:.1}°", c.to_degrees()),
-            color: window_line,
-        });
-        out.push(Mark::Text {
-            at: [at[0], at[1] + outer * 0.09 * at[1].signum()],
-            text: "Snell's window".into(),
+            at: polar_point(outer * 1.27, place),
+            text: format!("Snell's window, θc {:.1}°", c.to_degrees()),
             color: window_line,
         });
     }
