@@ -700,7 +700,10 @@ mod tests {
         assert_eq!(back.deck.slides[1].state.incident.theta_deg, 60.0);
         // One heading is written as a string, several as a list, none not at all.
         let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.contains("seed = \"Ideal Diffuse Reflection\"\n"), "{text}");
+        assert!(
+            text.contains("seed = \"Ideal Diffuse Reflection\"\n"),
+            "{text}"
+        );
         assert!(
             text.contains("seed = [\"Classical Phong Model\", \"Reflectance Models\"]"),
             "{text}"
