@@ -217,9 +217,9 @@ fn modified_phong_is_taller_when_sharper_by_e_plus_2_over_2_pi() {
 fn linearity_the_mix_is_the_weighted_sum_of_its_parts() {
     let slides = slides();
     let c = polar_curves(slide(&slides, "Property 1: linearity"));
-    for k in 0..c[0].len() {
-        let sum = 0.6 * c[0][k].1 + 0.4 * c[1][k].1;
-        assert!((c[2][k].1 - sum).abs() <= 1e-12 * sum.max(1.0), "{k}");
+    for (k, ((a, b), mix)) in c[0].iter().zip(&c[1]).zip(&c[2]).enumerate() {
+        let sum = 0.6 * a.1 + 0.4 * b.1;
+        assert!((mix.1 - sum).abs() <= 1e-12 * sum.max(1.0), "{k}");
     }
     // Lambert 0.8/π under it everywhere, the glossy lobe above it at +45°.
     assert!((value_at(&c[0], 10.0) - 0.8 / std::f64::consts::PI).abs() < 1e-12);
