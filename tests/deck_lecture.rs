@@ -309,17 +309,7 @@ fn bsdf_slide_transmits_near_snells_direction() {
 #[test]
 fn snell_slides_show_snells_law_fresnel_and_the_window() {
     let slides = slides();
-    // Closed forms written here: Snell and the unpolarised Fresnel term.
-    fn fresnel(cos_i: f64, eta_i: f64, eta_t: f64) -> f64 {
-        let sin_t = eta_i / eta_t * (1.0 - cos_i * cos_i).sqrt();
-        if sin_t >= 1.0 {
-            return 1.0;
-        }
-        let cos_t = (1.0 - sin_t * sin_t).sqrt();
-        let rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
-        let rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
-        0.5 * (rs * rs + rp * rp)
-    }
+    // Closed forms written here: Snell and the Fresnel term.
     for (title, eta, below) in [
         ("Snell's law", 1.5, false),
         ("Law of refraction and total internal reflection", 1.5, true),
@@ -337,7 +327,7 @@ fn snell_slides_show_snells_law_fresnel_and_the_window() {
         let texts = fig.texts().join(" | ");
         let (ei, et) = if below { (eta, 1.0) } else { (1.0, eta) };
         let tt = (ei / et * ti.to_radians().sin()).asin().to_degrees();
-        let r = fresnel(ti.to_radians().cos(), ei, et);
+        let r = fresnel_dielectric(ti.to_radians().cos(), ei, et);
         for want in [
             format!("θt = {tt:.1}°"),
             format!("R = {r:.3}"),
@@ -351,4 +341,53 @@ fn snell_slides_show_snells_law_fresnel_and_the_window() {
             assert!(texts.contains(&want), "{title}: {want} not in {texts}");
         }
     }
+}
+
+/// The unpolarised Fresnel reflectance of a smooth dielectric interface,
+/// written here from the Fresnel equations.
+fn fresnel_dielectric(cos_i: f64, eta_i: f64, eta_t: f64) -> f64 {
+    let sin_t = eta_i / eta_t * (1.0 - cos_i * cos_i).sqrt();
+    if sin_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t * sin_t).sqrt();
+    let rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+    let rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+#[test]
+fn delta_spikes_carry_their_weights_and_stay_visible() {
+    use bv::views::polar::{MIN_SPIKE, delta_spikes};
+    let slides = slides();
+    let outer = 1.0;
+    let spikes = |title: &str| {
+        let s = slide(&slides, title);
+        let mut rt = Runtime::default();
+        rt.sync(&s.state);
+        let scene = build_scene(&s.state, &rt, false);
+        delta_spikes(&scene, outer)
+    };
+    // Smooth glass at 60°: F at +60°, 1 − F refracted at θt from −n.
+    let sp = spikes("Ideal specular: reflection and transmission");
+    assert_eq!(sp.len(), 2, "{sp:?}");
+    let f = fresnel_dielectric(60f64.to_radians().cos(), 1.0, 1.5);
+    let theta_t = (60f64.to_radians().sin() / 1.5).asin().to_degrees();
+    let angle = |s: &bv::views::polar::Spike| s.tip[0].atan2(s.tip[1]).to_degrees();
+    let refl = sp.iter().find(|s| s.tip[1] > 0.0).unwrap();
+    let refr = sp.iter().find(|s| s.tip[1] < 0.0).unwrap();
+    assert!((refl.weight - f).abs() < 1e-9, "{} vs {f}", refl.weight);
+    assert!((refr.weight - (1.0 - f)).abs() < 1e-9);
+    assert!((angle(refl) - 60.0).abs() < 1e-9);
+    assert!((180.0 - angle(refr).abs() - theta_t).abs() < 1e-9);
+    assert_eq!(format!("δ {:.3}", refl.weight), "δ 0.089");
+    assert_eq!(format!("δ {:.3}", refr.weight), "δ 0.911");
+    // The small one is drawn at the shortest length, not as a dot.
+    let len = |s: &bv::views::polar::Spike| s.tip[0].hypot(s.tip[1]);
+    assert!((len(refl) - MIN_SPIKE * outer).abs() < 1e-12);
+    assert!((len(refr) - 0.911 * outer).abs() < 1e-3);
+    // A mirror with F = 1: one spike at the mirror direction, weight 1.
+    let sp = spikes("Ideal reflection as a delta function");
+    assert_eq!(sp.len(), 1);
+    assert!((sp[0].weight - 1.0).abs() < 1e-12 && (angle(&sp[0]) - 30.0).abs() < 1e-9);
 }

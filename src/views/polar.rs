@@ -288,7 +288,6 @@ impl View for PolarView {
         });
 
         let span: i32 = if transmits { 180 } else { 90 };
-        let brdfs = &scene.brdfs;
         let marks = interface_marks(scene, outer, dark);
         let response = plot.show(ui, |pui| {
             // Rings with the value they stand for, and spokes every 15°.
@@ -447,37 +446,25 @@ impl View for PolarView {
                         .width(scene.stroke(2.0)),
                 );
             }
-            // Delta lobes in the plane, as spikes reaching `weight` of the outer ring.
-            for b in brdfs {
-                for dl in b.brdf.deltas(scene.wi()) {
-                    let dir = dl.direction;
-                    let plane_n = glam::DVec3::new(-phi_i.sin(), phi_i.cos(), 0.0);
-                    if dir.dot(plane_n).abs() > 1e-6 {
-                        continue;
-                    }
-                    // Signed in-plane angle: positive towards the mirror side.
-                    let along = -(dir.x * phi_i.cos() + dir.y * phi_i.sin());
-                    let a = along.atan2(dir.z);
-                    let w = bv_core::mean_rgb(dl.weight);
-                    let tip = [outer * w * a.sin(), outer * w * a.cos()];
-                    pui.arrows(
-                        egui_plot::Arrows::new(
-                            format!("{} δ", b.label),
-                            PlotPoints::from(vec![[0.0, 0.0]]),
-                            PlotPoints::from(vec![tip]),
-                        )
-                        .color(b.color()),
-                    );
-                    pui.text(
-                        Text::new(
-                            "",
-                            PlotPoint::new(tip[0] * 1.05, tip[1] * 1.05),
-                            RichText::new(format!("δ {w:.3}")).size(11.0),
-                        )
-                        .color(b.color())
-                        .allow_hover(false),
-                    );
-                }
+            // Delta lobes in the plane, as labelled spikes.
+            for s in delta_spikes(scene, outer) {
+                pui.arrows(
+                    egui_plot::Arrows::new(
+                        format!("{} δ", s.label),
+                        PlotPoints::from(vec![[0.0, 0.0]]),
+                        PlotPoints::from(vec![s.tip]),
+                    )
+                    .color(s.color),
+                );
+                pui.text(
+                    Text::new(
+                        "",
+                        PlotPoint::new(s.tip[0] * 1.08, s.tip[1] * 1.08),
+                        RichText::new(format!("δ {:.3}", s.weight)).size(11.0),
+                    )
+                    .color(s.color)
+                    .allow_hover(false),
+                );
             }
             pui.pointer_coordinate()
         });
@@ -617,6 +604,53 @@ fn polar_point(r: f64, a: f64) -> [f64; 2] {
     [r * a.sin(), r * a.cos()]
 }
 
+/// Shortest δ spike, as a fraction of the outer ring. A spike's length is
+/// its flux weight, and a small one (glass's F = 0.04 at normal incidence)
+/// would be a dot hidden under the origin's labels; its label gives the true
+/// weight (LECTURE.md, N3).
+pub const MIN_SPIKE: f64 = 0.25;
+
+/// A delta lobe in the plane of incidence, as the polar plot draws it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spike {
+    /// The BRDF's label.
+    pub label: String,
+    /// Its colour.
+    pub color: Color32,
+    /// The tip, in plot units (the origin is the hit point, +y the normal).
+    pub tip: [f64; 2],
+    /// The lobe's flux weight (mean of r, g, b): what its label reads.
+    pub weight: f64,
+}
+
+/// The δ lobes of the scene's BRDFs that lie in the plane of incidence: each
+/// reaches its weight of `outer`, and at least [`MIN_SPIKE`] of it.
+pub fn delta_spikes(scene: &Scene<'_>, outer: f64) -> Vec<Spike> {
+    let phi_i = scene.incident.phi_deg.to_radians();
+    let plane_n = glam::DVec3::new(-phi_i.sin(), phi_i.cos(), 0.0);
+    let mut out = Vec::new();
+    for b in &scene.brdfs {
+        for dl in b.brdf.deltas(scene.wi()) {
+            let dir = dl.direction;
+            if dir.dot(plane_n).abs() > 1e-6 {
+                continue;
+            }
+            // Signed in-plane angle: positive towards the mirror side.
+            let along = -(dir.x * phi_i.cos() + dir.y * phi_i.sin());
+            let a = along.atan2(dir.z);
+            let weight = bv_core::mean_rgb(dl.weight);
+            let len = outer * weight.max(MIN_SPIKE);
+            out.push(Spike {
+                label: b.label.clone(),
+                color: b.color(),
+                tip: [len * a.sin(), len * a.cos()],
+                weight,
+            });
+        }
+    }
+    out
+}
+
 /// The interface overlay of a transmitting model (issue 33): Snell's window
 /// shaded and bounded by the critical angle on the denser side, the
 /// refracted direction ωt with θt, or "TIR" when the light is beyond the
@@ -748,7 +782,6 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
     let (curves, outer) = polar_curves(scene);
     let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
     let theta_i = scene.incident.theta_deg.to_radians();
-    let phi_i = scene.incident.phi_deg.to_radians();
     let [w, h] = [size[0].max(120.0), size[1].max(90.0)];
     let mut svg = Svg::new(w, h);
     if let Some(bg) = pal.background {
@@ -881,28 +914,17 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
             dash: None,
         });
     }
-    for b in &scene.brdfs {
-        for dl in b.brdf.deltas(scene.wi()) {
-            let dir = dl.direction;
-            let plane_n = glam::DVec3::new(-phi_i.sin(), phi_i.cos(), 0.0);
-            if dir.dot(plane_n).abs() > 1e-6 {
-                continue;
-            }
-            let along = -(dir.x * phi_i.cos() + dir.y * phi_i.sin());
-            let a = along.atan2(dir.z);
-            let wgt = bv_core::mean_rgb(dl.weight);
-            let tip = [outer * wgt * a.sin(), outer * wgt * a.cos()];
-            svg.line(at([0.0, 0.0]), at(tip), b.color(), 2.0, None);
-            svg.text(
-                at([tip[0] * 1.05, tip[1] * 1.05]),
-                &format!("δ {wgt:.3}"),
-                10.5,
-                b.color(),
-                Anchor::Middle,
-                Baseline::Middle,
-                None,
-            );
-        }
+    for s in delta_spikes(scene, outer) {
+        svg.line(at([0.0, 0.0]), at(s.tip), s.color, 2.0, None);
+        svg.text(
+            at([s.tip[0] * 1.08, s.tip[1] * 1.08]),
+            &format!("δ {:.3}", s.weight),
+            10.5,
+            s.color,
+            Anchor::Middle,
+            Baseline::Middle,
+            None,
+        );
     }
     svg.text(
         [10.0, h - 8.0],
