@@ -471,6 +471,10 @@ impl Viewer {
     /// asked for.
     pub fn ui(&mut self, ui: &mut Ui) {
         let ctx = ui.ctx().clone();
+        // Every context that shows the viewer (eframe's window, the web
+        // page, a test harness) gets the glyphs of the lecture's notation;
+        // a no-op once the font is there.
+        crate::views::fonts::install(&ctx);
         // Keys typed in a frame that began with a widget owning the keyboard
         // are that widget's, even if it lets go during the frame (Enter).
         // A file dialog owns the keyboard too: its name field may not have

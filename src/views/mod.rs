@@ -18,6 +18,7 @@ pub mod curves;
 pub mod environment;
 pub mod factor;
 pub mod factor_overlay;
+pub mod fonts;
 pub mod fresnel;
 pub mod gpu_image;
 pub mod image_slice;
@@ -342,6 +343,7 @@ pub fn decade_label(k: i32) -> String {
 /// find egui's render state through the context install it here), for
 /// eframe's window and for offscreen figures alike.
 pub fn install_context(ctx: &egui::Context, render_state: &eframe::egui_wgpu::RenderState) {
+    fonts::install(ctx);
     gpu_image::install(ctx, render_state);
 }
 
