@@ -287,3 +287,61 @@ fn snapshot_presentation_mode() {
             .max_failed_pixels(400),
     );
 }
+
+/// The rotated texts (the plots' y-axis labels) of the last frame whose
+/// glyphs reach outside their clip rect, with by how much (points).
+fn cut_rotated_text(h: &Harness<'_, Viewer>) -> Vec<(String, f32)> {
+    let mut out = Vec::new();
+    for c in &h.output().shapes {
+        let egui::Shape::Text(t) = &c.shape else {
+            continue;
+        };
+        if t.angle == 0.0 {
+            continue;
+        }
+        let glyphs = t
+            .galley
+            .mesh_bounds
+            .rotate_bb(egui::emath::Rot2::from_angle(t.angle))
+            .translate(t.pos.to_vec2());
+        let over = (c.clip_rect.min.x - glyphs.min.x)
+            .max(c.clip_rect.min.y - glyphs.min.y)
+            .max(glyphs.max.x - c.clip_rect.max.x)
+            .max(glyphs.max.y - c.clip_rect.max.y);
+        if over > 0.01 {
+            out.push((t.galley.job.text.clone(), over));
+        }
+    }
+    out
+}
+
+#[test]
+fn rotated_axis_labels_are_drawn_whole() {
+    // "F (reflectance)" read "⊢ (retlectance)": the tops of the glyphs of
+    // the y label were outside the presented view's clip rect.
+    let mut s = state("cook-torrance", 45.0);
+    s.add(ModelSpec::new("lambert").unwrap());
+    let mut h = viewer_sized(s, [1920.0, 1080.0]);
+    for presenting in [false, true] {
+        if presenting {
+            press(&mut h, egui::Key::F5);
+        }
+        for view in ["fresnel", "albedo", "cartesian", "terms"] {
+            h.state_mut()
+                .push(bv::session::Command::Maximise(Some(view.into())));
+            h.run();
+            let labels = h
+                .output()
+                .shapes
+                .iter()
+                .filter(|c| matches!(&c.shape, egui::Shape::Text(t) if t.angle != 0.0))
+                .count();
+            assert!(labels > 0, "{view}: no rotated label drawn");
+            let cut = cut_rotated_text(&h);
+            assert!(
+                cut.is_empty(),
+                "{view} (presenting: {presenting}): rotated text cut by its clip rect: {cut:?}"
+            );
+        }
+    }
+}

@@ -948,7 +948,9 @@ fn central_presenting(
         );
     });
     ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {
-        ui.set_clip_rect(rect.intersect(ui.clip_rect()));
+        // Room on the left for a plot's rotated y label (the panel's margin).
+        let clip = rect.with_min_x(rect.min.x - crate::views::y_label_overhang(ui));
+        ui.set_clip_rect(clip.intersect(ui.clip_rect()));
         crate::views::show(view.as_mut(), ui, scene, out);
     });
 }

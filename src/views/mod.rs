@@ -311,6 +311,16 @@ pub fn with_legend(
     }
 }
 
+/// How far (points) a plot's y-axis label may reach left of the rect the
+/// plot is laid out in: egui_plot (0.38) draws the label rotated, starting a
+/// quarter of a text row (its `AXIS_LABEL_GAP`) outside the plot, so a clip
+/// rect at the view's edge cuts off the tops of its glyphs ("F
+/// (reflectance)" read "⊢ (retlectance)"). Whoever clips a view leaves this
+/// much room on its left (the grid's frames have it in their margin).
+pub fn y_label_overhang(ui: &Ui) -> f32 {
+    0.25 * ui.text_style_height(&egui::TextStyle::Body) + 1.0
+}
+
 /// A faint colour for grids.
 pub fn grid_color(dark: bool) -> Color32 {
     if dark {
