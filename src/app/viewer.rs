@@ -527,6 +527,7 @@ impl Viewer {
             let views = &mut self.views;
             if self.present.on {
                 scene.line_scale = crate::session::presentation::LINE_SCALE;
+                scene.presenting = true;
                 panel.show(ui, |ui| {
                     central_presenting(ui, views, &scene, &mut out);
                 });

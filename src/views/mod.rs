@@ -321,6 +321,66 @@ pub fn y_label_overhang(ui: &Ui) -> f32 {
     0.25 * ui.text_style_height(&egui::TextStyle::Body) + 1.0
 }
 
+/// Length (points) of the line sample in front of a [`side_legend`] label.
+const LEGEND_SAMPLE: f32 = 26.0;
+
+/// The width (points) a [`side_legend`] of `series` takes: the line sample
+/// and the widest label at body size.
+pub fn side_legend_width(ui: &Ui, series: &[chart::Series]) -> f32 {
+    let font = egui::TextStyle::Body.resolve(ui.style());
+    let widest = series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .map(|s| {
+            ui.painter()
+                .layout_no_wrap(s.label.clone(), font.clone(), Color32::WHITE)
+                .size()
+                .x
+        })
+        .fold(0.0, f32::max);
+    LEGEND_SAMPLE + 3.0 * ui.spacing().item_spacing.x + widest
+}
+
+/// A legend drawn beside a plot rather than over it (presentation mode,
+/// where the plots are short and egui_plot's legend either covered the
+/// curves or was left out): per labelled series a sample of its line, in
+/// its colour, width and dash, and its label in the text colour (legible
+/// on the ground whatever the curve's colour).
+pub fn side_legend(ui: &mut Ui, series: &[chart::Series], scene: &Scene<'_>) {
+    let text = strong_text(ui);
+    for s in series.iter().filter(|s| !s.label.is_empty()) {
+        ui.horizontal(|ui| {
+            let h = ui.text_style_height(&egui::TextStyle::Body);
+            let (rect, _) =
+                ui.allocate_exact_size(egui::vec2(LEGEND_SAMPLE, h), egui::Sense::hover());
+            let y = rect.center().y;
+            let ends = [egui::pos2(rect.left(), y), egui::pos2(rect.right(), y)];
+            let stroke = egui::Stroke::new(scene.stroke(s.width), s.color);
+            match s.dash {
+                Some(d) => {
+                    ui.painter()
+                        .extend(egui::Shape::dashed_line(&ends, stroke, d, d * 0.8));
+                }
+                None => {
+                    ui.painter().line_segment(ends, stroke);
+                }
+            }
+            ui.add(egui::Label::new(egui::RichText::new(&s.label).color(text)).extend());
+        });
+    }
+}
+
+/// `plot` without its hover readout and crosshair when presenting: the
+/// presenter's pointer rests on the slide, and a crosshair with coordinates
+/// where it happens to be would be read as part of the figure.
+pub fn calm_hover<'a>(plot: egui_plot::Plot<'a>, scene: &Scene<'_>) -> egui_plot::Plot<'a> {
+    if scene.presenting {
+        plot.show_x(false).show_y(false).show_crosshair(false)
+    } else {
+        plot
+    }
+}
+
 /// A faint colour for grids.
 pub fn grid_color(dark: bool) -> Color32 {
     if dark {

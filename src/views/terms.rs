@@ -471,6 +471,7 @@ mod tests {
             figure: true,
             transparent: false,
             line_scale: 1.0,
+            presenting: false,
         };
         let c = term_charts(&scene, TermToggles::default(), true);
         assert_eq!(c.lines.len(), 2);
