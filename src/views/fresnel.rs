@@ -592,6 +592,11 @@ impl View for FresnelView {
             .include_y(1.05)
             .allow_scroll(false)
             .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        let plot = if scene.presenting {
+            super::presented_axes(plot, c)
+        } else {
+            plot
+        };
         let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             for (k, m) in c.vlines.iter().enumerate() {
                 let mut v = VLine::new("", m.at)
@@ -628,7 +633,7 @@ impl View for FresnelView {
                 let r = plot.show(ui, draw);
                 ui.vertical(|ui| {
                     ui.add_space(4.0);
-                    super::side_legend(ui, &c.series, scene);
+                    super::side_legend(ui, &c.series, scene, legend_w);
                 });
                 r
             })

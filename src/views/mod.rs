@@ -346,10 +346,13 @@ pub fn side_legend_width(ui: &Ui, series: &[chart::Series]) -> f32 {
 /// curves or was left out): per labelled series a sample of its line, in
 /// its colour, width and dash, and its label in the text colour (legible
 /// on the ground whatever the curve's colour).
-pub fn side_legend(ui: &mut Ui, series: &[chart::Series], scene: &Scene<'_>) {
+/// `width` is the column's (from [`side_legend_width`], or less: a longer
+/// label wraps).
+pub fn side_legend(ui: &mut Ui, series: &[chart::Series], scene: &Scene<'_>, width: f32) {
     let text = strong_text(ui);
+    ui.set_max_width(width);
     for s in series.iter().filter(|s| !s.label.is_empty()) {
-        ui.horizontal(|ui| {
+        ui.horizontal_top(|ui| {
             let h = ui.text_style_height(&egui::TextStyle::Body);
             let (rect, _) =
                 ui.allocate_exact_size(egui::vec2(LEGEND_SAMPLE, h), egui::Sense::hover());
@@ -365,7 +368,7 @@ pub fn side_legend(ui: &mut Ui, series: &[chart::Series], scene: &Scene<'_>) {
                     ui.painter().line_segment(ends, stroke);
                 }
             }
-            ui.add(egui::Label::new(egui::RichText::new(&s.label).color(text)).extend());
+            ui.add(egui::Label::new(egui::RichText::new(&s.label).color(text)).wrap());
         });
     }
 }
@@ -379,6 +382,84 @@ pub fn calm_hover<'a>(plot: egui_plot::Plot<'a>, scene: &Scene<'_>) -> egui_plot
     } else {
         plot
     }
+}
+
+/// egui_plot's smallest grid spacing in points (`Plot::grid_spacing`'s
+/// default minimum): its `GridInput::base_step_size` is this many points in
+/// data units.
+const PLOT_MIN_GRID_POINTS: f64 = 8.0;
+
+/// Grid marks at `ticks` inside `bounds`, thinned to ones at least `gap`
+/// points apart (the first and the last tick kept), each with a step size
+/// spanning the whole axis. egui_plot fades a label whose step is closer
+/// than its label spacing (60–80 points on x, 20–30 on y) and drops it below
+/// that: presenting, that left the Fresnel plot's 15° ticks in a dim grey
+/// and the term view's short plots with a lone "0" on their y axes. With
+/// the whole span as step every kept label is drawn at full strength; the
+/// thinning keeps them apart.
+pub fn presented_marks(
+    ticks: &[f64],
+    bounds: (f64, f64),
+    base_step: f64,
+    gap: f64,
+) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = (bounds.0.min(bounds.1), bounds.0.max(bounds.1));
+    if !(lo.is_finite() && hi.is_finite() && base_step.is_finite()) || base_step <= 0.0 {
+        return Vec::new();
+    }
+    let gap_units = gap * base_step / PLOT_MIN_GRID_POINTS;
+    let inside: Vec<f64> = ticks
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite() && (lo..=hi).contains(t))
+        .collect();
+    let mut kept: Vec<f64> = Vec::new();
+    for &t in &inside {
+        if kept.last().is_none_or(|&k| t - k >= gap_units) {
+            kept.push(t);
+        }
+    }
+    // The top tick too (what a short axis reads its scale by), in place of
+    // a kept one too close to it.
+    if let (Some(&last), Some(&top)) = (kept.last(), inside.last())
+        && top != last
+    {
+        if top - last < gap_units && kept.len() > 1 {
+            kept.pop();
+        }
+        if kept.last().is_none_or(|&k| top - k >= gap_units) {
+            kept.push(top);
+        }
+    }
+    let step = (hi - lo).max(1e-12) * 10.0;
+    kept.into_iter()
+        .map(|value| egui_plot::GridMark {
+            value,
+            step_size: step,
+        })
+        .collect()
+}
+
+/// `plot` with its axes marked at `chart`'s ticks, labelled as the chart
+/// labels them and all at full strength (see [`presented_marks`]): the
+/// axes of a presented plot.
+pub fn presented_axes<'a>(plot: egui_plot::Plot<'a>, chart: &chart::Chart) -> egui_plot::Plot<'a> {
+    fn label_of(ticks: &[(f64, String)], value: f64) -> String {
+        ticks
+            .iter()
+            .find(|(t, _)| (t - value).abs() <= 1e-9 * t.abs().max(1.0))
+            .map(|(_, l)| l.clone())
+            .unwrap_or_default()
+    }
+    let (xs, ys) = (chart.x_ticks.clone(), chart.y_ticks.clone());
+    let (xv, yv): (Vec<f64>, Vec<f64>) = (
+        xs.iter().map(|t| t.0).collect(),
+        ys.iter().map(|t| t.0).collect(),
+    );
+    plot.x_grid_spacer(move |input| presented_marks(&xv, input.bounds, input.base_step_size, 36.0))
+        .y_grid_spacer(move |input| presented_marks(&yv, input.bounds, input.base_step_size, 24.0))
+        .x_axis_formatter(move |mark, _| label_of(&xs, mark.value))
+        .y_axis_formatter(move |mark, _| label_of(&ys, mark.value))
 }
 
 /// A faint colour for grids.
