@@ -309,20 +309,20 @@ fn legend_corner(c: &Chart) -> Corner {
     }
 }
 
-/// Draws a chart with egui_plot into `width` × `height` points; presenting,
-/// its legend is a column `legend_w` wide (of the `width`) beside it (over a plot that short it
-/// covered the curves).
+/// Draws a chart with egui_plot into `size` points; presenting, its legend
+/// is a column `legend_w` wide (of the width) beside it (over a plot that
+/// short it covered the curves).
 fn plot_chart(
     ui: &mut Ui,
     id: egui::Id,
     c: &Chart,
-    height: f32,
+    size: egui::Vec2,
     log_y: bool,
     scene: &Scene<'_>,
-    width: f32,
     legend_w: f32,
 ) {
-    let width = (width - legend_w).max(50.0);
+    let height = size.y;
+    let width = (size.x - legend_w).max(50.0);
     let plot = Plot::new(id).width(width).height(height.max(40.0));
     let plot = if scene.presenting {
         super::calm_hover(plot, scene)
@@ -452,7 +452,7 @@ impl View for TermsView {
                     self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
                 // The scale is part of the id: each keeps its own zoom.
                 let id = super::view_id(crate::session::views::TERMS.id).with((k, log_y));
-                plot_chart(ui, id, c, height, log_y, scene, width, legend_w);
+                plot_chart(ui, id, c, egui::vec2(width, height), log_y, scene, legend_w);
             }
         }
         self.last = Some(charts);
