@@ -345,3 +345,230 @@ fn rotated_axis_labels_are_drawn_whole() {
         }
     }
 }
+
+/// A text shape of the last frame: its text, where its glyphs are, its
+/// size in pixels and its colour (as drawn, premultiplied).
+struct Drawn {
+    text: String,
+    rect: egui::Rect,
+    px: f32,
+    color: egui::Color32,
+}
+
+/// The text shapes of the last frame inside `area`.
+fn drawn_in(h: &Harness<'_, Viewer>, area: egui::Rect) -> Vec<Drawn> {
+    fn walk(s: &egui::Shape, ppp: f32, area: egui::Rect, out: &mut Vec<Drawn>) {
+        match s {
+            egui::Shape::Text(t) if area.contains(t.pos) => {
+                let Some(sec) = t.galley.job.sections.first() else {
+                    return;
+                };
+                let color = t.override_text_color.unwrap_or(
+                    if sec.format.color == egui::Color32::PLACEHOLDER {
+                        t.fallback_color
+                    } else {
+                        sec.format.color
+                    },
+                );
+                out.push(Drawn {
+                    text: t.galley.job.text.clone(),
+                    rect: t.visual_bounding_rect(),
+                    px: sec.format.font_id.size * ppp,
+                    color: color.gamma_multiply(t.opacity_factor),
+                });
+            }
+            egui::Shape::Vec(v) => v.iter().for_each(|s| walk(s, ppp, area, out)),
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    let ppp = h.ctx.pixels_per_point();
+    for c in &h.output().shapes {
+        walk(&c.shape, ppp, area, &mut out);
+    }
+    out
+}
+
+/// WCAG 2 contrast ratio of an (opaque, or premultiplied over `ground`)
+/// colour against `ground`.
+fn contrast(fg: egui::Color32, ground: egui::Color32) -> f32 {
+    let lum = |c: [f32; 3]| {
+        let lin = |v: f32| {
+            if v <= 0.04045 {
+                v / 12.92
+            } else {
+                ((v + 0.055) / 1.055).powf(2.4)
+            }
+        };
+        0.2126 * lin(c[0]) + 0.7152 * lin(c[1]) + 0.0722 * lin(c[2])
+    };
+    let a = f32::from(fg.a()) / 255.0;
+    let over = |f: u8, g: u8| (f32::from(f) + f32::from(g) * (1.0 - a)) / 255.0;
+    let f = lum([
+        over(fg.r(), ground.r()),
+        over(fg.g(), ground.g()),
+        over(fg.b(), ground.b()),
+    ]);
+    let g = lum([
+        f32::from(ground.r()) / 255.0,
+        f32::from(ground.g()) / 255.0,
+        f32::from(ground.b()) / 255.0,
+    ]);
+    (f.max(g) + 0.05) / (f.min(g) + 0.05)
+}
+
+/// Shows `view` of `s` presented in a 1080p window.
+fn presented(s: AppState, view: &str) -> Harness<'static, Viewer> {
+    let mut h = viewer_sized(s, [1920.0, 1080.0]);
+    press(&mut h, egui::Key::F5);
+    h.state_mut()
+        .push(bv::session::Command::Maximise(Some(view.into())));
+    h.run();
+    h
+}
+
+/// Every text of `drawn` is at least 20 pixels tall in its capitals (0.7
+/// em) and of AA contrast (4.5:1) against `ground`.
+fn assert_legible(view: &str, drawn: &[Drawn], ground: egui::Color32) {
+    for d in drawn.iter().filter(|d| !d.text.trim().is_empty()) {
+        assert!(
+            0.7 * d.px >= 20.0,
+            "{view}: {:?} at {} pixels",
+            d.text,
+            d.px
+        );
+        let c = contrast(d.color, ground);
+        assert!(c >= 4.5, "{view}: {:?} of contrast {c:.2}", d.text);
+    }
+}
+
+#[test]
+fn presented_fresnel_view_keeps_its_legend_and_formulas_beside_the_curves() {
+    let h = presented(state("glass", 45.0), "fresnel");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "fresnel").expect("drawn");
+    let drawn = drawn_in(&h, rect);
+    let texts: Vec<&str> = drawn.iter().map(|d| d.text.as_str()).collect();
+    let legend = [
+        "Rp = rp² (p-polarised)",
+        "Rs = rs² (s-polarised)",
+        "F = (Rp + Rs)/2, η = 1.5",
+        "F from inside (η = 0.6667)",
+        "Schlick, same F0 = 0.040",
+    ];
+    for t in legend.iter().chain(&[
+        "F0 = ((η − 1)/(η + 1))² = 0.0400",
+        "η = (1 + √F0)/(1 − √F0) = 1.5000",
+    ]) {
+        assert!(texts.contains(t), "{t:?} not drawn: {texts:?}");
+    }
+    // The legend lies right of the plot (of its 90° tick), over no curve.
+    let right_of_plot = drawn
+        .iter()
+        .filter(|d| d.text.starts_with("90"))
+        .map(|d| d.rect.right())
+        .fold(f32::NEG_INFINITY, f32::max);
+    assert!(right_of_plot.is_finite(), "no 90° tick: {texts:?}");
+    for d in drawn.iter().filter(|d| legend.contains(&d.text.as_str())) {
+        assert!(
+            d.rect.left() > right_of_plot,
+            "{:?} at {:?}, the plot ends at {right_of_plot}",
+            d.text,
+            d.rect
+        );
+    }
+    assert_legible("fresnel", &drawn, egui::Color32::BLACK);
+}
+
+#[test]
+fn presented_term_view_labels_its_y_axes_and_keeps_its_legends_beside_them() {
+    let h = presented(state("cook-torrance", 45.0), "terms");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "terms").expect("drawn");
+    let drawn = drawn_in(&h, rect);
+    let texts: Vec<&str> = drawn.iter().map(|d| d.text.as_str()).collect();
+    // Each of the three plots has a y tick other than 0 (at the left of
+    // the view, where the y axes are), drawn at full strength.
+    let y_ticks: Vec<&Drawn> = drawn
+        .iter()
+        .filter(|d| d.rect.right() < rect.left() + 60.0)
+        .filter(|d| d.text.parse::<f64>().is_ok_and(|v| v != 0.0))
+        .collect();
+    assert!(
+        y_ticks.len() >= 3,
+        "y ticks besides 0: {:?}",
+        y_ticks.iter().map(|d| &d.text).collect::<Vec<_>>()
+    );
+    for t in [
+        "Cook-Torrance: D Beckmann",
+        "Cook-Torrance: G1(ωo)",
+        "Cook-Torrance: F dielectric",
+    ] {
+        assert!(texts.contains(&t), "{t:?} not drawn: {texts:?}");
+    }
+    // The legends lie right of the plots' 90° ticks.
+    let right_of_plots = drawn
+        .iter()
+        .filter(|d| d.text.starts_with("90"))
+        .map(|d| d.rect.right())
+        .fold(f32::NEG_INFINITY, f32::max);
+    // (The view's note above the plots names the terms with " = ".)
+    for d in drawn
+        .iter()
+        .filter(|d| d.text.starts_with("Cook-Torrance: ") && !d.text.contains(" = "))
+    {
+        assert!(
+            d.rect.left() > right_of_plots,
+            "{:?} at {:?} over the plots (to {right_of_plots})",
+            d.text,
+            d.rect
+        );
+    }
+    assert_legible("terms", &drawn, egui::Color32::BLACK);
+}
+
+#[test]
+fn presented_snell_view_has_full_size_opaque_annotations() {
+    let mut s = state("glass", 50.0);
+    s.plots.snell.from_below = true;
+    let h = presented(s, "snell");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "snell").expect("drawn");
+    let drawn = drawn_in(&h, rect);
+    let texts: Vec<&str> = drawn.iter().map(|d| d.text.as_str()).collect();
+    for t in ["T = 0: totally reflected", "critical angle θc = 41.8°"] {
+        assert!(texts.contains(&t), "{t:?} not drawn: {texts:?}");
+    }
+    assert!(drawn.len() >= 10, "{texts:?}");
+    // The medium below is tinted: the lighter of the two grounds.
+    assert_legible("snell", &drawn, egui::Color32::from_rgb(12, 25, 39));
+}
+
+#[test]
+fn presented_sampling_view_footer_is_drawn_whole() {
+    let mut h = presented(state("cook-torrance", 45.0), "sampling");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "sampling").expect("drawn");
+    // The histogram is drawn in the background.
+    let mut tries = 0;
+    while !drawn_in(&h, rect)
+        .iter()
+        .any(|d| d.text.starts_with("∫ pdf dω"))
+    {
+        tries += 1;
+        assert!(tries < 200, "the histogram never arrived");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run();
+    }
+    let drawn = drawn_in(&h, rect);
+    for d in &drawn {
+        assert!(
+            rect.contains_rect(d.rect),
+            "{:?} at {:?} leaves the view {rect:?}",
+            d.text,
+            d.rect
+        );
+    }
+    let footer = drawn
+        .iter()
+        .find(|d| d.text.starts_with("∫ pdf dω"))
+        .unwrap();
+    assert!(footer.text.ends_with("ring: its mirror direction"));
+    assert_legible("sampling", &drawn, egui::Color32::BLACK);
+}
