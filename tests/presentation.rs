@@ -572,3 +572,56 @@ fn presented_sampling_view_footer_is_drawn_whole() {
     assert!(footer.text.ends_with("ring: its mirror direction"));
     assert_legible("sampling", &drawn, egui::Color32::BLACK);
 }
+
+#[test]
+fn snapshot_presented_views_with_their_legends() {
+    // One set of results for the four harnesses (kittest's rule for
+    // several harnesses in one test).
+    let mut results = egui_kittest::SnapshotResults::new();
+    let mut glass = state("glass", 50.0);
+    glass.plots.snell.from_below = true;
+    for (view, s, label) in [
+        ("fresnel", state("glass", 45.0), "Schlick, same F0 = 0.040"),
+        (
+            "terms",
+            state("cook-torrance", 45.0),
+            "Cook-Torrance: F dielectric",
+        ),
+        ("snell", glass, "T = 0: totally reflected"),
+        ("sampling", state("cook-torrance", 45.0), "draws per bin"),
+    ] {
+        // A render state serves one harness.
+        let rs = egui_kittest::wgpu::create_render_state(
+            egui_kittest::wgpu::default_wgpu_setup(),
+            eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+        );
+        bv::views::lobe_gpu::install(&rs);
+        let mut h = Harness::builder()
+            .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(rs))
+            // 1080p's layout at half the pixels (the same points).
+            .with_size([960.0, 540.0])
+            .with_max_steps(12)
+            .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(s));
+        h.run();
+        press(&mut h, egui::Key::F5);
+        h.state_mut()
+            .push(bv::session::Command::Maximise(Some(view.into())));
+        h.run();
+        let rect = bv::app::viewer::view_rect(&h.ctx, view).expect("drawn");
+        let mut tries = 0;
+        while !drawn_in(&h, rect).iter().any(|d| d.text == label) {
+            tries += 1;
+            assert!(tries < 200, "{view}: {label:?} never drawn");
+            std::thread::sleep(std::time::Duration::from_millis(50));
+            h.run();
+        }
+        h.snapshot_options(
+            &format!("presentation_{view}"),
+            &egui_kittest::SnapshotOptions::new()
+                .threshold(2.0)
+                .max_failed_pixels(400),
+        );
+        results.extend_harness(&mut h);
+    }
+    results.unwrap();
+}
