@@ -616,7 +616,7 @@ fn snapshot_presented_views_with_their_legends() {
             h.run();
         }
         h.snapshot_options(
-            &format!("presentation_{view}"),
+            format!("presentation_{view}"),
             &egui_kittest::SnapshotOptions::new()
                 .threshold(2.0)
                 .max_failed_pixels(400),
