@@ -615,6 +615,9 @@ fn snapshot_presented_views_with_their_legends() {
             std::thread::sleep(std::time::Duration::from_millis(50));
             h.run();
         }
+        // egui_plot sizes its axes by the last frame's labels: a few more
+        // frames after the switch to the presentation font.
+        h.run_steps(3);
         h.snapshot_options(
             format!("presentation_{view}"),
             &egui_kittest::SnapshotOptions::new()

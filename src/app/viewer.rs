@@ -471,10 +471,6 @@ impl Viewer {
     /// asked for.
     pub fn ui(&mut self, ui: &mut Ui) {
         let ctx = ui.ctx().clone();
-        // Every context that shows the viewer (eframe's window, the web
-        // page, a test harness) gets the glyphs of the lecture's notation;
-        // a no-op once the font is there.
-        crate::views::fonts::install(&ctx);
         // Keys typed in a frame that began with a widget owning the keyboard
         // are that widget's, even if it lets go during the frame (Enter).
         // A file dialog owns the keyboard too: its name field may not have
@@ -496,6 +492,12 @@ impl Viewer {
                 );
             }
             ctx.set_theme(theme);
+            // Every context that shows the viewer (eframe's window, the web
+            // page, a test harness, a rendered slide) gets the glyphs of the
+            // lecture's notation, and presenting, the projector's typeface.
+            if self.applied_look.is_none_or(|(_, p)| p != self.present.on) {
+                crate::views::fonts::set_presenting(&ctx, self.present.on);
+            }
             self.applied_look = Some(look);
         }
         self.sync_zoom(&ctx);

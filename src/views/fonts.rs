@@ -36,6 +36,38 @@ pub fn install(ctx: &egui::Context) {
     ));
 }
 
+/// egui's fonts with DejaVu Sans: after them (their look, DejaVu only for
+/// the glyphs they lack) or, for `presenting`, first in proportional text.
+/// Projected, Ubuntu Light's ρ reads as a p ("ρhd" as "phd") and its thin
+/// strokes wash out; DejaVu Sans's ρ is unmistakable and its strokes
+/// heavier. The window keeps egui's look otherwise.
+pub fn definitions(presenting: bool) -> egui::FontDefinitions {
+    let mut defs = egui::FontDefinitions::default();
+    defs.font_data.insert(
+        FALLBACK_NAME.to_owned(),
+        std::sync::Arc::new(egui::FontData::from_static(DEJAVU_SANS)),
+    );
+    for (family, first) in [
+        (egui::FontFamily::Proportional, presenting),
+        (egui::FontFamily::Monospace, false),
+    ] {
+        let list = defs.families.entry(family).or_default();
+        if first {
+            list.insert(0, FALLBACK_NAME.to_owned());
+        } else {
+            list.push(FALLBACK_NAME.to_owned());
+        }
+    }
+    defs
+}
+
+/// Sets `ctx`'s fonts to [`definitions`]`(presenting)`. Compares the whole
+/// definitions with the current ones (font data included): call it when
+/// the mode changes, not every frame.
+pub fn set_presenting(ctx: &egui::Context, presenting: bool) {
+    ctx.set_fonts(definitions(presenting));
+}
+
 /// The characters of `text` that no font of `family` in `ctx` has a glyph
 /// for (what would be drawn as an empty box), each once, in order. White
 /// space and control characters are not drawn and not reported.
@@ -53,4 +85,31 @@ pub fn missing_glyphs(ctx: &egui::Context, family: &egui::FontFamily, text: &str
         }
     });
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dejavu_comes_first_only_when_presenting() {
+        let order = |presenting: bool, family: egui::FontFamily| {
+            definitions(presenting)
+                .families
+                .get(&family)
+                .cloned()
+                .unwrap_or_default()
+        };
+        let window = order(false, egui::FontFamily::Proportional);
+        assert_eq!(window.first().map(String::as_str), Some("Ubuntu-Light"));
+        assert_eq!(window.last().map(String::as_str), Some(FALLBACK_NAME));
+        // Presenting: its ρ (Ubuntu Light's reads as a p) and heavier strokes.
+        let presented = order(true, egui::FontFamily::Proportional);
+        assert_eq!(presented.first().map(String::as_str), Some(FALLBACK_NAME));
+        assert!(presented.iter().any(|f| f == "Ubuntu-Light"));
+        for presenting in [false, true] {
+            let mono = order(presenting, egui::FontFamily::Monospace);
+            assert_eq!(mono.last().map(String::as_str), Some(FALLBACK_NAME));
+        }
+    }
 }

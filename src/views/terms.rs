@@ -322,7 +322,12 @@ fn plot_chart(
     legend_w: f32,
 ) {
     let height = size.y;
-    let width = (size.x - legend_w).max(50.0);
+    let gap = if legend_w > 0.0 {
+        ui.spacing().item_spacing.x
+    } else {
+        0.0
+    };
+    let width = (size.x - legend_w - gap).max(50.0);
     let plot = Plot::new(id).width(width).height(height.max(40.0));
     let plot = if scene.presenting {
         super::calm_hover(plot, scene)
