@@ -628,3 +628,41 @@ fn snapshot_presented_views_with_their_legends() {
     }
     results.unwrap();
 }
+
+#[test]
+fn presented_albedo_legend_is_beside_the_plot() {
+    let mut s = state("modified-phong", 45.0);
+    s.add(ModelSpec::new("phong").unwrap());
+    let mut h = presented(s, "albedo");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "albedo").expect("drawn");
+    let legend = |h: &Harness<'_, Viewer>| -> Vec<Drawn> {
+        drawn_in(h, rect)
+            .into_iter()
+            .filter(|d| d.text.contains("ρhh"))
+            .collect()
+    };
+    // The curves are computed in the background.
+    let mut tries = 0;
+    while legend(&h).len() < 2 {
+        tries += 1;
+        assert!(tries < 200, "the albedo curves never arrived");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run();
+    }
+    let drawn = drawn_in(&h, rect);
+    let right_of_plot = drawn
+        .iter()
+        .filter(|d| d.text.starts_with("90"))
+        .map(|d| d.rect.right())
+        .fold(f32::NEG_INFINITY, f32::max);
+    assert!(right_of_plot.is_finite());
+    for d in legend(&h) {
+        assert!(
+            d.rect.left() > right_of_plot && rect.contains_rect(d.rect),
+            "{:?} at {:?}: over the plot (to {right_of_plot}) or outside the view",
+            d.text,
+            d.rect
+        );
+    }
+    assert_legible("albedo", &drawn, egui::Color32::BLACK);
+}
