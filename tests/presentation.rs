@@ -666,3 +666,44 @@ fn presented_albedo_legend_is_beside_the_plot() {
     }
     assert_legible("albedo", &drawn, egui::Color32::BLACK);
 }
+
+#[test]
+fn a_resting_pointer_draws_no_crosshair_or_readout_when_presenting() {
+    let mut s = state("cook-torrance", 45.0);
+    s.add(ModelSpec::new("lambert").unwrap());
+    let mut h = viewer_sized(s, [1920.0, 1080.0]);
+    press(&mut h, egui::Key::F5);
+    // What a view draws: its shapes other than text, and its texts.
+    let drawn = |h: &Harness<'_, Viewer>, rect: egui::Rect| {
+        let texts: Vec<String> = drawn_in(h, rect).into_iter().map(|d| d.text).collect();
+        let mut n = 0;
+        fn count(s: &egui::Shape, n: &mut usize) {
+            match s {
+                egui::Shape::Vec(v) => v.iter().for_each(|s| count(s, n)),
+                egui::Shape::Text(_) | egui::Shape::Noop => {}
+                _ => *n += 1,
+            }
+        }
+        for c in &h.output().shapes {
+            if rect.intersects(c.clip_rect) {
+                count(&c.shape, &mut n);
+            }
+        }
+        (n, texts)
+    };
+    for view in ["polar", "cartesian", "albedo", "fresnel", "terms"] {
+        h.state_mut()
+            .push(bv::session::Command::Maximise(Some(view.into())));
+        h.run();
+        let rect = bv::app::viewer::view_rect(&h.ctx, view).expect("drawn");
+        h.hover_at(egui::pos2(-10.0, -10.0));
+        h.run();
+        let away = drawn(&h, rect);
+        // On a curve's neighbourhood: the middle of the view, a little up.
+        for at in [rect.center(), rect.center() - egui::vec2(0.0, 40.0)] {
+            h.hover_at(at);
+            h.run();
+            assert_eq!(drawn(&h, rect), away, "{view}: the pointer at {at:?} drew");
+        }
+    }
+}

@@ -103,7 +103,12 @@ impl View for CartesianView {
         let axis = p.axis;
         let x_name = axis_name(axis);
 
-        let readout_h = if scene.figure { 0.0 } else { 22.0 };
+        // Presenting, no hover readout (nor its hint) below the plot.
+        let readout_h = if scene.figure || scene.presenting {
+            0.0
+        } else {
+            22.0
+        };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         // Presenting, the legend is a column beside the plot (a curve
         // rising to the right, GGX's tail, ran under it in the corner).
@@ -329,7 +334,7 @@ impl View for CartesianView {
                 });
             }
         }
-        if !scene.figure {
+        if !scene.figure && !scene.presenting {
             readout_ui(ui, self.readout.as_ref(), d.cosine);
         }
     }
