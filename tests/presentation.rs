@@ -430,7 +430,14 @@ fn presented(s: AppState, view: &str) -> Harness<'static, Viewer> {
 /// Every text of `drawn` is at least 20 pixels tall in its capitals (0.7
 /// em) and of AA contrast (4.5:1) against `ground`.
 fn assert_legible(view: &str, drawn: &[Drawn], ground: egui::Color32) {
-    for d in drawn.iter().filter(|d| !d.text.trim().is_empty()) {
+    let shown = drawn.iter().filter(|d| !d.text.trim().is_empty());
+    let smallest = shown.clone().map(|d| d.px).fold(f32::INFINITY, f32::min);
+    let weakest = shown
+        .clone()
+        .map(|d| contrast(d.color, ground))
+        .fold(f32::INFINITY, f32::min);
+    eprintln!("{view}: smallest text {smallest:.1} px, lowest contrast {weakest:.1}:1");
+    for d in shown {
         assert!(
             0.7 * d.px >= 20.0,
             "{view}: {:?} at {} pixels",
