@@ -569,7 +569,12 @@ impl View for FresnelView {
             0.0
         };
         // (The column sits one item spacing right of the plot.)
-        let plot_w = (size.x - legend_w - ui.spacing().item_spacing.x).max(50.0);
+        let gap = if scene.presenting {
+            ui.spacing().item_spacing.x
+        } else {
+            0.0
+        };
+        let plot_w = (size.x - legend_w - gap).max(50.0);
         let plot = Plot::new(super::view_id(crate::session::views::FRESNEL.id))
             .width(plot_w)
             .height(plot_h);
