@@ -492,6 +492,12 @@ impl Viewer {
                 );
             }
             ctx.set_theme(theme);
+            // Every context that shows the viewer (eframe's window, the web
+            // page, a test harness, a rendered slide) gets the glyphs of the
+            // lecture's notation, and presenting, the projector's typeface.
+            if self.applied_look.is_none_or(|(_, p)| p != self.present.on) {
+                crate::views::fonts::set_presenting(&ctx, self.present.on);
+            }
             self.applied_look = Some(look);
         }
         self.sync_zoom(&ctx);
@@ -523,6 +529,7 @@ impl Viewer {
             let views = &mut self.views;
             if self.present.on {
                 scene.line_scale = crate::session::presentation::LINE_SCALE;
+                scene.presenting = true;
                 panel.show(ui, |ui| {
                     central_presenting(ui, views, &scene, &mut out);
                 });
@@ -944,7 +951,9 @@ fn central_presenting(
         );
     });
     ui.scope_builder(UiBuilder::new().max_rect(rect).id_salt(entry.id), |ui| {
-        ui.set_clip_rect(rect.intersect(ui.clip_rect()));
+        // Room on the left for a plot's rotated y label (the panel's margin).
+        let clip = rect.with_min_x(rect.min.x - crate::views::y_label_overhang(ui));
+        ui.set_clip_rect(clip.intersect(ui.clip_rect()));
         crate::views::show(view.as_mut(), ui, scene, out);
     });
 }

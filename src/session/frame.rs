@@ -58,6 +58,11 @@ pub struct Scene<'a> {
     /// presentation mode, `presentation::LINE_SCALE`): read it through
     /// [`Scene::stroke`].
     pub line_scale: f32,
+    /// Shown in presentation mode (a projector, a rendered slide): views
+    /// keep every legend and formula (beside the plot where the plot is
+    /// short), draw text no smaller than the body size and leave out hover
+    /// hints.
+    pub presenting: bool,
 }
 
 impl Scene<'_> {
@@ -127,6 +132,7 @@ pub fn build_scene<'a>(state: &'a AppState, runtime: &Runtime, interacting: bool
         figure: false,
         transparent: false,
         line_scale: 1.0,
+        presenting: false,
     }
 }
 

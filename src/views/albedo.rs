@@ -238,29 +238,65 @@ impl View for AlbedoView {
         let top = y_top(&shown);
         let size = ui.available_size();
         let light = super::light_color(dark);
-        let plot = super::with_legend(
-            super::curves::with_linear_y(Plot::new(super::view_id(
-                crate::session::views::ALBEDO.id,
-            ))),
-            size,
-            shown.iter().map(|s| series_of(s).len()).sum(),
-            legend_corner(&shown, top, size),
-        )
-        .width(size.x.max(50.0))
-        .height(size.y.max(50.0))
-        .x_axis_label(X_LABEL)
-        .y_axis_label(Y_LABEL)
-        .y_axis_min_width(36.0)
-        .include_x(0.0)
-        .include_x(x_max(&shown))
-        .include_y(0.0)
-        .include_y(top)
-        .allow_scroll(false)
-        .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        // Presenting, the legend is a column beside the plot: its long
+        // lines (ρhh of each) covered a curve in every corner of a plot
+        // that short.
+        let legend: Vec<Series> = if scene.presenting {
+            shown
+                .iter()
+                .flat_map(|s| {
+                    let width = if s.brdf.selected { 2.5 } else { 1.8 };
+                    series_of(s)
+                        .into_iter()
+                        .map(move |(part, label, _)| Series {
+                            label,
+                            color: s.brdf.color(),
+                            points: Vec::new(),
+                            width,
+                            dash: part.dash(),
+                        })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let legend_w = if legend.is_empty() {
+            0.0
+        } else {
+            super::side_legend_width(ui, &legend).min(0.4 * size.x)
+        };
+        let plot_w = if legend.is_empty() {
+            size.x
+        } else {
+            size.x - legend_w - ui.spacing().item_spacing.x
+        };
+        let plot = Plot::new(super::view_id(crate::session::views::ALBEDO.id));
+        let plot = if scene.presenting {
+            super::calm_hover(plot, scene)
+        } else {
+            super::with_legend(
+                plot,
+                size,
+                shown.iter().map(|s| series_of(s).len()).sum(),
+                legend_corner(&shown, top, size),
+            )
+        };
+        let plot = super::curves::with_linear_y(plot)
+            .width(plot_w.max(50.0))
+            .height(size.y.max(50.0))
+            .x_axis_label(X_LABEL)
+            .y_axis_label(Y_LABEL)
+            .y_axis_min_width(36.0)
+            .include_x(0.0)
+            .include_x(x_max(&shown))
+            .include_y(0.0)
+            .include_y(top)
+            .allow_scroll(false)
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
         let theta_i = scene.incident.theta_deg;
         let surface = x_max(&shown) > 90.0;
         let surface_col = super::strong_text(ui).gamma_multiply(0.6);
-        plot.show(ui, |pui| {
+        let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             if surface {
                 // The surface: light from above on the left, from below on
                 // the right.
@@ -317,7 +353,18 @@ impl View for AlbedoView {
                     }
                 }
             }
-        });
+        };
+        if legend.is_empty() {
+            plot.show(ui, draw);
+        } else {
+            ui.horizontal_top(|ui| {
+                plot.show(ui, draw);
+                ui.vertical(|ui| {
+                    ui.add_space(4.0);
+                    super::side_legend(ui, &legend, scene, legend_w);
+                });
+            });
+        }
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

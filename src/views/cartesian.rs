@@ -103,50 +103,76 @@ impl View for CartesianView {
         let axis = p.axis;
         let x_name = axis_name(axis);
 
-        let readout_h = if scene.figure { 0.0 } else { 22.0 };
+        // Presenting, no hover readout (nor its hint) below the plot.
+        let readout_h = if scene.figure || scene.presenting {
+            0.0
+        } else {
+            22.0
+        };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
-        let mut plot = super::with_legend(
-            Plot::new(super::view_id(crate::session::views::CARTESIAN.id))
-                .width(size.x.max(50.0))
-                .height(size.y.max(50.0)),
-            size,
-            scene.brdfs.len(),
-            Corner::RightTop,
-        )
-        .x_axis_label(x_label)
-        .y_axis_label(y_label)
-        .y_axis_min_width(44.0)
-        // Angles read in steps a lecturer uses: 15°, 45°, 90°.
-        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
-            let span = input.bounds.1 - input.bounds.0;
-            if span > 200.0 {
-                [10.0, 30.0, 90.0]
-            } else if span > 50.0 {
-                [5.0, 15.0, 45.0]
-            } else {
-                [1.0, 5.0, 15.0]
-            }
-        }))
-        .allow_scroll(false)
-        .label_formatter(move |hover| match hover {
-            egui_plot::HoverPosition::NearDataPoint {
-                plot_name,
-                position,
-                ..
-            } if !plot_name.is_empty() => {
-                let v = if log {
-                    10f64.powf(position.y)
+        // Presenting, the legend is a column beside the plot (a curve
+        // rising to the right, GGX's tail, ran under it in the corner).
+        let legend: Vec<super::chart::Series> = if scene.presenting {
+            data.iter()
+                .map(|(b, _)| super::chart::Series {
+                    label: b.label.clone(),
+                    color: b.color(),
+                    points: Vec::new(),
+                    width: if b.selected { 2.5 } else { 1.8 },
+                    dash: None,
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let legend_w = if legend.is_empty() {
+            0.0
+        } else {
+            super::side_legend_width(ui, &legend).min(0.4 * size.x) + ui.spacing().item_spacing.x
+        };
+        let plot = Plot::new(super::view_id(crate::session::views::CARTESIAN.id))
+            .width((size.x - legend_w).max(50.0))
+            .height(size.y.max(50.0));
+        let plot = if scene.presenting {
+            super::calm_hover(plot, scene)
+        } else {
+            super::with_legend(plot, size, scene.brdfs.len(), Corner::RightTop)
+        };
+        let mut plot = plot
+            .x_axis_label(x_label)
+            .y_axis_label(y_label)
+            .y_axis_min_width(44.0)
+            // Angles read in steps a lecturer uses: 15°, 45°, 90°.
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+                let span = input.bounds.1 - input.bounds.0;
+                if span > 200.0 {
+                    [10.0, 30.0, 90.0]
+                } else if span > 50.0 {
+                    [5.0, 15.0, 45.0]
                 } else {
-                    position.y
-                };
-                Some(format!(
-                    "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
-                    position.x,
-                    curves::fmt_value(v)
-                ))
-            }
-            _ => None,
-        });
+                    [1.0, 5.0, 15.0]
+                }
+            }))
+            .allow_scroll(false)
+            .label_formatter(move |hover| match hover {
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
+                    let v = if log {
+                        10f64.powf(position.y)
+                    } else {
+                        position.y
+                    };
+                    Some(format!(
+                        "{plot_name}\n{x_name} = {:.1}°\n{value_name} = {} 1/sr",
+                        position.x,
+                        curves::fmt_value(v)
+                    ))
+                }
+                _ => None,
+            });
         if log {
             // The axis spans the decades the data reach (see
             // `curves::LogRange`): curves below it leave through the bottom
@@ -165,7 +191,7 @@ impl View for CartesianView {
         let light = super::light_color(dark);
         let mirror = super::mirror_color(dark);
         let wi = scene.wi();
-        let response = plot.show(ui, |pui| {
+        let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             if axis == CartesianAxis::ThetaO {
                 let li = slices::incident_signed_angle(theta_i).to_degrees();
                 pui.vline(
@@ -240,13 +266,28 @@ impl View for CartesianView {
                 );
             }
             pui.pointer_coordinate()
-        });
+        };
+        let response = if legend.is_empty() {
+            plot.show(ui, draw)
+        } else {
+            ui.horizontal_top(|ui| {
+                let r = plot.show(ui, draw);
+                ui.vertical(|ui| {
+                    ui.add_space(4.0);
+                    super::side_legend(ui, &legend, scene, legend_w);
+                });
+                r
+            })
+            .inner
+        };
 
         self.readout = None;
         self.plot_rect = Some(response.response.rect);
         let b = response.transform.bounds();
         self.y_bounds = Some((b.min()[1], b.max()[1]));
+        // No readout where a presenter's pointer happens to rest.
         if response.response.hovered()
+            && !scene.presenting
             && let Some(pc) = response.inner
         {
             let x = pc.x.to_radians();
@@ -293,7 +334,7 @@ impl View for CartesianView {
                 });
             }
         }
-        if !scene.figure {
+        if !scene.figure && !scene.presenting {
             readout_ui(ui, self.readout.as_ref(), d.cosine);
         }
     }

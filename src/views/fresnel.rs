@@ -509,8 +509,8 @@ pub struct FresnelView {
 }
 
 /// Paints the strip's rows between `x0` and `x1` (the plot's 0° and 90°)
-/// from `top`.
-fn paint_strip(ui: &Ui, rows: &[StripRow], x0: f32, x1: f32, top: f32) {
+/// from `top`, the rows' names in `label_pt` points.
+fn paint_strip(ui: &Ui, rows: &[StripRow], x0: f32, x1: f32, top: f32, label_pt: f32) {
     let painter = ui.painter();
     let text = ui.visuals().weak_text_color();
     for (r, row) in rows.iter().enumerate() {
@@ -529,7 +529,7 @@ fn paint_strip(ui: &Ui, rows: &[StripRow], x0: f32, x1: f32, top: f32) {
             egui::pos2(x0 - 4.0, y + STRIP_ROW * 0.5),
             egui::Align2::RIGHT_CENTER,
             &row.label,
-            egui::FontId::proportional(10.0),
+            egui::FontId::proportional(label_pt),
             text,
         );
     }
@@ -549,31 +549,61 @@ impl View for FresnelView {
             fig.strip.len() as f32 * (STRIP_ROW + 2.0) + 4.0
         };
         let size = ui.available_size();
-        // Small views (thumbnails) keep their height for the curves.
-        let readouts: &[String] = if size.y >= 260.0 { &fig.readouts } else { &[] };
+        // Small views (thumbnails) keep their height for the curves; a
+        // presented slide keeps the formulas (its plot is short at the
+        // presentation scale, but the formulas are what the slide is about).
+        let readouts: &[String] = if size.y >= 260.0 || scene.presenting {
+            &fig.readouts
+        } else {
+            &[]
+        };
         let readout_h = readouts.len() as f32
             * (ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y);
         let plot_h = (size.y - strip_h - readout_h).max(50.0);
-        let plot = super::with_legend(
-            super::curves::with_linear_y(
-                Plot::new(super::view_id(crate::session::views::FRESNEL.id))
-                    .width(size.x.max(50.0))
-                    .height(plot_h),
-            ),
-            egui::vec2(size.x, plot_h),
-            c.series.len(),
-            Corner::LeftTop,
-        )
-        .x_axis_label(c.x_label.clone())
-        .y_axis_label(c.y_label.clone())
-        .y_axis_min_width(36.0)
-        .include_x(0.0)
-        .include_x(90.0)
-        .include_y(0.0)
-        .include_y(1.05)
-        .allow_scroll(false)
-        .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
-        let response = plot.show(ui, |pui| {
+        // Presenting, the legend is a column beside the plot: over a plot
+        // that short it covered the curves (and was left out for lack of
+        // room).
+        let legend_w = if scene.presenting {
+            super::side_legend_width(ui, &c.series).min(0.45 * size.x)
+        } else {
+            0.0
+        };
+        // (The column sits one item spacing right of the plot.)
+        let gap = if scene.presenting {
+            ui.spacing().item_spacing.x
+        } else {
+            0.0
+        };
+        let plot_w = (size.x - legend_w - gap).max(50.0);
+        let plot = Plot::new(super::view_id(crate::session::views::FRESNEL.id))
+            .width(plot_w)
+            .height(plot_h);
+        let plot = if scene.presenting {
+            super::calm_hover(plot, scene)
+        } else {
+            super::with_legend(
+                plot,
+                egui::vec2(size.x, plot_h),
+                c.series.len(),
+                Corner::LeftTop,
+            )
+        };
+        let plot = super::curves::with_linear_y(plot)
+            .x_axis_label(c.x_label.clone())
+            .y_axis_label(c.y_label.clone())
+            .y_axis_min_width(36.0)
+            .include_x(0.0)
+            .include_x(90.0)
+            .include_y(0.0)
+            .include_y(1.05)
+            .allow_scroll(false)
+            .x_grid_spacer(egui_plot::uniform_grid_spacer(|_| [5.0, 15.0, 45.0]));
+        let plot = if scene.presenting {
+            super::presented_axes(plot, c)
+        } else {
+            plot
+        };
+        let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             for (k, m) in c.vlines.iter().enumerate() {
                 let mut v = VLine::new("", m.at)
                     .color(m.color)
@@ -603,7 +633,20 @@ impl View for FresnelView {
                 }
                 pui.line(l);
             }
-        });
+        };
+        let response = if scene.presenting {
+            ui.horizontal_top(|ui| {
+                let r = plot.show(ui, draw);
+                ui.vertical(|ui| {
+                    ui.add_space(4.0);
+                    super::side_legend(ui, &c.series, scene, legend_w);
+                });
+                r
+            })
+            .inner
+        } else {
+            plot.show(ui, draw)
+        };
         if !fig.strip.is_empty() {
             // Aligned with the plot's own 0° and 90°.
             let t = &response.transform;
@@ -615,7 +658,10 @@ impl View for FresnelView {
                 .x;
             let (rect, _) =
                 ui.allocate_exact_size(egui::vec2(size.x.max(50.0), strip_h), egui::Sense::hover());
-            paint_strip(ui, &fig.strip, x0, x1, rect.top() + 2.0);
+            // Presenting: no smaller than the other text of the slide
+            // (11 points, 20-pixel capitals at 1080p).
+            let label_pt = if scene.presenting { 11.0 } else { 10.0 };
+            paint_strip(ui, &fig.strip, x0, x1, rect.top() + 2.0, label_pt);
         }
         for line in readouts {
             ui.label(RichText::new(line).size(11.0));

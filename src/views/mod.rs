@@ -18,6 +18,7 @@ pub mod curves;
 pub mod environment;
 pub mod factor;
 pub mod factor_overlay;
+pub mod fonts;
 pub mod fresnel;
 pub mod gpu_image;
 pub mod image_slice;
@@ -310,6 +311,157 @@ pub fn with_legend(
     }
 }
 
+/// How far (points) a plot's y-axis label may reach left of the rect the
+/// plot is laid out in: egui_plot (0.38) draws the label rotated, starting a
+/// quarter of a text row (its `AXIS_LABEL_GAP`) outside the plot, so a clip
+/// rect at the view's edge cuts off the tops of its glyphs ("F
+/// (reflectance)" read "⊢ (retlectance)"). Whoever clips a view leaves this
+/// much room on its left (the grid's frames have it in their margin).
+pub fn y_label_overhang(ui: &Ui) -> f32 {
+    0.25 * ui.text_style_height(&egui::TextStyle::Body) + 1.0
+}
+
+/// Length (points) of the line sample in front of a [`side_legend`] label.
+const LEGEND_SAMPLE: f32 = 26.0;
+
+/// The width (points) a [`side_legend`] of `series` takes: the line sample
+/// and the widest label at body size.
+pub fn side_legend_width(ui: &Ui, series: &[chart::Series]) -> f32 {
+    let font = egui::TextStyle::Body.resolve(ui.style());
+    let widest = series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .map(|s| {
+            ui.painter()
+                .layout_no_wrap(s.label.clone(), font.clone(), Color32::WHITE)
+                .size()
+                .x
+        })
+        .fold(0.0, f32::max);
+    LEGEND_SAMPLE + 3.0 * ui.spacing().item_spacing.x + widest
+}
+
+/// A legend drawn beside a plot rather than over it (presentation mode,
+/// where the plots are short and egui_plot's legend either covered the
+/// curves or was left out): per labelled series a sample of its line, in
+/// its colour, width and dash, and its label in the text colour (legible
+/// on the ground whatever the curve's colour).
+/// `width` is the column's (from [`side_legend_width`], or less: a longer
+/// label wraps).
+pub fn side_legend(ui: &mut Ui, series: &[chart::Series], scene: &Scene<'_>, width: f32) {
+    let text = strong_text(ui);
+    ui.set_max_width(width);
+    for s in series.iter().filter(|s| !s.label.is_empty()) {
+        ui.horizontal_top(|ui| {
+            let h = ui.text_style_height(&egui::TextStyle::Body);
+            let (rect, _) =
+                ui.allocate_exact_size(egui::vec2(LEGEND_SAMPLE, h), egui::Sense::hover());
+            let y = rect.center().y;
+            let ends = [egui::pos2(rect.left(), y), egui::pos2(rect.right(), y)];
+            let stroke = egui::Stroke::new(scene.stroke(s.width), s.color);
+            match s.dash {
+                Some(d) => {
+                    ui.painter()
+                        .extend(egui::Shape::dashed_line(&ends, stroke, d, d * 0.8));
+                }
+                None => {
+                    ui.painter().line_segment(ends, stroke);
+                }
+            }
+            ui.add(egui::Label::new(egui::RichText::new(&s.label).color(text)).wrap());
+        });
+    }
+}
+
+/// `plot` without its hover readout and crosshair when presenting: the
+/// presenter's pointer rests on the slide, and a crosshair with coordinates
+/// where it happens to be would be read as part of the figure.
+pub fn calm_hover<'a>(plot: egui_plot::Plot<'a>, scene: &Scene<'_>) -> egui_plot::Plot<'a> {
+    if scene.presenting {
+        plot.show_x(false).show_y(false).show_crosshair(false)
+    } else {
+        plot
+    }
+}
+
+/// egui_plot's smallest grid spacing in points (`Plot::grid_spacing`'s
+/// default minimum): its `GridInput::base_step_size` is this many points in
+/// data units.
+const PLOT_MIN_GRID_POINTS: f64 = 8.0;
+
+/// Grid marks at `ticks` inside `bounds`, thinned to ones at least `gap`
+/// points apart (the first and the last tick kept), each with a step size
+/// spanning the whole axis. egui_plot fades a label whose step is closer
+/// than its label spacing (60–80 points on x, 20–30 on y) and drops it below
+/// that: presenting, that left the Fresnel plot's 15° ticks in a dim grey
+/// and the term view's short plots with a lone "0" on their y axes. With
+/// the whole span as step every kept label is drawn at full strength; the
+/// thinning keeps them apart.
+pub fn presented_marks(
+    ticks: &[f64],
+    bounds: (f64, f64),
+    base_step: f64,
+    gap: f64,
+) -> Vec<egui_plot::GridMark> {
+    let (lo, hi) = (bounds.0.min(bounds.1), bounds.0.max(bounds.1));
+    if !(lo.is_finite() && hi.is_finite() && base_step.is_finite()) || base_step <= 0.0 {
+        return Vec::new();
+    }
+    let gap_units = gap * base_step / PLOT_MIN_GRID_POINTS;
+    let inside: Vec<f64> = ticks
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite() && (lo..=hi).contains(t))
+        .collect();
+    let mut kept: Vec<f64> = Vec::new();
+    for &t in &inside {
+        if kept.last().is_none_or(|&k| t - k >= gap_units) {
+            kept.push(t);
+        }
+    }
+    // The top tick too (what a short axis reads its scale by), in place of
+    // a kept one too close to it.
+    if let (Some(&last), Some(&top)) = (kept.last(), inside.last())
+        && top != last
+    {
+        if top - last < gap_units && kept.len() > 1 {
+            kept.pop();
+        }
+        if kept.last().is_none_or(|&k| top - k >= gap_units) {
+            kept.push(top);
+        }
+    }
+    let step = (hi - lo).max(1e-12) * 10.0;
+    kept.into_iter()
+        .map(|value| egui_plot::GridMark {
+            value,
+            step_size: step,
+        })
+        .collect()
+}
+
+/// `plot` with its axes marked at `chart`'s ticks, labelled as the chart
+/// labels them and all at full strength (see [`presented_marks`]): the
+/// axes of a presented plot.
+pub fn presented_axes<'a>(plot: egui_plot::Plot<'a>, chart: &chart::Chart) -> egui_plot::Plot<'a> {
+    fn label_of(ticks: &[(f64, String)], value: f64) -> String {
+        ticks
+            .iter()
+            .find(|(t, _)| (t - value).abs() <= 1e-9 * t.abs().max(1.0))
+            .map(|(_, l)| l.clone())
+            .unwrap_or_default()
+    }
+    let (xs, ys) = (chart.x_ticks.clone(), chart.y_ticks.clone());
+    let (xv, yv): (Vec<f64>, Vec<f64>) = (
+        xs.iter().map(|t| t.0).collect(),
+        ys.iter().map(|t| t.0).collect(),
+    );
+    plot.x_grid_spacer(move |input| presented_marks(&xv, input.bounds, input.base_step_size, 36.0))
+        .y_grid_spacer(move |input| presented_marks(&yv, input.bounds, input.base_step_size, 24.0))
+        .x_axis_formatter(move |mark, _| label_of(&xs, mark.value))
+        .y_axis_formatter(move |mark, _| label_of(&ys, mark.value))
+}
+
 /// A faint colour for grids.
 pub fn grid_color(dark: bool) -> Color32 {
     if dark {
@@ -342,6 +494,7 @@ pub fn decade_label(k: i32) -> String {
 /// find egui's render state through the context install it here), for
 /// eframe's window and for offscreen figures alike.
 pub fn install_context(ctx: &egui::Context, render_state: &eframe::egui_wgpu::RenderState) {
+    fonts::install(ctx);
     gpu_image::install(ctx, render_state);
 }
 

@@ -247,7 +247,8 @@ impl View for PolarView {
         let mirror = super::mirror_color(dark);
         // Room for the readout line, and for the swap line once a direction
         // has been hovered (before that it would be an empty band).
-        let readout_h = if scene.figure {
+        // Presenting, no hover readout (nor its hint) below the plot.
+        let readout_h = if scene.figure || (scene.presenting && self.pinned.is_none()) {
             0.0
         } else if self.pinned.is_some() {
             46.0
@@ -258,11 +259,14 @@ impl View for PolarView {
         let value_name = super::value_label(d.cosine);
         let log = d.log;
 
-        let plot = super::with_legend(
-            Plot::new(super::view_id(crate::session::views::POLAR.id)),
-            size,
-            scene.brdfs.len(),
-            Corner::RightTop,
+        let plot = super::calm_hover(
+            super::with_legend(
+                Plot::new(super::view_id(crate::session::views::POLAR.id)),
+                size,
+                scene.brdfs.len(),
+                Corner::RightTop,
+            ),
+            scene,
         )
         .width(size.x.max(50.0))
         .height(size.y.max(50.0))
@@ -472,7 +476,9 @@ impl View for PolarView {
         // Exact values along the hovered direction.
         self.readout = None;
         self.plot_rect = Some(response.response.rect);
+        // No readout where a presenter's pointer happens to rest.
         if response.response.hovered()
+            && !scene.presenting
             && let Some(p) = response.inner
         {
             let a = p.x.atan2(p.y);
@@ -501,7 +507,9 @@ impl View for PolarView {
             }
         }
         if !scene.figure {
-            readout_ui(ui, self.readout.as_ref(), d.cosine);
+            if !scene.presenting {
+                readout_ui(ui, self.readout.as_ref(), d.cosine);
+            }
             self.swap = self.pinned.and_then(|a| {
                 let b = scene.primary()?;
                 let wo = slices::plane_direction(a, phi_i);

@@ -130,6 +130,9 @@ fn histogram_disc(
     painter.add(Shape::mesh(mesh));
 }
 
+/// Where the footer starts below the verdict's top, points.
+const FOOTER_AT: f32 = 18.0;
+
 impl View for SamplingView {
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
@@ -201,8 +204,33 @@ impl View for SamplingView {
             &[Side::Above]
         };
         let rows = sides.len() as f32;
+        // One colour scale for both histograms: the largest of either.
+        let observed: Vec<f64> = h.observed.iter().map(|&o| o as f64).collect();
+        let scale = observed
+            .iter()
+            .chain(&h.expected)
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        // The footer wraps at the view's width, and the discs leave it room:
+        // as one line it ran off the right edge (a presented slide cut it
+        // after "ring:").
+        let footer = painter.layout(
+            format!(
+                "∫ pdf dω over the {} {}; {} draws gave no direction{} ({} expected); colour: count / {}; dot: ωi, ring: its mirror direction",
+                if h.whole_sphere { "sphere" } else { "hemisphere" },
+                bv_core::text::fmt_value(h.pdf_mass),
+                h.failed,
+                if h.whole_sphere { "" } else { " above the horizon" },
+                bv_core::text::fmt_value(h.expected_failed),
+                bv_core::text::fmt_value(scale),
+            ),
+            small.clone(),
+            weak,
+            (area.width() - 12.0).max(40.0),
+        );
         let top = 48.0;
-        let bottom = 52.0;
+        let bottom = (FOOTER_AT + footer.size().y + 12.0).max(52.0);
         let gap = 16.0;
         // Room for a row's caption between the rows.
         let row_gap = if h.whole_sphere { 34.0 } else { 0.0 };
@@ -241,14 +269,6 @@ impl View for SamplingView {
             "draws per bin".to_string(),
             "draws × ∫ pdf dω per bin".to_string(),
         ];
-        // One colour scale for both histograms: the largest of either.
-        let observed: Vec<f64> = h.observed.iter().map(|&o| o as f64).collect();
-        let scale = observed
-            .iter()
-            .chain(&h.expected)
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0, f64::max);
         let wi = scene.wi();
         for (n, (disc, s)) in discs.iter().enumerate() {
             let (k, s) = (n % 3, *s);
@@ -312,21 +332,7 @@ impl View for SamplingView {
             font,
             verdict_color,
         );
-        painter.text(
-            Pos2::new(area.left() + 6.0, y + 18.0),
-            Align2::LEFT_TOP,
-            format!(
-                "∫ pdf dω over the {} {}; {} draws gave no direction{} ({} expected); colour: count / {}; dot: ωi, ring: its mirror direction",
-                if h.whole_sphere { "sphere" } else { "hemisphere" },
-                bv_core::text::fmt_value(h.pdf_mass),
-                h.failed,
-                if h.whole_sphere { "" } else { " above the horizon" },
-                bv_core::text::fmt_value(h.expected_failed),
-                bv_core::text::fmt_value(scale),
-            ),
-            small,
-            weak,
-        );
+        painter.galley(Pos2::new(area.left() + 6.0, y + FOOTER_AT), footer, weak);
     }
 
     fn as_any(&self) -> &dyn std::any::Any {

@@ -567,9 +567,59 @@ fn to_screen(v: DVec2, centre: Pos2, s: f32) -> Pos2 {
     Pos2::new(centre.x + v.x as f32 * s, centre.y - v.y as f32 * s)
 }
 
-/// Paints the figure into `rect`.
-fn paint(painter: &egui::Painter, rect: egui::Rect, fig: &SnellFigure) {
+/// The figure's details (the interface's numbers) as a column of text in
+/// `rect`, at their own size: presenting, the diagram is too short for
+/// them at a legible size (they covered the rays and each other).
+fn paint_details(painter: &egui::Painter, rect: egui::Rect, fig: &SnellFigure) {
+    let mut y = rect.top();
+    for prim in &fig.prims {
+        if let Prim::Text {
+            text,
+            color,
+            size,
+            detail: true,
+            ..
+        } = prim
+        {
+            let galley = painter.layout(
+                text.clone(),
+                egui::FontId::proportional(*size),
+                *color,
+                rect.width().max(1.0),
+            );
+            let h = galley.size().y;
+            painter.galley(Pos2::new(rect.left(), y), galley, *color);
+            y += h + 2.0;
+        }
+    }
+}
+
+/// `fig` with its translucent labels (the weak ones) in `strong`: opaque
+/// text for a projector.
+fn presented(mut fig: SnellFigure, strong: Color32) -> SnellFigure {
+    for p in &mut fig.prims {
+        if let Prim::Text { color, .. } = p
+            && color.a() < 255
+        {
+            *color = strong;
+        }
+    }
+    fig
+}
+
+/// Paints the figure into `rect`, its text scaled by at least `min_text`;
+/// without its details (the interface's numbers) when `details_apart`
+/// (drawn beside it by [`paint_details`]).
+fn paint(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    fig: &SnellFigure,
+    min_text: f32,
+    details_apart: bool,
+) {
     let (centre, s, text_scale, details) = fit(rect);
+    let text_scale = text_scale.max(min_text);
+    let details = details && !details_apart;
     for prim in &fig.prims {
         match prim {
             Prim::Fill { points, color } => {
@@ -782,7 +832,33 @@ impl View for SnellView {
         let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
         let painter = ui.painter_at(rect);
         painter.rect_filled(rect, 0.0, super::figure_fill(ui, scene));
-        paint(&painter, rect, &fig);
+        // Presenting, the annotations keep their full size (11–12 points,
+        // 30 pixels at 1080p, where the figure's fit had shrunk them to
+        // 14 pixels) and are drawn opaque: a translucent grey over the
+        // tinted media fell short of AA contrast.
+        let fig = if scene.presenting {
+            presented(fig, super::strong_text_color(dark))
+        } else {
+            fig
+        };
+        let rect = if scene.presenting {
+            // The diagram as large as the height allows, its numbers in the
+            // column to its right; a little of the width left over goes to
+            // its left, where its full-size labels reach past its edge.
+            let s = rect.height() / (2.0 * EXTENT[1] as f32);
+            let w = (2.0 * EXTENT[0] as f32 * s).min(0.7 * rect.width());
+            let left = rect.left() + ((rect.width() - w) / 5.0).clamp(0.0, 60.0);
+            let diagram = egui::Rect::from_x_y_ranges(left..=left + w, rect.y_range());
+            let column = rect
+                .with_min_x(diagram.right() + 12.0)
+                .shrink2(Vec2::new(0.0, 12.0));
+            paint(&painter, diagram, &fig, 1.0, true);
+            paint_details(&painter, column, &fig);
+            diagram
+        } else {
+            paint(&painter, rect, &fig, 0.0, false);
+            rect
+        };
         let (centre, scale, _, _) = fit(rect);
         self.last_rect = Some((rect, centre, scale));
         if !scene.figure {

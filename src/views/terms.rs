@@ -299,30 +299,62 @@ pub struct TermsView {
     pub last: Option<TermCharts>,
 }
 
-/// Draws a chart with egui_plot into `height` points.
-fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
-    let width = ui.available_width().max(50.0);
-    let mut plot = super::with_legend(
-        Plot::new(id).width(width).height(height.max(40.0)),
-        egui::vec2(width, height),
-        c.series.len(),
-        Corner::RightTop,
-    )
-    .x_axis_label(c.x_label.clone())
-    .y_axis_label(c.y_label.clone())
-    .y_axis_min_width(40.0)
-    .include_x(c.x_range.0)
-    .include_x(c.x_range.1)
-    .include_y(c.y_range.0)
-    .include_y(c.y_range.1)
-    .allow_scroll(false)
-    .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
-        if input.bounds.1 - input.bounds.0 > 100.0 {
-            [5.0, 15.0, 45.0]
-        } else {
-            [5.0, 15.0, 15.0]
-        }
-    }));
+/// Where a chart's legend covers the least of its curves: D falls from its
+/// peak at 0° (and G from 1 towards grazing), F rises towards 90°.
+fn legend_corner(c: &Chart) -> Corner {
+    if c.x_label.starts_with("θd") {
+        Corner::LeftTop
+    } else {
+        Corner::RightTop
+    }
+}
+
+/// Draws a chart with egui_plot into `size` points; presenting, its legend
+/// is a column `legend_w` wide (of the width) beside it (over a plot that
+/// short it covered the curves).
+fn plot_chart(
+    ui: &mut Ui,
+    id: egui::Id,
+    c: &Chart,
+    size: egui::Vec2,
+    log_y: bool,
+    scene: &Scene<'_>,
+    legend_w: f32,
+) {
+    let height = size.y;
+    let gap = if legend_w > 0.0 {
+        ui.spacing().item_spacing.x
+    } else {
+        0.0
+    };
+    let width = (size.x - legend_w - gap).max(50.0);
+    let plot = Plot::new(id).width(width).height(height.max(40.0));
+    let plot = if scene.presenting {
+        super::calm_hover(plot, scene)
+    } else {
+        super::with_legend(
+            plot,
+            egui::vec2(width, height),
+            c.series.len(),
+            legend_corner(c),
+        )
+    };
+    let mut plot = plot
+        .x_axis_label(c.x_label.clone())
+        .y_axis_label(c.y_label.clone())
+        .y_axis_min_width(40.0)
+        .include_x(c.x_range.0)
+        .include_x(c.x_range.1)
+        .include_y(c.y_range.0)
+        .include_y(c.y_range.1)
+        .allow_scroll(false)
+        .x_grid_spacer(egui_plot::uniform_grid_spacer(|input| {
+            if input.bounds.1 - input.bounds.0 > 100.0 {
+                [5.0, 15.0, 45.0]
+            } else {
+                [5.0, 15.0, 15.0]
+            }
+        }));
     if log_y {
         plot = plot
             .y_axis_formatter(|mark, _| {
@@ -334,7 +366,10 @@ fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
     } else {
         plot = curves::with_linear_y(plot);
     }
-    plot.show(ui, |pui| {
+    if scene.presenting {
+        plot = super::presented_axes(plot, c);
+    }
+    let draw = |pui: &mut egui_plot::PlotUi<'_>| {
         for m in &c.vlines {
             let mut v = VLine::new("", m.at)
                 .color(m.color)
@@ -361,7 +396,18 @@ fn plot_chart(ui: &mut Ui, id: egui::Id, c: &Chart, height: f32, log_y: bool) {
                 pui.line(l);
             }
         }
-    });
+    };
+    if scene.presenting {
+        ui.horizontal_top(|ui| {
+            plot.show(ui, draw);
+            ui.vertical(|ui| {
+                ui.add_space(4.0);
+                super::side_legend(ui, &c.series, scene, legend_w);
+            });
+        });
+    } else {
+        plot.show(ui, draw);
+    }
 }
 
 impl View for TermsView {
@@ -390,6 +436,19 @@ impl View for TermsView {
         if shown.is_empty() {
             ui.label(RichText::new("no term is switched on").weak());
         } else {
+            // One width for all three, taken before any is drawn (a
+            // legend may widen the ui), and one legend width, so that their
+            // axes align.
+            let width = ui.available_width();
+            let legend_w = if scene.presenting {
+                shown
+                    .iter()
+                    .map(|c| super::side_legend_width(ui, &c.series))
+                    .fold(0.0, f32::max)
+                    .min(0.4 * width)
+            } else {
+                0.0
+            };
             let spacing = ui.spacing().item_spacing.y;
             let height =
                 (ui.available_height() - spacing * (shown.len() as f32 - 1.0)) / shown.len() as f32;
@@ -398,7 +457,7 @@ impl View for TermsView {
                     self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
                 // The scale is part of the id: each keeps its own zoom.
                 let id = super::view_id(crate::session::views::TERMS.id).with((k, log_y));
-                plot_chart(ui, id, c, height, log_y);
+                plot_chart(ui, id, c, egui::vec2(width, height), log_y, scene, legend_w);
             }
         }
         self.last = Some(charts);
@@ -471,6 +530,7 @@ mod tests {
             figure: true,
             transparent: false,
             line_scale: 1.0,
+            presenting: false,
         };
         let c = term_charts(&scene, TermToggles::default(), true);
         assert_eq!(c.lines.len(), 2);
