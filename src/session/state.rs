@@ -305,6 +305,8 @@ pub struct PlotSettings {
     pub fixed_theta_h_deg: f64,
     /// The Snell view's interface.
     pub snell: SnellSettings,
+    /// The microfacet term view's charts.
+    pub terms: TermToggles,
 }
 
 impl Default for PlotSettings {
@@ -314,6 +316,36 @@ impl Default for PlotSettings {
             fixed_theta_d_deg: 30.0,
             fixed_theta_h_deg: 0.0,
             snell: SnellSettings::default(),
+            terms: TermToggles::default(),
+        }
+    }
+}
+
+/// Which charts the microfacet term view draws: saved with the scene, so
+/// that a deck's slide can show D alone (LECTURE.md N1) or G2 alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TermToggles {
+    /// D(θh).
+    pub d: bool,
+    /// D on a logarithmic scale.
+    pub log_d: bool,
+    /// Smith's masking G1(ωo).
+    pub g1: bool,
+    /// The model's masking-shadowing G2(ωi, ωo).
+    pub g2: bool,
+    /// F(θd).
+    pub f: bool,
+}
+
+impl Default for TermToggles {
+    fn default() -> Self {
+        Self {
+            d: true,
+            log_d: false,
+            g1: true,
+            g2: true,
+            f: true,
         }
     }
 }

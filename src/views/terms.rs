@@ -22,6 +22,7 @@ use super::svg::Svg;
 use super::{Scene, View};
 use crate::derive::slices;
 use crate::session::command::Command;
+use crate::session::state::PlotSettings;
 use bv_core::frame;
 use eframe::egui::{self, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoints, VLine};
@@ -30,32 +31,9 @@ use std::f64::consts::FRAC_PI_2;
 /// Samples over 0..90° (D, F); twice as many over −90..90° (G).
 const SAMPLES: usize = 360;
 
-/// Which terms are drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct TermToggles {
-    /// D(θh).
-    pub d: bool,
-    /// D on a logarithmic scale.
-    pub log_d: bool,
-    /// Smith's masking G1(ωo).
-    pub g1: bool,
-    /// The model's masking-shadowing G2(ωi, ωo).
-    pub g2: bool,
-    /// F(θd).
-    pub f: bool,
-}
-
-impl Default for TermToggles {
-    fn default() -> Self {
-        Self {
-            d: true,
-            log_d: false,
-            g1: true,
-            g2: true,
-            f: true,
-        }
-    }
-}
+/// Which terms are drawn: the scene's (`plots.terms`), so that a slide can
+/// show D alone or G2 alone.
+pub use crate::session::state::TermToggles;
 
 /// The charts of one frame.
 #[derive(Debug, Clone, Default)]
@@ -293,8 +271,6 @@ fn d_chart(mut series: Vec<Series>, log: bool) -> Chart {
 /// The microfacet term view.
 #[derive(Default)]
 pub struct TermsView {
-    /// Which terms are drawn (kept with the view, not saved).
-    pub show: TermToggles,
     /// The charts of the last frame (for tests).
     pub last: Option<TermCharts>,
 }
@@ -411,8 +387,9 @@ fn plot_chart(
 }
 
 impl View for TermsView {
-    fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
-        let s = &mut self.show;
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let before = scene.state.plots.terms;
+        let mut s = before;
         for (on, label, hint) in [
             (&mut s.d, "D", "The distribution of normals D(θh)"),
             (&mut s.log_d, "log D", "D on a logarithmic scale"),
@@ -424,11 +401,17 @@ impl View for TermsView {
                 *on = !*on;
             }
         }
+        if s != before {
+            out.push(Command::SetPlots(PlotSettings {
+                terms: s,
+                ..scene.state.plots
+            }));
+        }
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
-        let charts = term_charts(scene, self.show, dark);
+        let charts = term_charts(scene, scene.state.plots.terms, dark);
         for line in &charts.lines {
             ui.label(RichText::new(line).weak().size(11.0));
         }
@@ -453,8 +436,8 @@ impl View for TermsView {
             let height =
                 (ui.available_height() - spacing * (shown.len() as f32 - 1.0)) / shown.len() as f32;
             for (k, c) in shown.iter().enumerate() {
-                let log_y =
-                    self.show.log_d && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
+                let log_y = scene.state.plots.terms.log_d
+                    && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
                 // The scale is part of the id: each keeps its own zoom.
                 let id = super::view_id(crate::session::views::TERMS.id).with((k, log_y));
                 plot_chart(ui, id, c, egui::vec2(width, height), log_y, scene, legend_w);
@@ -468,7 +451,7 @@ impl View for TermsView {
     }
 
     fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
-        let charts = term_charts(scene, self.show, dark);
+        let charts = term_charts(scene, scene.state.plots.terms, dark);
         let pal = Palette::new(dark, scene.transparent);
         let [w, h] = [size[0].max(120.0), size[1].max(90.0)];
         let mut svg = Svg::new(w, h);
