@@ -714,3 +714,38 @@ fn a_resting_pointer_draws_no_crosshair_or_readout_when_presenting() {
         }
     }
 }
+
+#[test]
+fn presented_polar_legend_is_beside_the_circle_clear_of_its_labels() {
+    let mut s = state("cook-torrance", 45.0);
+    s.add(ModelSpec::new("lambert").unwrap());
+    s.add(ModelSpec::from_json("mirror", &serde_json::json!({"fresnel": "none"})).unwrap());
+    let h = presented(s, "polar");
+    let rect = bv::app::viewer::view_rect(&h.ctx, "polar").expect("drawn");
+    let drawn = drawn_in(&h, rect);
+    let names = ["Cook-Torrance", "Lambert", "Mirror", "Mirror δ"];
+    let legend: Vec<&Drawn> = drawn
+        .iter()
+        .filter(|d| names.contains(&d.text.as_str()))
+        .collect();
+    assert_eq!(legend.len(), names.len(), "{:?}", drawn.iter().map(|d| &d.text).collect::<Vec<_>>());
+    // The circle's own labels: the ring angles, ωr and the spike's weight.
+    let circle: Vec<&Drawn> = drawn
+        .iter()
+        .filter(|d| d.text.ends_with('°') || d.text == "ωr" || d.text.starts_with("δ "))
+        .collect();
+    assert!(circle.iter().any(|d| d.text == "ωr") && circle.iter().any(|d| d.text == "δ 1.000"));
+    let right_of_circle = circle
+        .iter()
+        .map(|d| d.rect.right())
+        .fold(f32::NEG_INFINITY, f32::max);
+    for d in &legend {
+        assert!(
+            d.rect.left() > right_of_circle && rect.contains_rect(d.rect),
+            "{:?} at {:?}: over the circle (to {right_of_circle}) or outside the view",
+            d.text,
+            d.rect
+        );
+    }
+    assert_legible("polar", &drawn, egui::Color32::BLACK);
+}

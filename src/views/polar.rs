@@ -259,16 +259,50 @@ impl View for PolarView {
         let value_name = super::value_label(d.cosine);
         let log = d.log;
 
-        let plot = super::calm_hover(
-            super::with_legend(
-                Plot::new(super::view_id(crate::session::views::POLAR.id)),
-                size,
-                scene.brdfs.len(),
-                Corner::RightTop,
-            ),
-            scene,
-        )
-        .width(size.x.max(50.0))
+        // Presenting, the legend is a column beside the plot: in the corner
+        // it covered the ωr label and a δ spike's weight once the circle
+        // filled the slide's height.
+        let legend: Vec<super::chart::Series> = if scene.presenting {
+            let entry = |label: &str, color: Color32, width: f32, dash: Option<f32>| {
+                super::chart::Series {
+                    label: label.to_string(),
+                    color,
+                    points: Vec::new(),
+                    width,
+                    dash,
+                }
+            };
+            let mut l: Vec<_> = curves
+                .iter()
+                .filter(|c| !c.3.is_empty())
+                .map(|c| entry(&c.0, c.1, if c.2 { 2.5 } else { 1.8 }, None))
+                .collect();
+            if let Some((label, color, _)) = &sh {
+                l.push(entry(label, *color, 2.0, Some(8.0)));
+            }
+            if let Some((label, _)) = &factor {
+                l.push(entry(label, factor_color, 2.0, Some(12.0)));
+            }
+            for s in delta_spikes(scene, outer) {
+                l.push(entry(&format!("{} δ", s.label), s.color, 1.8, None));
+            }
+            l
+        } else {
+            Vec::new()
+        };
+        let legend_w = if legend.is_empty() {
+            0.0
+        } else {
+            super::side_legend_width(ui, &legend).min(0.4 * size.x) + ui.spacing().item_spacing.x
+        };
+        let plot = Plot::new(super::view_id(crate::session::views::POLAR.id));
+        let plot = if scene.presenting {
+            plot
+        } else {
+            super::with_legend(plot, size, scene.brdfs.len(), Corner::RightTop)
+        };
+        let plot = super::calm_hover(plot, scene)
+        .width((size.x - legend_w).max(50.0))
         .height(size.y.max(50.0))
         .data_aspect(1.0)
         .show_axes(false)
@@ -293,7 +327,7 @@ impl View for PolarView {
 
         let span: i32 = if transmits { 180 } else { 90 };
         let marks = interface_marks(scene, outer, dark);
-        let response = plot.show(ui, |pui| {
+        let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             // Rings with the value they stand for, and spokes every 15°.
             // On the log scale the rings stand at round values of f.
             for (r, _) in rings(outer, log) {
@@ -471,7 +505,20 @@ impl View for PolarView {
                 );
             }
             pui.pointer_coordinate()
-        });
+        };
+        let response = if legend.is_empty() {
+            plot.show(ui, draw)
+        } else {
+            ui.horizontal_top(|ui| {
+                let r = plot.show(ui, draw);
+                ui.vertical(|ui| {
+                    ui.add_space(4.0);
+                    super::side_legend(ui, &legend, scene, legend_w);
+                });
+                r
+            })
+            .inner
+        };
 
         // Exact values along the hovered direction.
         self.readout = None;
