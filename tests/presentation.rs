@@ -728,7 +728,12 @@ fn presented_polar_legend_is_beside_the_circle_clear_of_its_labels() {
         .iter()
         .filter(|d| names.contains(&d.text.as_str()))
         .collect();
-    assert_eq!(legend.len(), names.len(), "{:?}", drawn.iter().map(|d| &d.text).collect::<Vec<_>>());
+    assert_eq!(
+        legend.len(),
+        names.len(),
+        "{:?}",
+        drawn.iter().map(|d| &d.text).collect::<Vec<_>>()
+    );
     // The circle's own labels: the ring angles, ωr and the spike's weight.
     let circle: Vec<&Drawn> = drawn
         .iter()
