@@ -2,14 +2,15 @@
 // f = f_coat(wi, wo) + (1 − F(θi)) (1 − F(θo)) / η² · e^(−σa d (1/cosθi' + 1/cosθo')) · f_base(wi', wo')
 // with f_coat Walter et al. 2007 eq. 20 (separable Smith), wi', wo' the
 // macro refractions into the coat, f_base Lambert or a rough conductor of
-// index (base_eta + i base_k)/η (Walter eq. 20). Reflection only.
+// index (base_eta + i base_k)/η (Walter eq. 20), times the derived
+// inter-reflection factor 1/(1 − r̄ K) per channel. Reflection only.
 #define_import_path bv::models::coated
 
 #import bv::params::{pf, prgb, pu}
 #import bv::frame::INV_PI
 #import bv::fresnel::{dielectric, conductor}
 #import bv::microfacet::{ggx_d, beckmann_d, ggx_lambda, beckmann_lambda}
-#import bv::layout::{COATED_DISTRIBUTION, COATED_DISTRIBUTION_BECKMANN, COATED_ALPHA_X, COATED_ALPHA_Y, COATED_ETA, COATED_THICKNESS, COATED_ABSORPTION, COATED_BASE, COATED_BASE_CONDUCTOR, COATED_BASE_ALBEDO, COATED_BASE_ETA, COATED_BASE_K, COATED_BASE_ALPHA}
+#import bv::layout::{COATED_DISTRIBUTION, COATED_DISTRIBUTION_BECKMANN, COATED_ALPHA_X, COATED_ALPHA_Y, COATED_ETA, COATED_THICKNESS, COATED_ABSORPTION, COATED_BASE, COATED_BASE_CONDUCTOR, COATED_BASE_ALBEDO, COATED_BASE_ETA, COATED_BASE_K, COATED_BASE_ALPHA, COATED_MS_R}
 
 fn d_of(beckmann: bool, h: vec3<f32>, ax: f32, ay: f32) -> f32 {
     if (beckmann) {
@@ -84,7 +85,8 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     } else {
         base = prgb(o + COATED_BASE_ALBEDO) * INV_PI;
     }
-    let t = base * absorb * trans;
+    // The internal inter-reflections 1/(1 − r̄ K), a derived slot per channel.
+    let t = base * absorb * prgb(o + COATED_MS_R) * trans;
     if (all(t >= vec3<f32>(0.0)) && all(t < vec3<f32>(3.0e38))) {
         v += t;
     }
