@@ -503,10 +503,14 @@ impl Brdf for Coated {
             // the product of the two transmittances, the path length, and
             // the base's own BRDF of (wi', wo').
             reciprocal: true,
-            // The base term integrates, by η² cos θ' dω' = cos θ dω, to at
-            // most (1 − F(θi)) ρ_base(wi'), and the coat reflects at most
-            // F(θi) plus what its tilted facets add (checked numerically in
-            // the unit tests over the parameter ranges).
+            // For a smooth coat over a Lambertian base the model is the
+            // exact sum of every internal bounce, which conserves energy;
+            // over a conductor the base term integrates, by
+            // η² cos θ' dω' = cos θ dω, to at most (1 − F(θi)) times the
+            // base's albedo. A rough coat reflects F(θi) plus what its
+            // tilted facets add, less what masking removes; the unit tests
+            // and the catalogue's property test check ρhd ≤ 1 numerically
+            // over the parameter ranges.
             energy_conserving: match self.base {
                 Base::Lambert { albedo } => albedo.max_element() <= 1.0,
                 Base::Conductor { .. } => true,
