@@ -9,6 +9,7 @@ use crate::model::ModelInfo;
 pub mod ashikhmin_shirley;
 pub mod banks;
 pub mod blinn_phong;
+pub mod coated;
 pub mod cook_torrance;
 pub mod disney;
 pub mod glass;
@@ -45,6 +46,7 @@ pub static BUILT_IN: &[&ModelInfo] = &[
     &mirror::INFO,
     &glass::INFO,
     &rough_dielectric::INFO,
+    &coated::INFO,
     &merl::INFO,
     &mix::INFO,
 ];
