@@ -31,7 +31,7 @@ fn the_lecture_deck_renders_one_png_per_scene() {
     let loaded = deck::load(&deck_path(), Builds::Required).unwrap();
     assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
     let slides = loaded.deck.slides;
-    assert!(slides.len() >= 61, "{} scenes", slides.len());
+    assert!(slides.len() >= 62, "{} scenes", slides.len());
 
     let out = out_dir("lecture");
     let dir = format!("{}/", out.display());

@@ -263,15 +263,14 @@ impl View for PolarView {
         // it covered the ωr label and a δ spike's weight once the circle
         // filled the slide's height.
         let legend: Vec<super::chart::Series> = if scene.presenting {
-            let entry = |label: &str, color: Color32, width: f32, dash: Option<f32>| {
-                super::chart::Series {
+            let entry =
+                |label: &str, color: Color32, width: f32, dash: Option<f32>| super::chart::Series {
                     label: label.to_string(),
                     color,
                     points: Vec::new(),
                     width,
                     dash,
-                }
-            };
+                };
             let mut l: Vec<_> = curves
                 .iter()
                 .filter(|c| !c.3.is_empty())
@@ -302,28 +301,28 @@ impl View for PolarView {
             super::with_legend(plot, size, scene.brdfs.len(), Corner::RightTop)
         };
         let plot = super::calm_hover(plot, scene)
-        .width((size.x - legend_w).max(50.0))
-        .height(size.y.max(50.0))
-        .data_aspect(1.0)
-        .show_axes(false)
-        .show_grid(false)
-        .allow_scroll(false)
-        .label_formatter(move |hover| match hover {
-            egui_plot::HoverPosition::NearDataPoint {
-                plot_name,
-                position,
-                ..
-            } if !plot_name.is_empty() => {
-                let angle = position.x.atan2(position.y).to_degrees();
-                let v = value_at(position.x.hypot(position.y), log);
-                Some(format!(
-                    "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
-                    angle,
-                    curves::fmt_value(v)
-                ))
-            }
-            _ => None,
-        });
+            .width((size.x - legend_w).max(50.0))
+            .height(size.y.max(50.0))
+            .data_aspect(1.0)
+            .show_axes(false)
+            .show_grid(false)
+            .allow_scroll(false)
+            .label_formatter(move |hover| match hover {
+                egui_plot::HoverPosition::NearDataPoint {
+                    plot_name,
+                    position,
+                    ..
+                } if !plot_name.is_empty() => {
+                    let angle = position.x.atan2(position.y).to_degrees();
+                    let v = value_at(position.x.hypot(position.y), log);
+                    Some(format!(
+                        "{plot_name}\nθo = {:.1}°\n{value_name} = {} 1/sr",
+                        angle,
+                        curves::fmt_value(v)
+                    ))
+                }
+                _ => None,
+            });
 
         let span: i32 = if transmits { 180 } else { 90 };
         let marks = interface_marks(scene, outer, dark);
