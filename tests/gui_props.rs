@@ -44,7 +44,7 @@ fn settle(h: &mut Harness<'_, Viewer>) {
     // While jobs run the panel keeps repainting (progress), so a frame may
     // not settle within the harness's step limit: that is what this loop
     // waits out, not an error.
-    let mut frame = |h: &mut Harness<'_, Viewer>| {
+    let frame = |h: &mut Harness<'_, Viewer>| {
         let _ = h.try_run();
     };
     loop {
