@@ -106,15 +106,29 @@ pub fn brdf_list(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec
 }
 
 /// θi and φi sliders and the hemisphere widget.
-pub fn light_ui(ui: &mut Ui, state: &AppState, out: &mut Vec<Command>) {
+pub fn light_ui(ui: &mut Ui, state: &AppState, runtime: &Runtime, out: &mut Vec<Command>) {
     ui.heading("Light");
     let inc = state.incident;
     let mut t = inc.theta_deg;
     let mut p = inc.phi_deg;
+    // The slider crosses the horizon only where light below the surface
+    // means something: a shown model transmits (or a scene put the light
+    // there). For reflection-only models it keeps its 0–89.5° range, so its
+    // whole length still moves a light they reflect.
+    let transmits = state.brdfs.iter().filter(|e| e.visible).any(|e| {
+        runtime
+            .get(e.id)
+            .and_then(|b| b.brdf.as_ref())
+            .is_some_and(|b| b.transmits())
+    });
     ui.horizontal(|ui| {
         ui.vertical(|ui| {
             ui.spacing_mut().slider_width = 110.0;
-            let max_t = Incident::MAX_THETA_DEG;
+            let max_t = if transmits || inc.below() {
+                Incident::MAX_THETA_DEG
+            } else {
+                Incident::MAX_ABOVE_DEG
+            };
             ui.horizontal(|ui| {
                 let row = params_ui::slider_row(
                     ui,

@@ -700,7 +700,7 @@ impl Viewer {
                         panel::brdf_list(ui, &self.ws.state, &self.ws.runtime, out);
                         measured_ui::progress_ui(ui, &self.ws.loader);
                         ui.separator();
-                        panel::light_ui(ui, &self.ws.state, out);
+                        panel::light_ui(ui, &self.ws.state, &self.ws.runtime, out);
                         ui.separator();
                         panel::params_section(ui, &self.ws.state, &self.ws.runtime, out);
                         if let Some(e) = self.ws.state.selected_entry() {
