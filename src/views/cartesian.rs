@@ -125,11 +125,7 @@ impl View for CartesianView {
         } else {
             Vec::new()
         };
-        let legend_w = if legend.is_empty() {
-            0.0
-        } else {
-            super::side_legend_width(ui, &legend).min(0.4 * size.x) + ui.spacing().item_spacing.x
-        };
+        let legend_w = super::side_legend_room(ui, &legend, size.x);
         let plot = Plot::new(super::view_id(crate::session::views::CARTESIAN.id))
             .width((size.x - legend_w).max(50.0))
             .height(size.y.max(50.0));
@@ -267,19 +263,7 @@ impl View for CartesianView {
             }
             pui.pointer_coordinate()
         };
-        let response = if legend.is_empty() {
-            plot.show(ui, draw)
-        } else {
-            ui.horizontal_top(|ui| {
-                let r = plot.show(ui, draw);
-                ui.vertical(|ui| {
-                    ui.add_space(4.0);
-                    super::side_legend(ui, &legend, scene, legend_w);
-                });
-                r
-            })
-            .inner
-        };
+        let response = super::show_with_side_legend(ui, plot, draw, &legend, scene, legend_w);
 
         self.readout = None;
         self.plot_rect = Some(response.response.rect);

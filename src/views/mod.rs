@@ -341,6 +341,42 @@ pub fn side_legend_width(ui: &Ui, series: &[chart::Series]) -> f32 {
     LEGEND_SAMPLE + 3.0 * ui.spacing().item_spacing.x + widest
 }
 
+/// The room (points) a plot leaves beside it for a [`side_legend`] of
+/// `legend` in a view `width` wide: none without entries, else the legend's
+/// width (at most 0.4 of the view) and a gap.
+pub fn side_legend_room(ui: &Ui, legend: &[chart::Series], width: f32) -> f32 {
+    if legend.is_empty() {
+        0.0
+    } else {
+        side_legend_width(ui, legend).min(0.4 * width) + ui.spacing().item_spacing.x
+    }
+}
+
+/// Shows `plot` with `draw`, and `legend` in a column of `legend_w` points
+/// to its right when it has entries (the polar and Cartesian views when
+/// presenting).
+pub fn show_with_side_legend<R>(
+    ui: &mut Ui,
+    plot: egui_plot::Plot<'_>,
+    draw: impl FnOnce(&mut egui_plot::PlotUi<'_>) -> R,
+    legend: &[chart::Series],
+    scene: &Scene<'_>,
+    legend_w: f32,
+) -> egui_plot::PlotResponse<R> {
+    if legend.is_empty() {
+        return plot.show(ui, draw);
+    }
+    ui.horizontal_top(|ui| {
+        let r = plot.show(ui, draw);
+        ui.vertical(|ui| {
+            ui.add_space(4.0);
+            side_legend(ui, legend, scene, legend_w);
+        });
+        r
+    })
+    .inner
+}
+
 /// A legend drawn beside a plot rather than over it (presentation mode,
 /// where the plots are short and egui_plot's legend either covered the
 /// curves or was left out): per labelled series a sample of its line, in

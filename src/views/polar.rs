@@ -289,11 +289,7 @@ impl View for PolarView {
         } else {
             Vec::new()
         };
-        let legend_w = if legend.is_empty() {
-            0.0
-        } else {
-            super::side_legend_width(ui, &legend).min(0.4 * size.x) + ui.spacing().item_spacing.x
-        };
+        let legend_w = super::side_legend_room(ui, &legend, size.x);
         let plot = Plot::new(super::view_id(crate::session::views::POLAR.id));
         let plot = if scene.presenting {
             plot
@@ -505,19 +501,7 @@ impl View for PolarView {
             }
             pui.pointer_coordinate()
         };
-        let response = if legend.is_empty() {
-            plot.show(ui, draw)
-        } else {
-            ui.horizontal_top(|ui| {
-                let r = plot.show(ui, draw);
-                ui.vertical(|ui| {
-                    ui.add_space(4.0);
-                    super::side_legend(ui, &legend, scene, legend_w);
-                });
-                r
-            })
-            .inner
-        };
+        let response = super::show_with_side_legend(ui, plot, draw, &legend, scene, legend_w);
 
         // Exact values along the hovered direction.
         self.readout = None;
