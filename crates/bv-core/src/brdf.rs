@@ -17,6 +17,12 @@ pub struct Claims {
     pub isotropic: bool,
 }
 
+/// A function of the outgoing direction whose zero set is a kink of
+/// `f(wi, ·)`: where a `min`, `max` or clamp in the model switches branch, so
+/// that `f` is continuous but its slope jumps (see [`Brdf::kinks`]). Its sign
+/// says which branch applies; only where it changes sign matters.
+pub type Kink<'a> = Box<dyn Fn(DVec3) -> f64 + 'a>;
+
 /// Whether a delta lobe reflects or transmits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DeltaKind {
@@ -106,6 +112,17 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// the far side of the surface from `wi` (the refracted direction), about
     /// which the quadrature of the transmitted part is graded. Default: none.
     fn peaks(&self, _wi: DVec3) -> Vec<DVec3> {
+        Vec::new()
+    }
+
+    /// The kinks of `f(wi, ·)` (see [`Kink`]) over the outgoing directions on
+    /// `wi`'s side, so that the albedo quadrature breaks its panels where
+    /// they cross a circle of integration instead of bisecting towards them:
+    /// Oren-Nayar's `max(0, cos Δφ)` and `max(cos θi, cos θo)`, V-groove's
+    /// `min`. A kink left out costs evaluations, not accuracy (the
+    /// quadrature verifies its panels); a function whose sign changes where
+    /// `f` is smooth costs a break. Default: none.
+    fn kinks(&self, _wi: DVec3) -> Vec<Kink<'_>> {
         Vec::new()
     }
 

@@ -34,7 +34,9 @@ pub mod sampling;
 pub mod text;
 pub mod user;
 
-pub use brdf::{Brdf, Claims, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, MicrofacetTerms, Ndf};
+pub use brdf::{
+    Brdf, Claims, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, Kink, MicrofacetTerms, Ndf,
+};
 pub use error::{BvError, Result};
 pub use model::ModelInfo;
 pub use params::{Applies, ModelSpec, ParamDecl, ParamKind, ParamValue, Params};

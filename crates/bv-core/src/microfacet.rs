@@ -126,6 +126,23 @@ pub fn v_groove_g(wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
     1.0f64.min(k * wo.z).min(k * wi.z)
 }
 
+/// The kinks of [`v_groove_g`] for light from `wi` (see [`crate::Kink`]):
+/// where either shadowing term reaches 1 and where the two swap (`θo = θi`).
+pub fn v_groove_kinks(wi: DVec3) -> Vec<crate::Kink<'static>> {
+    let half = move |wo: DVec3| (wi + wo).try_normalize().unwrap_or(DVec3::Z);
+    vec![
+        Box::new(move |wo: DVec3| {
+            let h = half(wo);
+            2.0 * h.z * wo.z - wo.dot(h)
+        }),
+        Box::new(move |wo: DVec3| {
+            let h = half(wo);
+            2.0 * h.z * wi.z - wo.dot(h)
+        }),
+        Box::new(move |wo: DVec3| wo.z - wi.z),
+    ]
+}
+
 /// The constant `c` of Blinn's distribution `c · exp(−(θh/α)²)` such that
 /// `∫ D cosθh dω_h = 1`: `1/c = π ∫₀^{π/2} exp(−θ²/α²) sin 2θ dθ`.
 ///

@@ -132,6 +132,14 @@ impl Brdf for Rotated {
             .collect()
     }
 
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.inner
+            .kinks(self.to_inner(wi))
+            .into_iter()
+            .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(self.to_inner(wo))) })
+            .collect()
+    }
+
     fn is_analytic(&self) -> bool {
         self.inner.is_analytic()
     }

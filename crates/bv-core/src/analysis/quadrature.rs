@@ -30,8 +30,17 @@
 //! at the tangent axes for anisotropic models and at the peaks' azimuths. The
 //! error is `|K15 − G7|` per panel plus the inner integrals' errors carried
 //! through the outer weights: an upper-bound style estimate, not a standard
-//! error. Transmitting models add the lower hemisphere in `(cos θo, φo)`.
-//! Delta lobes add their exact weights.
+//! error. Transmitting models add the lower hemisphere in polar coordinates
+//! about their refracted peak (see [`transmitted`]). Delta lobes add their
+//! exact weights.
+//!
+//! # Less work for the same answer
+//! - An isotropic model symmetric about the plane of incidence (tested at 24
+//!   points before it is relied on, since isotropy does not imply it and a
+//!   claim may be wrong) is integrated over one side of the plane, doubled.
+//! - The kinks a model names ([`Brdf::kinks`]: Oren-Nayar's clamps,
+//!   V-groove's `min`) are located on each inner circle by regula falsi and
+//!   become panel breaks, instead of a cloud of bisections about each.
 
 use super::directions::below;
 use super::estimate::{AlbedoParts, Estimate, Method};
@@ -95,6 +104,109 @@ fn wrap_near(phi: f64, c: f64) -> f64 {
         d += TAU;
     }
     c + d
+}
+
+/// Whether azimuth `p` lies in the plane of incidence at azimuth `phi_i`
+/// (on either side of the normal).
+fn in_plane(p: f64, phi_i: f64) -> bool {
+    let d = (wrap_near(p, phi_i) - phi_i).abs();
+    d < 1e-9 || (d - PI).abs() < 1e-9
+}
+
+/// Whether `f(wi, ·)` takes the same values at outgoing directions and at
+/// their mirror images through the plane of incidence (azimuth `phi_i`), at
+/// 24 directions of a fixed spiral over the hemisphere above the surface
+/// (below it with `below`), to 1e-12 relative: the test [`reflected`] and
+/// [`transmitted`] make before they integrate one side of the plane.
+fn mirror_symmetric(brdf: &dyn Brdf, wi: DVec3, phi_i: f64, below: bool) -> bool {
+    const POINTS: usize = 24;
+    let golden = PI * (3.0 - 5f64.sqrt());
+    (0..POINTS).all(|k| {
+        let z = 1.0 - (k as f64 + 0.5) / POINTS as f64;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        // Relative to the plane of incidence, mirrored: φi ± d.
+        let d = 0.37 + golden * k as f64;
+        let z = if below { -z } else { z };
+        let at = |a: f64| DVec3::new(r * a.cos(), r * a.sin(), z);
+        let (p, q) = (brdf.eval(wi, at(phi_i + d)), brdf.eval(wi, at(phi_i - d)));
+        let scale = p.abs().max(q.abs()).max_element();
+        scale.is_finite() && (p - q).abs().max_element() <= 1e-12 * scale
+    })
+}
+
+/// Points of the scan over an arc in which the kinks' sign changes are
+/// looked for (a kink crossing the arc twice within one step is missed and
+/// left to the verified bisection).
+const KINK_SCAN: usize = 8;
+
+/// Adds to `out` the azimuths in `(lo, hi)` where a kink of the model
+/// ([`Brdf::kinks`]) changes sign along the directions `dir(φ)` (`None`
+/// where there is no direction), each to within 1e-12 rad by the Illinois
+/// variant of regula falsi (superlinear, and it keeps the root bracketed):
+/// panel breaks, so that no Gauss–Kronrod panel straddles a kink.
+fn kink_roots(
+    kinks: &[crate::Kink<'_>],
+    dir: impl Fn(f64) -> Option<DVec3>,
+    lo: f64,
+    hi: f64,
+    out: &mut Vec<f64>,
+) {
+    if kinks.is_empty() || hi - lo <= 0.0 {
+        return;
+    }
+    let step = (hi - lo) / KINK_SCAN as f64;
+    let dirs: Vec<Option<DVec3>> = (0..=KINK_SCAN).map(|k| dir(lo + step * k as f64)).collect();
+    for kink in kinks {
+        let value = |phi: f64| dir(phi).map(kink);
+        for k in 0..KINK_SCAN {
+            let (Some(a), Some(b)) = (dirs[k], dirs[k + 1]) else {
+                continue;
+            };
+            let (mut fa, mut fb) = (kink(a), kink(b));
+            if !(fa.is_finite() && fb.is_finite()) || (fa > 0.0) == (fb > 0.0) {
+                continue;
+            }
+            let (mut x0, mut x1) = (lo + step * k as f64, lo + step * (k + 1) as f64);
+            // Which end was kept last time (Illinois halves its value).
+            let mut kept = 0i8;
+            for _ in 0..100 {
+                if x1 - x0 <= 1e-12 {
+                    break;
+                }
+                let mut m = x1 - fb * (x1 - x0) / (fb - fa);
+                if !(m > x0 && m < x1) {
+                    m = 0.5 * (x0 + x1);
+                }
+                let Some(fm) = value(m).filter(|v| v.is_finite()) else {
+                    break;
+                };
+                if fm == 0.0 {
+                    x0 = m;
+                    x1 = m;
+                    break;
+                }
+                if (fm > 0.0) == (fa > 0.0) {
+                    x0 = m;
+                    fa = fm;
+                    if kept == 1 {
+                        fb *= 0.5;
+                    }
+                    kept = 1;
+                } else {
+                    x1 = m;
+                    fb = fm;
+                    if kept == -1 {
+                        fa *= 0.5;
+                    }
+                    kept = -1;
+                }
+            }
+            let x = 0.5 * (x0 + x1);
+            if x > lo && x < hi {
+                out.push(x);
+            }
+        }
+    }
 }
 
 /// Half-width of the arc of φh − φi whose `wo` is above the horizon, for
@@ -204,6 +316,13 @@ impl Brdf for Flipped<'_> {
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         self.0.peaks(below(wi)).into_iter().map(below).collect()
     }
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.0
+            .kinks(below(wi))
+            .into_iter()
+            .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
+            .collect()
+    }
 }
 
 fn quad_estimate(value: Rgb, error: Rgb, samples: usize, converged: bool) -> Estimate {
@@ -272,6 +391,17 @@ fn reflected(
         fixed_phis.extend([0.0, FRAC_PI_2, PI, -FRAC_PI_2]);
     }
     fixed_phis.extend(peaks.iter().map(|&(_, p)| p));
+    // An isotropic model is in practice also symmetric about the plane of
+    // incidence (a function of θi, θo and |φo − φi|: every model built from
+    // dot products with n, wi, wo and h is), and then the inner integral is
+    // twice its half on one side of the plane, if no peak lies off it.
+    // Isotropy does not imply that symmetry, and a claim may be wrong (bv
+    // check exists to catch such models), so it is also tested at points
+    // spread over the hemisphere before it is relied on.
+    let half = !anisotropic
+        && peaks.iter().all(|&(t, p)| t < 1e-9 || in_plane(p, phi_i))
+        && mirror_symmetric(brdf, wi, phi_i, false);
+    let kinks = brdf.kinks(wi);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta_h: f64| -> (Rgb, Rgb) {
@@ -292,7 +422,7 @@ fn reflected(
             (brdf.eval(wi, wo) * (wo.z * 4.0 * c * sh), Rgb::ZERO)
         };
         let full = psi >= PI;
-        let (lo, hi) = (phi_i - psi, phi_i + psi);
+        let (lo, hi) = (if half { phi_i } else { phi_i - psi }, phi_i + psi);
         let mut br = vec![lo, phi_i, hi];
         for &p in &fixed_phis {
             let p = wrap_near(p, phi_i);
@@ -300,11 +430,22 @@ fn reflected(
                 br.push(p);
             }
         }
-        let segs = gauss_kronrod::segments(&br, !full, !full);
-        let r =
-            gauss_kronrod::integrate(&mut inner, &segs, inner_tol, 0.0, opts.inner_panels, false);
+        let dir = |phi: f64| {
+            let (sp, cp) = phi.sin_cos();
+            let h = DVec3::new(sh * cp, sh * sp, ch);
+            let wo = 2.0 * wi.dot(h) * h - wi;
+            (wo.z > 0.0).then(|| wo.normalize())
+        };
+        kink_roots(&kinks, dir, lo, hi, &mut br);
+        let segs = gauss_kronrod::segments(&br, !full && !half, !full);
+        let (tol, scale) = if half {
+            (0.5 * inner_tol, 2.0)
+        } else {
+            (inner_tol, 1.0)
+        };
+        let r = gauss_kronrod::integrate(&mut inner, &segs, tol, 0.0, opts.inner_panels, false);
         inner_evals += r.evaluations;
-        (r.value, r.error)
+        (r.value * scale, r.error * scale)
     };
     let mut r = gauss_kronrod::integrate(
         &mut outer,
@@ -318,118 +459,177 @@ fn reflected(
     r
 }
 
-/// The transmitted part, over the polar angle `θ'` of `wo` from −z and its
-/// azimuth φo: `wo = (sin θ' cos φo, sin θ' sin φo, −cos θ')`,
-/// `∫∫ f cos θ' sin θ' dφo dθ'`. θ' is graded geometrically (down to
-/// [`FINEST`]) about each peak the model names below the surface
-/// ([`Brdf::peaks`]: a rough dielectric's refracted direction) and φo about
-/// the peak's azimuth, as the reflected part is graded about its peaks, so a
-/// lobe as narrow as α = 0.001 is resolved; a peak at the pole is a cap that
-/// the grading at θ' = 0 resolves. For a model of an interface
-/// ([`Brdf::interface_eta`]) θ' also breaks where the generalised half
+/// The transmitted part, in polar coordinates `(θ, ψ)` about the model's
+/// first peak below the surface `p` ([`Brdf::peaks`]: a rough dielectric's
+/// refracted direction; the pole −z when it names none):
+/// `wo = cos θ p − sin θ (cos ψ e₁ + sin ψ e₂)`, with `e₁` in the vertical
+/// plane through `p` pointing up and `e₂ = p × e₁` horizontal, and
+/// `ρT = ∫∫ f |cos θo| sin θ dψ dθ` over the part of that sphere below the
+/// surface. The lobe is then a cap at `θ = 0` (graded as the reflected part
+/// grades the normal, so a lobe as narrow as α = 0.001 is resolved) and
+/// smooth in ψ, where the pole's coordinates would see it as a narrow
+/// feature in both angles away from normal incidence. With `β` the angle of
+/// `p` from −z, each ring `θ ≤ 90° − β` lies wholly below the surface; past
+/// it the part below is the arc `cos ψ > −cos θ cos β / (sin θ sin β)` about
+/// `ψ = 0`, which closes at `θ = 90° + β`. For a model of an interface
+/// ([`Brdf::interface_eta`]) the rule also breaks where the generalised half
 /// vector `ηi wi + ηo wo` of Walter et al. 2007 (eq. 16) turns horizontal,
-/// `cos θ' = ηi cos θi / ηo`: a microfacet BTDF whose D does not vanish at
-/// the horizon (GGX) drops to 0 across that circle, and a panel edge there
-/// keeps the rule's error estimate honest.
+/// `cos θo = −ηi cos θi / ηo`: a microfacet BTDF whose D does not vanish at
+/// the horizon (GGX) drops to 0 across that circle. It crosses each ring at
+/// azimuths found in closed form (inner breaks), and the rings that touch it
+/// are outer breaks. Other peaks below add graded outer breaks and inner
+/// breaks at their azimuths.
 fn transmitted(
     brdf: &dyn Brdf,
     wi: DVec3,
     opts: &QuadratureOptions,
 ) -> gauss_kronrod::Integral<Rgb> {
-    let peaks: Vec<(f64, f64)> = brdf
+    let below_peaks: Vec<DVec3> = brdf
         .peaks(wi)
         .into_iter()
         .filter(|p| p.is_finite() && p.z < 0.0)
-        .filter_map(|p| {
-            let p = p.try_normalize()?;
-            Some(((-p.z).clamp(-1.0, 1.0).acos(), p.y.atan2(p.x)))
+        .filter_map(|p| p.try_normalize())
+        .collect();
+    let p = below_peaks.first().copied().unwrap_or(DVec3::NEG_Z);
+    let phi_i = wi.y.atan2(wi.x);
+    let up = DVec3::Z - p.z * p;
+    let e1 = if up.length() > 1e-9 {
+        up.normalize()
+    } else {
+        // p at the pole: e₁ (any horizontal) in the plane of incidence.
+        let (s, c) = phi_i.sin_cos();
+        DVec3::new(c, s, 0.0)
+    };
+    let e2 = p.cross(e1);
+    let (sb, cb) = (e1.z.clamp(0.0, 1.0), (-p.z).clamp(0.0, 1.0));
+    let beta = sb.atan2(cb);
+    let theta_full = FRAC_PI_2 - beta;
+    let theta_end = FRAC_PI_2 + beta;
+    let at = |theta: f64, psi: f64| {
+        let (st, ct) = theta.sin_cos();
+        let (sp, cp) = psi.sin_cos();
+        ct * p - st * (cp * e1 + sp * e2)
+    };
+    // The other peaks, as (θ, ψ) about p.
+    let others: Vec<(f64, f64)> = below_peaks
+        .iter()
+        .skip(1)
+        .map(|q| {
+            let t = q.dot(p).clamp(-1.0, 1.0).acos();
+            (t, (-q.dot(e2)).atan2(-q.dot(e1)))
         })
         .collect();
-    let mut breaks = vec![0.0, FRAC_PI_2];
-    for &(t, _) in &peaks {
-        graded_about(t, 0.0, FRAC_PI_2, &mut breaks);
-    }
-    if let Some(eta) = brdf.interface_eta() {
-        // wi is above here: ηi = 1, ηo = η.
+    // The interface's circle cos θo = −c.
+    let interface = brdf.interface_eta().and_then(|eta| {
         let c = wi.z / eta;
-        if c.is_finite() && c > 0.0 && c < 1.0 {
-            breaks.push(c.acos());
-        }
+        (c.is_finite() && c > 0.0 && c < 1.0).then_some(c)
+    });
+    let mut breaks = vec![0.0, theta_end];
+    if theta_full > 0.0 && theta_full < theta_end {
+        breaks.push(theta_full);
     }
-    breaks.retain(|&x| (0.0..=FRAC_PI_2).contains(&x));
+    for &(t, _) in &others {
+        graded_about(t, 0.0, theta_end, &mut breaks);
+    }
+    if let Some(c) = interface {
+        let gamma = c.acos();
+        breaks.extend([gamma + beta, gamma - beta, beta - gamma]);
+    }
+    breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
     let mut segs = Vec::with_capacity(breaks.len());
-    let last = breaks.len().saturating_sub(2);
-    for (k, w) in breaks.windows(2).enumerate() {
-        let grading = match (k == 0, k == last) {
+    for w in breaks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let start = a == 0.0 || (a == theta_full && theta_full > 0.0);
+        let end = b == theta_end;
+        let grading = match (start, end) {
             (true, true) => gauss_kronrod::Grading::Both,
             (true, false) => gauss_kronrod::Grading::Start,
             (false, true) => gauss_kronrod::Grading::End,
             (false, false) => gauss_kronrod::Grading::Linear,
         };
-        segs.push(Segment {
-            a: w[0],
-            b: w[1],
-            grading,
-        });
+        segs.push(Segment { a, b, grading });
     }
     let anisotropic = !brdf.claims().isotropic;
-    // The azimuth the inner integrals centre on: the peak's, or wi's
-    // opposite (where a refracted lobe lies).
-    let phi_c = peaks.first().map_or(wi.y.atan2(wi.x) + PI, |&(_, p)| p);
-    // Breaks at the peaks' azimuths (and the tangent axes of an anisotropic
-    // model), the panels on either side of φc graded towards it (their first
-    // Kronrod nodes lie within 1e-4 rad of it, inside any lobe of α ≥ 0.001),
-    // the rest left to bisection, as the reflected part's are.
-    let mut phi_breaks = vec![phi_c - PI, phi_c, phi_c + PI];
-    for &(_, p) in peaks.iter().skip(1) {
-        phi_breaks.push(wrap_near(p, phi_c));
-    }
-    if anisotropic {
-        for a in [0.0, FRAC_PI_2, PI, -FRAC_PI_2] {
-            phi_breaks.push(wrap_near(a, phi_c));
-        }
-    }
-    phi_breaks.retain(|&x| x >= phi_c - PI && x <= phi_c + PI);
-    phi_breaks.sort_by(f64::total_cmp);
-    phi_breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-12);
-    let inner_segs: Vec<Segment> = phi_breaks
-        .windows(2)
-        .map(|w| Segment {
-            a: w[0],
-            b: w[1],
-            grading: if w[1] == phi_c {
-                gauss_kronrod::Grading::End
-            } else if w[0] == phi_c {
-                gauss_kronrod::Grading::Start
-            } else {
-                gauss_kronrod::Grading::Linear
-            },
-        })
-        .collect();
-    let inner_tol = 0.2 * opts.abs_tol / FRAC_PI_2;
+    // One side of the plane of incidence, doubled, when the model is
+    // symmetric about it (see `reflected`) and p lies in it.
+    let half = !anisotropic
+        && (p.z <= -1.0 + 1e-12 || in_plane(p.y.atan2(p.x), phi_i))
+        && others.iter().all(|&(t, a)| t < 1e-9 || in_plane(a, 0.0))
+        && mirror_symmetric(brdf, wi, phi_i, true);
+    let kinks = brdf.kinks(wi);
+    let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta: f64| -> (Rgb, Rgb) {
         let (st, ct) = theta.sin_cos();
-        if ct <= 0.0 {
+        // Half-width of the arc about ψ = 0 below the surface, where
+        // cos θo = −cos θ cos β − sin θ sin β cos ψ < 0.
+        let psi_max = if theta <= theta_full || sb * st <= 0.0 {
+            PI
+        } else {
+            let c0 = -ct * cb / (st * sb);
+            if c0 <= -1.0 {
+                PI
+            } else if c0 >= 1.0 {
+                0.0
+            } else {
+                c0.acos()
+            }
+        };
+        if psi_max <= 0.0 {
             return (Rgb::ZERO, Rgb::ZERO);
         }
-        let mut inner = |phi: f64| -> (Rgb, Rgb) {
-            let (sp, cp) = phi.sin_cos();
-            let wo = DVec3::new(st * cp, st * sp, -ct);
-            (brdf.eval(wi, wo) * (ct * st), Rgb::ZERO)
-        };
-        let r = gauss_kronrod::integrate(
-            &mut inner,
-            &inner_segs,
-            inner_tol,
-            0.0,
-            opts.inner_panels,
-            false,
+        let full = psi_max >= PI;
+        let (lo, hi) = (if half { 0.0 } else { -psi_max }, psi_max);
+        let mut br = vec![lo, 0.0, hi];
+        for &(_, a) in &others {
+            let a = wrap_near(a, 0.0);
+            if a > lo && a < hi {
+                br.push(a);
+            }
+        }
+        if let Some(c) = interface {
+            // cos θo = −cos θ cos β − sin θ sin β cos ψ = −c.
+            let den = st * sb;
+            if den > 0.0 {
+                let x = (c - ct * cb) / den;
+                if x.abs() < 1.0 {
+                    let a = x.acos();
+                    for a in [a, -a] {
+                        if a > lo && a < hi {
+                            br.push(a);
+                        }
+                    }
+                }
+            }
+        }
+        kink_roots(
+            &kinks,
+            |psi| {
+                let wo = at(theta, psi);
+                (wo.z < 0.0).then_some(wo)
+            },
+            lo,
+            hi,
+            &mut br,
         );
+        let mut inner = |psi: f64| -> (Rgb, Rgb) {
+            let wo = at(theta, psi);
+            if wo.z >= 0.0 {
+                return (Rgb::ZERO, Rgb::ZERO);
+            }
+            (brdf.eval(wi, wo) * (-wo.z * st), Rgb::ZERO)
+        };
+        let segs = gauss_kronrod::segments(&br, !full && !half, !full);
+        let (tol, scale) = if half {
+            (0.5 * inner_tol, 2.0)
+        } else {
+            (inner_tol, 1.0)
+        };
+        let r = gauss_kronrod::integrate(&mut inner, &segs, tol, 0.0, opts.inner_panels, false);
         inner_evals += r.evaluations;
-        (r.value, r.error)
+        (r.value * scale, r.error * scale)
     };
     let mut r = gauss_kronrod::integrate(
         &mut outer,

@@ -237,6 +237,14 @@ impl Brdf for CookTorrance {
         self.diffuse + self.ks * self.specular(wi, wo)
     }
 
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        if self.geometry == Geometry::VGroove && self.ks != 0.0 {
+            crate::microfacet::v_groove_kinks(wi)
+        } else {
+            Vec::new()
+        }
+    }
+
     fn claims(&self) -> Claims {
         // Energy. Changing variables dωo = 4 (wo·h) dω_h, the specular albedo is
         // ρs(wi) = ∫ F D G (wi·h)/cosθi dω_h (over the h that reflect wi above the

@@ -286,6 +286,10 @@ impl Brdf for Mix {
         self.parts.iter().flat_map(|p| p.brdf.peaks(wi)).collect()
     }
 
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.parts.iter().flat_map(|p| p.brdf.kinks(wi)).collect()
+    }
+
     fn is_analytic(&self) -> bool {
         self.parts.iter().all(|p| p.brdf.is_analytic())
     }

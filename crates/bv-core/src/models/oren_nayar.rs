@@ -133,6 +133,16 @@ impl Brdf for OrenNayar {
         self.albedo_over_pi * (self.a + self.b * t)
     }
 
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        // The two clamps of `eval`: the tangential parts turn perpendicular
+        // (cos Δφ = 0), and θo passes θi (α and β swap).
+        let (tx, ty, cz) = (wi.x, wi.y, wi.z);
+        vec![
+            Box::new(move |wo: DVec3| tx * wo.x + ty * wo.y),
+            Box::new(move |wo: DVec3| wo.z - cz),
+        ]
+    }
+
     fn batch_kernel(&self) -> Option<&dyn Kernel> {
         Some(&self.kernel)
     }
