@@ -68,8 +68,8 @@ fn ndf_histograms_match_d() {
     for (dist, ax, ay, n, seeds, single_tol) in [
         (SlopeDistribution::Beckmann, 0.4, 0.4, 256, 6, 0.08),
         (SlopeDistribution::Beckmann, 0.2, 0.5, 256, 6, 0.08),
-        // GGX: the roughness scale has ~(512/32)² independent patches.
-        (SlopeDistribution::Ggx, 0.3, 0.3, 512, 6, 0.15),
+        // GGX: the roughness scale has ~(512/8)² independent patches.
+        (SlopeDistribution::Ggx, 0.3, 0.3, 512, 6, 0.08),
     ] {
         let mut sum: Option<Vec<f64>> = None;
         let mut errs = Vec::new();
@@ -142,6 +142,37 @@ fn g1_of_a_beckmann_surface_matches_smith() {
     }
 }
 
+/// Masking on the GGX surface: the tracer must agree with the surface's own
+/// masking identity within 4σ at every angle (it holds for any heightfield).
+/// Against Smith's GGX G1 the surface is only approximately Smith-like
+/// (heights and slopes are correlated through the roughness scale, and its
+/// heavy tail is sampled by (256/8)² patches; the surface masks less than
+/// Smith predicts): within 4 % for θ ≤ 70°, a bound set from the deviations
+/// seen on this surface (up to 2.3 %, at α = 0.8, θ = 70°), not a property
+/// of GGX surfaces in general.
+#[test]
+fn g1_of_a_ggx_surface_matches_its_identity_and_roughly_smith() {
+    let thetas: Vec<f64> = [20.0f64, 40.0, 60.0, 70.0, 80.0]
+        .iter()
+        .map(|d| d.to_radians())
+        .collect();
+    for alpha in [0.3, 0.8] {
+        let s = surface(SlopeDistribution::Ggx, alpha, alpha, 256, 31);
+        let pts = measure::measure_g1(&s, &thetas, 0.0, 40_000, 2).unwrap();
+        for p in &pts {
+            let th = p.theta.to_degrees();
+            eprintln!(
+                "GGX α {alpha} θ {th:4.1}: measured {:.4} ± {:.4}, identity {:.4}, Smith {:.4}",
+                p.measured, p.sigma, p.identity, p.smith
+            );
+            assert!((p.measured - p.identity).abs() <= 4.0 * p.sigma + 1e-9);
+            if th <= 70.0 {
+                assert!((p.measured - p.smith).abs() <= 0.04 * p.smith);
+            }
+        }
+    }
+}
+
 /// With F = 1 every ray leaves eventually: total ρhd = 1 within 1 % (the
 /// bounce cap of 64 and lost rays are what could take energy; both are
 /// counted and must be rare).
@@ -177,11 +208,15 @@ fn furnace_total_albedo_is_one() {
 /// height-correlated G, on a Beckmann surface with α = 0.2 at θi = 30°, with
 /// a conductor F. Smith is close to exact where masking is small: at α = 0.2
 /// and these angles G differs from 1 by a few per cent, so Smith's own
-/// approximation is a fraction of that. Tolerance per bin (bins holding ≥ 2 %
-/// of the peak value): 4σ plus 8 % of the value — the surface's NDF deviates
-/// from D by its finite-size fluctuation, which the ray statistics do not
-/// include (the NDF test shows a few per cent per surface). The single-bounce
-/// ρhd must match the analytic within 3 %.
+/// approximation is a fraction of that. Per bin (bins holding ≥ 2 % of the
+/// peak value) the error bar is the start tiles' spread
+/// (`single_sigma_surface`, ray noise and the surface's own NDF fluctuation
+/// together; with the ray noise alone the z-scores spread ~4× too wide on
+/// 256² surfaces): within 4σ plus 3 % of the value (the systematic part —
+/// measured single scattering sat 1.5 % above Smith's on average over the
+/// bins of 1024² surfaces at α = 0.2 and 0.5). The z-scores must also look
+/// like errors, not noise hidden by a large σ: their RMS within [0.5, 2].
+/// The single-bounce ρhd must match the analytic within 1 %.
 #[test]
 fn single_bounce_brdf_matches_cook_torrance() {
     let s = Arc::new(surface(SlopeDistribution::Beckmann, 0.2, 0.2, 512, 21));
@@ -195,19 +230,20 @@ fn single_bounce_brdf_matches_cook_torrance() {
     let analytic: Vec<f64> = (0..bins).map(|b| g.analytic_single(&mf, b)).collect();
     let peak = analytic.iter().cloned().fold(0.0, f64::max);
     let mut checked = 0;
+    let mut z2 = 0.0;
     for (b, &a) in analytic.iter().enumerate() {
         if a < 0.02 * peak {
             continue;
         }
         checked += 1;
-        let err = (g.single[b] - a).abs();
-        assert!(
-            err <= 4.0 * g.single_sigma[b] + 0.08 * a,
-            "bin {b}: {} ± {} vs {a}",
-            g.single[b],
-            g.single_sigma[b],
-        );
+        let (m, sig) = (g.single[b], g.single_sigma_surface[b]);
+        let err = (m - a).abs();
+        z2 += ((m - a) / sig).powi(2);
+        assert!(err <= 4.0 * sig + 0.03 * a, "bin {b}: {m} ± {sig} vs {a}");
     }
+    let z_rms = (z2 / checked as f64).sqrt();
+    eprintln!("z RMS over {checked} bins: {z_rms:.2}");
+    assert!((0.5..=2.0).contains(&z_rms), "z RMS {z_rms}");
     let rho_a: f64 = (0..bins)
         .map(|b| analytic[b] * opts.bin_cos_integral(b))
         .sum();
@@ -216,7 +252,7 @@ fn single_bounce_brdf_matches_cook_torrance() {
         g.rho_single, g.rho_single_sigma, g.rho_multiple
     );
     assert!(checked >= 10);
-    assert!((g.rho_single - rho_a).abs() < 0.03 * rho_a);
+    assert!((g.rho_single - rho_a).abs() < 0.01 * rho_a);
 }
 
 /// The same seed gives the same surface and the same measurement on 1 and

@@ -31,10 +31,10 @@
 //! `√E`, `E` exponential of mean 1. The GGX surface is therefore a Gaussian
 //! surface `g` (correlation length `L`, as above) multiplied by a smooth local
 //! roughness scale `s = 1/√E`, where `E = −ln Φ(−u)` maps a second, independent
-//! Gaussian field `u` of longer correlation length `Ls` (default `8 L`) to an
+//! Gaussian field `u` of longer correlation length `Ls` (default `4 L`) to an
 //! exponential marginal. Its slope `s ∇g + g ∇s` follows GGX up to the
 //! `g ∇s` term, whose variance relative to the first is about
-//! `(L/Ls)²/2` where `s` is near its median (≈ 0.8 % for `Ls = 8L`) and grows in
+//! `(L/Ls)²/2` where `s` is near its median (≈ 3 % for `Ls = 4L`) and grows in
 //! the tail; `s` is capped at [`GGX_MAX_SCALE`] (the tail beyond, where
 //! `E < 1/S²`, is about 0.1 % of the area). Consequences for masking: heights
 //! and slopes are *correlated* on this surface (a rough patch is also a tall
@@ -107,7 +107,14 @@ pub struct SurfaceOptions {
 }
 
 impl SurfaceOptions {
-    /// Defaults (`L` = 4 cells, `Ls` = 32 cells) for a distribution and roughness.
+    /// Defaults for a distribution and roughness: Beckmann `L` = 4 cells;
+    /// GGX `L` = 2 cells and `Ls` = 8 cells. GGX's mean masking depends on
+    /// the heavy tail of its slopes, which a surface samples with only
+    /// `(N/Ls)²` independent roughness patches: with `Ls` = 32 on a 1024²
+    /// grid the measured G1(40°, α = 0.8) sat 1.3 % above Smith and the NDF's
+    /// L1 error was 0.04; with `Ls` = 8 they were 0.3 % and 0.014, at the
+    /// price of the `g ∇s` term (module doc) growing to about 3 % of the
+    /// slope variance near the median scale.
     pub fn new(
         distribution: SlopeDistribution,
         alpha_x: f64,
@@ -121,8 +128,11 @@ impl SurfaceOptions {
             alpha_y,
             size,
             seed,
-            correlation_cells: 4.0,
-            scale_cells: 32.0,
+            correlation_cells: match distribution {
+                SlopeDistribution::Beckmann => 4.0,
+                SlopeDistribution::Ggx => 2.0,
+            },
+            scale_cells: 8.0,
         }
     }
 
@@ -191,6 +201,9 @@ pub struct Surface {
     heights: Vec<f64>,
     hmin: f64,
     hmax: f64,
+    /// Block maxima for the tracer's skipping (coarsest last): block side in
+    /// cells and the highest vertex of each block (its far edge included).
+    blocks: Vec<(usize, Vec<f64>)>,
 }
 
 /// Splitmix64: decorrelated seeds for streams derived from one seed.
@@ -289,7 +302,7 @@ impl Surface {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
                 (lo.min(h), hi.max(h))
             });
-        Ok(Self {
+        let mut s = Self {
             opts: *opts,
             n,
             dx: 1.0 / opts.alpha_x,
@@ -297,7 +310,49 @@ impl Surface {
             heights,
             hmin,
             hmax,
-        })
+            blocks: Vec::new(),
+        };
+        s.blocks = s.block_maxima();
+        Ok(s)
+    }
+
+    /// Maxima over blocks of 8 and 64 cells (those no larger than the grid).
+    fn block_maxima(&self) -> Vec<(usize, Vec<f64>)> {
+        let n = self.n;
+        let mut out: Vec<(usize, Vec<f64>)> = Vec::new();
+        // Level 0: cells (each cell's four corners).
+        let mut prev_b = 1usize;
+        let mut prev: Vec<f64> = (0..n * n)
+            .map(|k| {
+                let (i, j) = (k % n, k / n);
+                self.height(i, j)
+                    .max(self.height(i + 1, j))
+                    .max(self.height(i, j + 1))
+                    .max(self.height(i + 1, j + 1))
+            })
+            .collect();
+        for b in [8usize, 64] {
+            if b > n {
+                break;
+            }
+            let (nb, np, f) = (n / b, n / prev_b, b / prev_b);
+            let mut cur = vec![f64::NEG_INFINITY; nb * nb];
+            for (k, m) in prev.iter().enumerate() {
+                let (i, j) = (k % np, k / np);
+                let c = &mut cur[(j / f) * nb + i / f];
+                *c = c.max(*m);
+            }
+            out.push((b, cur.clone()));
+            prev = cur;
+            prev_b = b;
+        }
+        out.reverse();
+        out
+    }
+
+    /// Block maxima, coarsest first: (block side in cells, maxima row-major).
+    pub fn blocks(&self) -> &[(usize, Vec<f64>)] {
+        &self.blocks
     }
 
     /// The options it was generated with.

@@ -49,25 +49,65 @@ pub fn trace(s: &Surface, origin: DVec3, dir: DVec3, skip: Option<FacetId>) -> H
         return Hit::Escaped;
     }
     let eps_t = 1e-9 * (dx.max(dy) + (hmax - hmin));
-    let mut ci = (origin.x / dx).floor() as i64;
-    let mut cj = (origin.y / dy).floor() as i64;
-    let (step_x, mut tmx, tdx) = axis(origin.x, dir.x, ci, dx);
-    let (step_y, mut tmy, tdy) = axis(origin.y, dir.y, cj, dy);
-    let mut t_enter = 0.0f64;
     let nm = n as i64;
-    for _ in 0..MAX_CELLS {
-        let t_exit = tmx.min(tmy);
-        let (i, j) = (ci.rem_euclid(nm) as usize, cj.rem_euclid(nm) as usize);
-        let z0 = origin.z + t_enter * dir.z;
-        let z1 = if t_exit.is_finite() {
-            origin.z + t_exit * dir.z
+    let z_at = |t: f64| {
+        if t.is_finite() {
+            origin.z + t * dir.z
         } else if dir.z > 0.0 {
             f64::INFINITY
         } else if dir.z < 0.0 {
             f64::NEG_INFINITY
         } else {
             origin.z
-        };
+        }
+    };
+    let mut ci = (origin.x / dx).floor() as i64;
+    let mut cj = (origin.y / dy).floor() as i64;
+    let (step_x, mut tmx, tdx) = axis(origin.x, dir.x, ci, dx);
+    let (step_y, mut tmy, tdy) = axis(origin.y, dir.y, cj, dy);
+    let mut t_enter = 0.0f64;
+    'cells: for _ in 0..MAX_CELLS {
+        // Skip whole blocks the ray passes above (coarsest first): the
+        // segment's lowest point is at one of its ends.
+        for (b, maxima) in s.blocks() {
+            let b = *b as i64;
+            let nb = nm / b;
+            let (bi, bj) = (ci.div_euclid(b), cj.div_euclid(b));
+            let bmax = maxima[(bj.rem_euclid(nb) * nb + bi.rem_euclid(nb)) as usize];
+            let tbx = boundary(origin.x, dir.x, bi * b, b, dx);
+            let tby = boundary(origin.y, dir.y, bj * b, b, dy);
+            let tb = tbx.min(tby);
+            if z_at(t_enter).min(z_at(tb)) <= bmax + eps_t {
+                continue;
+            }
+            if dir.z > 0.0 && z_at(tb) > hmax {
+                return Hit::Escaped;
+            }
+            if !tb.is_finite() {
+                return Hit::Lost;
+            }
+            // Into the next block: the axis (or axes) whose boundary comes
+            // first steps across it; the other takes the cell at that point.
+            t_enter = tb;
+            let p = origin + tb * dir;
+            ci = if tbx <= tby {
+                if step_x > 0 { (bi + 1) * b } else { bi * b - 1 }
+            } else {
+                (p.x / dx).floor() as i64
+            };
+            cj = if tby <= tbx {
+                if step_y > 0 { (bj + 1) * b } else { bj * b - 1 }
+            } else {
+                (p.y / dy).floor() as i64
+            };
+            tmx = axis(origin.x, dir.x, ci, dx).1;
+            tmy = axis(origin.y, dir.y, cj, dy).1;
+            continue 'cells;
+        }
+        let t_exit = tmx.min(tmy);
+        let (i, j) = (ci.rem_euclid(nm) as usize, cj.rem_euclid(nm) as usize);
+        let z0 = z_at(t_enter);
+        let z1 = z_at(t_exit);
         let cell_max = s
             .height(i, j)
             .max(s.height(i + 1, j))
@@ -127,6 +167,18 @@ pub fn trace(s: &Surface, origin: DVec3, dir: DVec3, skip: Option<FacetId>) -> H
         }
     }
     Hit::Lost
+}
+
+/// Parameter where the ray leaves the block starting at cell `c0` (side
+/// `b` cells of size `size`) along one axis; infinite if it does not move.
+fn boundary(o: f64, d: f64, c0: i64, b: i64, size: f64) -> f64 {
+    if d > 0.0 {
+        ((c0 + b) as f64 * size - o) / d
+    } else if d < 0.0 {
+        (c0 as f64 * size - o) / d
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// DDA set-up along one axis: step, parameter of the first cell boundary,
