@@ -170,3 +170,42 @@ pub fn request(
         },
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The view's job runs to its end: with F = 1 the surface returns all the
+    /// light (ρ = 1 up to the dropped rays), its G1 at θi agrees with Smith
+    /// within 3σ + 2 % (a Beckmann surface, where Smith is accurate), and
+    /// the single-scattering model keeps less than the whole.
+    #[test]
+    fn the_job_finishes_with_consistent_numbers() {
+        let wi = measure::direction(60f64.to_radians(), 0.4);
+        let mut job = Job {
+            opts: SurfaceOptions::new(SlopeDistribution::Beckmann, 0.6, 0.6, SIZE, 1),
+            wi,
+            phase: Phase::Start,
+        };
+        let sim = jobs::run_to_end(|| job.step());
+        let g = &sim.gonio;
+        assert_eq!(g.rays, RAYS);
+        assert!((g.rho() - 1.0).abs() <= (g.dropped + g.lost) as f64 / RAYS as f64 + 1e-12);
+        assert!(g.rho_multiple > 0.02, "{}", g.rho_multiple);
+        assert!(sim.analytic_rho > 0.5 && sim.analytic_rho < 1.0);
+        let p = &sim.g1;
+        assert!(
+            (p.measured - p.smith).abs() <= 3.0 * p.sigma + 0.02 * p.smith,
+            "{} ± {} vs {}",
+            p.measured,
+            p.sigma,
+            p.smith
+        );
+        assert!(!sim.paths.is_empty());
+        assert!(
+            sim.paths
+                .iter()
+                .all(|(path, dir)| path.len() >= 2 && dir.z > 0.0)
+        );
+    }
+}
