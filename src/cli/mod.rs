@@ -10,7 +10,8 @@
 //! - [`bench`]: batch evaluation speed;
 //! - [`render`]: figures without a window (PNG, SVG, OBJ/PLY);
 //! - [`slice`]: the plotted curves as numbers (CSV);
-//! - [`scene`]: check, print and create scene files.
+//! - [`scene`]: check, print and create scene files;
+//! - [`simulate`]: the virtual gonioreflectometer on a random microsurface.
 //!
 //! Errors are reported as `bv: <message>` on stderr with a non-zero exit
 //! status; nothing a user types makes the program panic.
@@ -25,6 +26,7 @@ pub mod output;
 pub mod params;
 pub mod render;
 pub mod scene;
+pub mod simulate;
 pub mod slice;
 pub mod tabulate;
 pub mod viewer_args;
@@ -77,6 +79,8 @@ pub enum Command {
     Slice(slice::SliceArgs),
     /// Check, print or create scene files.
     Scene(scene::SceneArgs),
+    /// Ray-trace a random microsurface: G1, NDF, BRDF and ρhd against the analytic model.
+    Simulate(simulate::SimulateArgs),
 }
 
 /// What the command line needs from the window above it: the binary wires
@@ -119,6 +123,7 @@ pub fn main(shell: &Shell) -> ExitCode {
         Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Render(a)) => render::run(a, shell).map(|()| ExitCode::SUCCESS),
         Some(Command::Slice(a)) => slice::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Simulate(a)) => simulate::run(a),
         Some(Command::Scene(a)) => {
             let argv: Vec<String> = std::env::args().collect();
             scene::run(a, &argv).map(|()| ExitCode::SUCCESS)

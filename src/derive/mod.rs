@@ -19,6 +19,7 @@ pub mod compare;
 pub mod factor;
 pub mod interface;
 pub mod jobs;
+pub mod microsurface;
 pub mod properties;
 pub mod reciprocity;
 pub mod sampling;

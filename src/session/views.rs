@@ -109,6 +109,13 @@ pub const FACTOR: ViewInfo = ViewInfo {
     in_grid: false,
 };
 
+/// A simulated rough surface and its virtual gonioreflectometer.
+pub const MICROSURFACE: ViewInfo = ViewInfo {
+    id: "microsurface",
+    title: "Microsurface (simulated)",
+    in_grid: false,
+};
+
 /// Every view, in layout order (the first two share the top row, the others
 /// fill the rows below).
 pub const VIEWS: &[ViewInfo] = &[
@@ -125,6 +132,7 @@ pub const VIEWS: &[ViewInfo] = &[
     TERMS,
     SAMPLING,
     FACTOR,
+    MICROSURFACE,
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

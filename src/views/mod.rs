@@ -25,6 +25,7 @@ pub mod image_slice;
 pub mod lit_sphere;
 pub mod lobe3d;
 pub mod lobe_gpu;
+pub mod microsurface;
 pub mod polar;
 pub mod reciprocity;
 pub mod sampling;
@@ -186,6 +187,9 @@ const CONSTRUCTORS: &[(views::ViewInfo, MakeView)] = &[
         Box::new(sampling::SamplingView::default())
     }),
     (views::FACTOR, || Box::new(factor::FactorView::default())),
+    (views::MICROSURFACE, || {
+        Box::new(microsurface::MicrosurfaceView::default())
+    }),
 ];
 
 /// The constructor of the view `v`.
