@@ -21,6 +21,7 @@ pub mod fsio;
 pub mod lobe;
 pub mod measured;
 pub mod microfacet;
+pub mod multiscatter;
 pub mod model;
 pub mod models;
 pub mod optics;
