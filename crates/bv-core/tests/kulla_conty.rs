@@ -21,8 +21,10 @@ fn model(params: Value) -> Box<dyn Brdf> {
 
 /// A white-furnace Cook-Torrance: F = 1, no diffuse, ks = 1.
 fn furnace(dist: &str, geo: &str, alpha: f64, ms: &str) -> Box<dyn Brdf> {
-    model(json!({"distribution": dist, "geometry": geo, "alpha": alpha,
-        "fresnel": "none", "kd": 0.0, "ks": 1.0, "multiscatter": ms}))
+    model(
+        json!({"distribution": dist, "geometry": geo, "alpha": alpha,
+        "fresnel": "none", "kd": 0.0, "ks": 1.0, "multiscatter": ms}),
+    )
 }
 
 /// `∫ f(wi, wo) cosθo dωo` (channel mean) by the midpoint rule over
@@ -231,8 +233,8 @@ fn coloured_fresnel_term_adds_f_ms_times_the_loss() {
     for th in [0.0f64, 50.0, 80.0] {
         let wi = from_spherical(th.to_radians(), 0.0);
         let loss = 1.0 - e(wi.z);
-        let added = brute_albedo(both.as_ref(), wi, 0.7, 300)
-            - brute_albedo(single.as_ref(), wi, 0.7, 300);
+        let added =
+            brute_albedo(both.as_ref(), wi, 0.7, 300) - brute_albedo(single.as_ref(), wi, 0.7, 300);
         let want = (f_ms.x + f_ms.y + f_ms.z) / 3.0 * loss;
         assert!(
             (added - want).abs() < 2e-3,
@@ -247,20 +249,17 @@ fn coloured_fresnel_term_adds_f_ms_times_the_loss() {
 /// αx/αy = 2 (the rough direction keeps less than the mean).
 #[test]
 fn anisotropic_compensation_is_one_on_average() {
-    let b = model(json!({"distribution": "ggx", "geometry": "smith-correlated",
+    let b = model(
+        json!({"distribution": "ggx", "geometry": "smith-correlated",
         "alpha_x": 0.8, "alpha_y": 0.4, "fresnel": "none", "kd": 0.0, "ks": 1.0,
-        "multiscatter": "kulla-conty"}));
+        "multiscatter": "kulla-conty"}),
+    );
     for th in [0.0f64, 60.0, 85.0] {
         let n_phi = 8;
         let mut mean = 0.0;
         for j in 0..n_phi {
             let phi = (j as f64 + 0.5) * 0.5 * PI / n_phi as f64;
-            let rho = brute_albedo(
-                b.as_ref(),
-                from_spherical(th.to_radians(), phi),
-                0.57,
-                400,
-            );
+            let rho = brute_albedo(b.as_ref(), from_spherical(th.to_radians(), phi), 0.57, 400);
             println!("θ {th} φ {phi:.3}: ρhd {rho:.4}");
             assert!((rho - 1.0).abs() < 0.1, "θ {th} φ {phi}: {rho}");
             mean += rho / n_phi as f64;
@@ -269,4 +268,3 @@ fn anisotropic_compensation_is_one_on_average() {
         assert!((mean - 1.0).abs() < 2e-3, "θ {th}: mean {mean}");
     }
 }
-
