@@ -4,7 +4,9 @@
 // bv_core::models::cook_torrance): Blinn's normalisation constants for
 // alpha_x and alpha2; Kulla & Conty's (2017) multiple-scattering colour
 // ks-free F_ms / (π (1 − E_avg)) (all 0 with multiscatter = none) and the
-// directional albedo table E of bv_core::multiscatter (MS_TABLE_LEN entries
+// table of the loss 1 − E of the directional albedo E of
+// bv_core::multiscatter (formed in f64: an f32 E near 1 would lose the
+// loss's digits; MS_TABLE_LEN entries
 // uniform in √μ, interpolated linearly in μ as bv_core::multiscatter::lookup).
 #define_import_path bv::models::cook_torrance
 
@@ -15,22 +17,22 @@
 #import bv::frame::INV_PI
 #import bv::fresnel::fresnel
 #import bv::microfacet::{Scale, mixture_d, mixture_g}
-#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_BLINN_NORM, COOK_TORRANCE_BLINN_NORM2, COOK_TORRANCE_MS_R, COOK_TORRANCE_MS_G, COOK_TORRANCE_MS_B, COOK_TORRANCE_MS_E0}
+#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_BLINN_NORM, COOK_TORRANCE_BLINN_NORM2, COOK_TORRANCE_MS_R, COOK_TORRANCE_MS_G, COOK_TORRANCE_MS_B, COOK_TORRANCE_MS_L0}
 
 // bv_core::multiscatter::TABLE_LEN.
 const MS_TABLE_LEN: u32 = 64u;
 
-// E(μ) from the table (bv_core::multiscatter::lookup).
-// The cell is found in √μ, the weight is linear in μ.
-fn ms_e(o: u32, mu_in: f32) -> f32 {
+// 1 − E(μ) from the table (bv_core::multiscatter::lookup): the cell is
+// found in √μ, the weight is linear in μ.
+fn ms_loss(o: u32, mu_in: f32) -> f32 {
     let mu = clamp(mu_in, 0.0, 1.0);
     let n = f32(MS_TABLE_LEN - 1u);
     let i = min(u32(floor(sqrt(mu) * n)), MS_TABLE_LEN - 2u);
     let s0 = f32(i) / n;
     let s1 = f32(i + 1u) / n;
     let t = clamp((mu - s0 * s0) / (s1 * s1 - s0 * s0), 0.0, 1.0);
-    let e0 = pf(o + COOK_TORRANCE_MS_E0 + i);
-    let e1 = pf(o + COOK_TORRANCE_MS_E0 + i + 1u);
+    let e0 = pf(o + COOK_TORRANCE_MS_L0 + i);
+    let e1 = pf(o + COOK_TORRANCE_MS_L0 + i + 1u);
     return e0 * (1.0 - t) + e1 * t;
 }
 
@@ -41,7 +43,7 @@ fn multiple(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (all(c == vec3<f32>(0.0))) {
         return vec3<f32>(0.0);
     }
-    return c * ((1.0 - ms_e(o, wi.z)) * (1.0 - ms_e(o, wo.z)));
+    return c * (ms_loss(o, wi.z) * ms_loss(o, wo.z));
 }
 
 fn first_scale(o: u32) -> Scale {

@@ -335,8 +335,11 @@ impl KullaConty {
         mean_rgb(self.f_ms).max(0.0) * (1.0 - e_min)
     }
 
-    /// The E table in f32, for the batch kernel and the GPU.
-    pub fn nodes_f32(&self) -> [f32; TABLE_LEN] {
-        self.table.nodes().map(|x| x as f32)
+    /// The loss `1 − E` at the nodes in f32, for the batch kernel and the
+    /// GPU: subtracted in f64 here, because a smooth lobe keeps E within
+    /// 1e-6 of 1 at most angles while `1/(π (1 − E_avg))` is large, and
+    /// `1 − E` formed from an f32 E would lose most of its digits.
+    pub fn loss_f32(&self) -> [f32; TABLE_LEN] {
+        self.table.nodes().map(|x| (1.0 - x) as f32)
     }
 }

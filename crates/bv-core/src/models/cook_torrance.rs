@@ -131,78 +131,78 @@ pub static INFO: ModelInfo = ModelInfo {
 /// normalisation constant for `alpha_x` and for `alpha2`, 0 unless the
 /// distribution is `blinn` (each costs a quadrature, done once here rather
 /// than per shaded pixel); then Kulla–Conty's colour `F_ms / (π (1 − E_avg))`
-/// (0 with `multiscatter = none`) and its E table ([`TABLE_LEN`] entries
-/// uniform in √μ, `crate::multiscatter`).
+/// (0 with `multiscatter = none`) and its table of the loss 1 − E
+/// ([`TABLE_LEN`] entries uniform in √μ, `crate::multiscatter`).
 const DERIVED_SLOTS: &[&str] = &[
     "blinn_norm",
     "blinn_norm2",
     "ms_r",
     "ms_g",
     "ms_b",
-    "ms_e0",
-    "ms_e1",
-    "ms_e2",
-    "ms_e3",
-    "ms_e4",
-    "ms_e5",
-    "ms_e6",
-    "ms_e7",
-    "ms_e8",
-    "ms_e9",
-    "ms_e10",
-    "ms_e11",
-    "ms_e12",
-    "ms_e13",
-    "ms_e14",
-    "ms_e15",
-    "ms_e16",
-    "ms_e17",
-    "ms_e18",
-    "ms_e19",
-    "ms_e20",
-    "ms_e21",
-    "ms_e22",
-    "ms_e23",
-    "ms_e24",
-    "ms_e25",
-    "ms_e26",
-    "ms_e27",
-    "ms_e28",
-    "ms_e29",
-    "ms_e30",
-    "ms_e31",
-    "ms_e32",
-    "ms_e33",
-    "ms_e34",
-    "ms_e35",
-    "ms_e36",
-    "ms_e37",
-    "ms_e38",
-    "ms_e39",
-    "ms_e40",
-    "ms_e41",
-    "ms_e42",
-    "ms_e43",
-    "ms_e44",
-    "ms_e45",
-    "ms_e46",
-    "ms_e47",
-    "ms_e48",
-    "ms_e49",
-    "ms_e50",
-    "ms_e51",
-    "ms_e52",
-    "ms_e53",
-    "ms_e54",
-    "ms_e55",
-    "ms_e56",
-    "ms_e57",
-    "ms_e58",
-    "ms_e59",
-    "ms_e60",
-    "ms_e61",
-    "ms_e62",
-    "ms_e63",
+    "ms_l0",
+    "ms_l1",
+    "ms_l2",
+    "ms_l3",
+    "ms_l4",
+    "ms_l5",
+    "ms_l6",
+    "ms_l7",
+    "ms_l8",
+    "ms_l9",
+    "ms_l10",
+    "ms_l11",
+    "ms_l12",
+    "ms_l13",
+    "ms_l14",
+    "ms_l15",
+    "ms_l16",
+    "ms_l17",
+    "ms_l18",
+    "ms_l19",
+    "ms_l20",
+    "ms_l21",
+    "ms_l22",
+    "ms_l23",
+    "ms_l24",
+    "ms_l25",
+    "ms_l26",
+    "ms_l27",
+    "ms_l28",
+    "ms_l29",
+    "ms_l30",
+    "ms_l31",
+    "ms_l32",
+    "ms_l33",
+    "ms_l34",
+    "ms_l35",
+    "ms_l36",
+    "ms_l37",
+    "ms_l38",
+    "ms_l39",
+    "ms_l40",
+    "ms_l41",
+    "ms_l42",
+    "ms_l43",
+    "ms_l44",
+    "ms_l45",
+    "ms_l46",
+    "ms_l47",
+    "ms_l48",
+    "ms_l49",
+    "ms_l50",
+    "ms_l51",
+    "ms_l52",
+    "ms_l53",
+    "ms_l54",
+    "ms_l55",
+    "ms_l56",
+    "ms_l57",
+    "ms_l58",
+    "ms_l59",
+    "ms_l60",
+    "ms_l61",
+    "ms_l62",
+    "ms_l63",
 ];
 
 // The slot list spells the table out: keep it the table's length.
@@ -223,7 +223,7 @@ fn derive_slots(spec: &ModelSpec, _tables: &mut dyn GpuTables) -> Result<Vec<f32
     match parts.multiscatter() {
         Some(ms) => {
             v.extend([ms.scale.x as f32, ms.scale.y as f32, ms.scale.z as f32]);
-            v.extend(ms.nodes_f32());
+            v.extend(ms.loss_f32());
         }
         None => v.extend([0.0; 3 + TABLE_LEN]),
     }
@@ -543,8 +543,8 @@ struct CtKernel {
     mix: bool,
     geometry: u8,
     fresnel: FresnelLanes,
-    /// Kulla–Conty: `ks F_ms / (π (1 − E_avg))` per channel and the E table,
-    /// when chosen.
+    /// Kulla–Conty: `ks F_ms / (π (1 − E_avg))` per channel and the table of
+    /// the loss 1 − E, when chosen.
     multiscatter: Option<([f32; 3], [f32; TABLE_LEN])>,
 }
 
@@ -587,15 +587,15 @@ impl CtKernel {
             fresnel: FresnelLanes::new(fresnel),
             multiscatter: multiscatter.map(|ms| {
                 let c = ms.scale * ks;
-                ([c.x as f32, c.y as f32, c.z as f32], ms.nodes_f32())
+                ([c.x as f32, c.y as f32, c.z as f32], ms.loss_f32())
             }),
         })
     }
 }
 
-/// `E(μ)` per lane from the table (`multiscatter::lookup`'s arithmetic in
-/// f32, as the WGSL port does it): lanes have no gather, so through a
-/// scalar loop over the stored lanes.
+/// `1 − E(μ)` per lane from the loss table (`multiscatter::lookup`'s
+/// arithmetic in f32, as the WGSL port does it): lanes have no gather, so
+/// through a scalar loop over the stored lanes.
 #[inline(always)]
 fn lookup_lanes<V: Lanes>(e: &[f32; TABLE_LEN], mu: V) -> V {
     const MAX_LANES: usize = 64;
@@ -672,8 +672,8 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
         match &k.multiscatter {
             // Kulla–Conty's lobe (see `crate::multiscatter`): a branch on the
             // model's choice, the same for every lane.
-            Some((c, e)) => {
-                let m = (one - lookup_lanes(e, wi[2])) * (one - lookup_lanes(e, wo[2]));
+            Some((c, loss)) => {
+                let m = lookup_lanes(loss, wi[2]) * lookup_lanes(loss, wo[2]);
                 math::channels!(|ch| above.select(fr[ch] * scalar + k.diffuse[ch] + m * c[ch], zero))
             }
             None => math::channels!(|c| above.select(fr[c] * scalar + k.diffuse[c], zero)),
