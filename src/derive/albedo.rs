@@ -215,10 +215,23 @@ impl AlbedoData {
 
     /// Whether some channel exceeds 1 by more than its error band somewhere.
     pub fn exceeds_one(&self) -> bool {
-        self.rho.iter().any(|e| {
-            let band = e.allowance(BAND_SIGMAS);
-            (0..3).any(|c| e.value[c] - band[c] > 1.0 + 1e-9)
-        })
+        self.excess_over_one().is_some()
+    }
+
+    /// By how much the curve exceeds 1 beyond its error band at most (over
+    /// θi and channels), `None` where it never does: a model that is 1 up
+    /// to a tabulated approximation's error (Kulla–Conty's compensation in
+    /// the furnace) says by how little.
+    pub fn excess_over_one(&self) -> Option<f64> {
+        let m = self
+            .rho
+            .iter()
+            .flat_map(|e| {
+                let band = e.allowance(BAND_SIGMAS);
+                (0..3).map(move |c| e.value[c] - band[c] - 1.0)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        (m > 1e-9).then_some(m)
     }
 
     /// How the numbers were computed, for the legend: `quadrature` or

@@ -104,13 +104,31 @@ fn legend_label(s: &Shown) -> String {
         if s.furnace { " E (F = 1)" } else { "" },
         mean_rgb(hh.value),
     );
-    if s.data.exceeds_one() {
-        l.push_str(" (ρhd > 1!)");
+    match s.data.excess_over_one() {
+        // Within a thousandth: say by how much (an approximation's error,
+        // not a model creating energy).
+        Some(e) if e < 1e-3 => l.push_str(&format!(" (ρhd ≤ 1 + {e:.0e})")),
+        Some(_) => l.push_str(" (ρhd > 1!)"),
+        None => {}
     }
     if s.stale {
         l.push_str(" (updating)");
     }
     l
+}
+
+/// The top of the y axis, leaving `legend_h` points of a plot `plot_h`
+/// points tall above ρ = 1 for the legend box under the furnace switch
+/// (where the curves to read run along 1 and a legend in a top corner would
+/// cover them).
+fn y_top_with_legend(shown: &[Shown], legend: bool, plot_h: f32) -> f64 {
+    let top = y_top(shown);
+    if !legend || !shown.iter().any(|s| s.furnace) {
+        return top;
+    }
+    let lines: usize = shown.iter().map(|s| series_of(s).len()).sum();
+    let frac = ((lines as f32 * 18.0 + 24.0) / plot_h.max(1.0)).min(0.6) as f64;
+    top.max(1.03 / (1.0 - frac))
 }
 
 fn y_top(shown: &[Shown]) -> f64 {
@@ -244,7 +262,7 @@ fn legend_corner(shown: &[Shown], top: f64, size: egui::Vec2) -> Corner {
 }
 
 const Y_LABEL: &str = "ρhd (mean of r, g, b)";
-const Y_LABEL_FURNACE: &str = "E with F = 1, kd = 0, and 1 − E (mean of r, g, b)";
+const Y_LABEL_FURNACE: &str = "E (F = 1, kd = 0) and 1 − E";
 
 fn y_label(scene: &Scene<'_>) -> &'static str {
     if scene.state.plots.albedo.furnace {
@@ -286,8 +304,8 @@ impl View for AlbedoView {
                     .text(format!("computing ρhd: {done}/{total} steps")),
             );
         }
-        let top = y_top(&shown);
         let size = ui.available_size();
+        let top = y_top_with_legend(&shown, !scene.presenting, size.y);
         let light = super::light_color(dark);
         // Presenting, the legend is a column beside the plot: its long
         // lines (ρhh of each) covered a curve in every corner of a plot
@@ -424,7 +442,7 @@ impl View for AlbedoView {
 
     fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
         let shown = self.update(scene, None);
-        let top = y_top(&shown);
+        let top = y_top_with_legend(&shown, true, size[1]);
         let xm = x_max(&shown);
         let mut c = Chart {
             x_label: X_LABEL.into(),
