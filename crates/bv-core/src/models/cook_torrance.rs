@@ -731,6 +731,44 @@ mod tests {
     }
 
     #[test]
+    fn furnace_is_the_lobe_with_f_one_and_no_diffuse() {
+        // The hook the albedo view's furnace switch calls: the same D, G, α
+        // and multiple-scattering choice, F = 1, kd = 0, ks = 1.
+        for ms in MULTISCATTER_OPTIONS {
+            let b = model(
+                json!({"kd": [0.3, 0.2, 0.1], "ks": 0.6, "distribution": "ggx",
+                "alpha_x": 0.5, "alpha_y": 0.5, "geometry": "smith", "fresnel": "conductor",
+                "multiscatter": ms}),
+            );
+            let want = model(json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx",
+                "alpha_x": 0.5, "alpha_y": 0.5, "geometry": "smith", "fresnel": "none",
+                "multiscatter": ms}));
+            let f = b.furnace().unwrap();
+            for (wi, wo) in [
+                (from_spherical(0.2, 0.1), from_spherical(1.1, 2.9)),
+                (from_spherical(1.4, -0.4), from_spherical(0.6, 1.7)),
+            ] {
+                assert_eq!(f.eval(wi, wo), want.eval(wi, wo), "{ms}");
+            }
+            assert_eq!(f.pdf(DVec3::Z, DVec3::Z), want.pdf(DVec3::Z, DVec3::Z));
+        }
+        let l = ModelSpec::new("lambert").unwrap().build().unwrap();
+        assert!(l.furnace().is_none());
+    }
+
+    #[test]
+    fn multiscatter_none_is_the_default_and_applies_only_with_ks() {
+        let d = ModelSpec::new("cook-torrance").unwrap();
+        assert_eq!(d.params().text("multiscatter").unwrap(), "none");
+        let decl = INFO.param("multiscatter").unwrap();
+        assert!(decl.applies_to(d.params()));
+        let mut off = d.clone();
+        off.set("ks", crate::ParamValue::Float(0.0)).unwrap();
+        assert!(!decl.applies_to(off.params()));
+        assert_eq!(decl.applies_text().unwrap(), "ks > 0");
+    }
+
+    #[test]
     fn normal_incidence_hand_value() {
         // wi = wo = n: h = n, D = 1/(π αx αy) (Beckmann and GGX), F = F(0),
         // G = 1 for every geometry; f = kd/π + ks F(0) / (4π αx αy).
