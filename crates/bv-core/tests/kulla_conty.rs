@@ -6,6 +6,9 @@
 //! with `bv_core::multiscatter`'s half-vector Gauss–Legendre tables but the
 //! model's f64 `eval`.
 
+// Test code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv_core::frame::from_spherical;
 use bv_core::{Brdf, ModelSpec};
 use glam::DVec3;

@@ -441,9 +441,10 @@ impl Brdf for CookTorrance {
         //   `tests/kulla_conty.rs`): no claim then. The table's error (below
         //   1e-3, `crate::multiscatter`) can put ρhd a few 1e-4 above 1 at
         //   ks = 1, F = 1, so the claim keeps that margin: kd + ks (1 + 1e-3) ≤ 1.
-        let provable = !(self.ndf.first.dist == Distribution::Blinn
-            && matches!(self.geometry, Geometry::Smith | Geometry::SmithCorrelated))
-            && !(self.multiscatter.is_some() && !self.ndf.is_isotropic());
+        let blinn_smith = self.ndf.first.dist == Distribution::Blinn
+            && matches!(self.geometry, Geometry::Smith | Geometry::SmithCorrelated);
+        let azimuth_mean = self.multiscatter.is_some() && !self.ndf.is_isotropic();
+        let provable = !blinn_smith && !azimuth_mean;
         Claims {
             // D, G (both Smith forms, and v-groove with wi·h = wo·h), F(wi·h) and
             // the cosines are all symmetric in (wi, wo).
