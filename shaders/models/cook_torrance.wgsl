@@ -2,7 +2,12 @@
 // kd/π + ks F(wi·h) D(h) G(wi, wo) / (4 cosθi cosθo), D, G, F by choice.
 // Derived slots after the block (declared and computed with the model in
 // bv_core::models::cook_torrance): Blinn's normalisation constants for
-// alpha_x and alpha2.
+// alpha_x and alpha2; Kulla & Conty's (2017) multiple-scattering colour
+// ks-free F_ms / (π (1 − E_avg)) (all 0 with multiscatter = none) and the
+// table of the loss 1 − E of the directional albedo E of
+// bv_core::multiscatter (formed in f64: an f32 E near 1 would lose the
+// loss's digits; MS_TABLE_LEN entries
+// uniform in √μ, interpolated linearly in μ as bv_core::multiscatter::lookup).
 #define_import_path bv::models::cook_torrance
 
 #import bv::sampling_lobe::{Lobe, LOBE_NONE, mean3, p_cos_of, alpha_of_exponent, none_lobe, power_lobe, ggx_lobe}
@@ -12,7 +17,34 @@
 #import bv::frame::INV_PI
 #import bv::fresnel::fresnel
 #import bv::microfacet::{Scale, mixture_d, mixture_g}
-#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_BLINN_NORM, COOK_TORRANCE_BLINN_NORM2}
+#import bv::layout::{COOK_TORRANCE_KD, COOK_TORRANCE_KS, COOK_TORRANCE_DISTRIBUTION, COOK_TORRANCE_ALPHA_X, COOK_TORRANCE_ALPHA_Y, COOK_TORRANCE_GEOMETRY, COOK_TORRANCE_FRESNEL, COOK_TORRANCE_ETA, COOK_TORRANCE_K, COOK_TORRANCE_F0, COOK_TORRANCE_ALPHA2, COOK_TORRANCE_WEIGHT2, COOK_TORRANCE_BLINN_NORM, COOK_TORRANCE_BLINN_NORM2, COOK_TORRANCE_MS_R, COOK_TORRANCE_MS_G, COOK_TORRANCE_MS_B, COOK_TORRANCE_MS_L0}
+
+// bv_core::multiscatter::TABLE_LEN.
+const MS_TABLE_LEN: u32 = 32u;
+
+// 1 − E(μ) from the table (bv_core::multiscatter::lookup): the cell is
+// found in √μ, the weight is linear in μ.
+fn ms_loss(o: u32, mu_in: f32) -> f32 {
+    let mu = clamp(mu_in, 0.0, 1.0);
+    let n = f32(MS_TABLE_LEN - 1u);
+    let i = min(u32(floor(sqrt(mu) * n)), MS_TABLE_LEN - 2u);
+    let s0 = f32(i) / n;
+    let s1 = f32(i + 1u) / n;
+    let t = clamp((mu - s0 * s0) / (s1 * s1 - s0 * s0), 0.0, 1.0);
+    let e0 = pf(o + COOK_TORRANCE_MS_L0 + i);
+    let e1 = pf(o + COOK_TORRANCE_MS_L0 + i + 1u);
+    return e0 * (1.0 - t) + e1 * t;
+}
+
+// Kulla–Conty's F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg)) without ks;
+// 0 without multiscatter (its colour slots are 0).
+fn multiple(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let c = vec3<f32>(pf(o + COOK_TORRANCE_MS_R), pf(o + COOK_TORRANCE_MS_G), pf(o + COOK_TORRANCE_MS_B));
+    if (all(c == vec3<f32>(0.0))) {
+        return vec3<f32>(0.0);
+    }
+    return c * (ms_loss(o, wi.z) * ms_loss(o, wo.z));
+}
 
 fn first_scale(o: u32) -> Scale {
     return Scale(pu(o + COOK_TORRANCE_DISTRIBUTION), pf(o + COOK_TORRANCE_ALPHA_X),
@@ -57,7 +89,8 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return prgb(o + COOK_TORRANCE_KD) * INV_PI + pf(o + COOK_TORRANCE_KS) * specular(o, wi, wo);
+    return prgb(o + COOK_TORRANCE_KD) * INV_PI
+        + pf(o + COOK_TORRANCE_KS) * (specular(o, wi, wo) + multiple(o, wi, wo));
 }
 
 // The proxy lobe the environment renderer samples (bv::sampling_lobe).

@@ -75,6 +75,7 @@ pub fn param_json(d: &ParamDecl) -> Value {
         "applies_when": match d.applies {
             Applies::Always => Value::Null,
             Applies::When { param, any_of } => json!({ "param": param, "any_of": any_of }),
+            Applies::Positive { param } => json!({ "param": param, "above": 0.0 }),
         },
     });
     let extra = match d.kind {

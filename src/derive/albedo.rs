@@ -10,6 +10,13 @@
 //! models (band: its error estimate), Monte Carlo for measured ones (band:
 //! ±3 standard errors).
 //!
+//! Under the albedo view's *furnace* switch (`plots.albedo.furnace`) the
+//! curve is that of the BRDF's microfacet lobe in a white furnace
+//! ([`bv_core::Brdf::furnace`]: F = 1, kd = 0, ks = 1): `E(μ)`, whose
+//! shortfall `1 − E(μ)` is the energy single scattering loses (Kulla & Conty
+//! 2017), and which a model with `multiscatter = kulla-conty` brings to 1.
+//! BRDFs that are not microfacet models have no such curve.
+//!
 //! A curve costs up to [`N_THETA`] × some 10⁵ evaluations plus ρhh, so it is
 //! a job in steps of a few θi (with progress), cached by (build revision, φi):
 //! the albedo view, figures, `bv render` and `bv slice` share it.
@@ -208,10 +215,23 @@ impl AlbedoData {
 
     /// Whether some channel exceeds 1 by more than its error band somewhere.
     pub fn exceeds_one(&self) -> bool {
-        self.rho.iter().any(|e| {
-            let band = e.allowance(BAND_SIGMAS);
-            (0..3).any(|c| e.value[c] - band[c] > 1.0 + 1e-9)
-        })
+        self.excess_over_one().is_some()
+    }
+
+    /// By how much the curve exceeds 1 beyond its error band at most (over
+    /// θi and channels), `None` where it never does: a model that is 1 up
+    /// to a tabulated approximation's error (Kulla–Conty's compensation in
+    /// the furnace) says by how little.
+    pub fn excess_over_one(&self) -> Option<f64> {
+        let m = self
+            .rho
+            .iter()
+            .flat_map(|e| {
+                let band = e.allowance(BAND_SIGMAS);
+                (0..3).map(move |c| e.value[c] - band[c] - 1.0)
+            })
+            .fold(f64::NEG_INFINITY, f64::max);
+        (m > 1e-9).then_some(m)
     }
 
     /// How the numbers were computed, for the legend: `quadrature` or
@@ -226,8 +246,8 @@ impl AlbedoData {
 pub const STEPS: usize = N_THETA + 1;
 
 /// What a curve is keyed by: the BRDF's build revision (a turned surface
-/// has its own) and φi's bits.
-pub type Key = (u64, u64);
+/// has its own), φi's bits and whether it is the furnace curve.
+pub type Key = (u64, u64, bool);
 
 /// A job computing the curve of one BRDF in steps, with progress.
 struct Run {
@@ -252,13 +272,33 @@ pub fn slots() -> Arc<Slots<Key, Arc<AlbedoData>>> {
 
 /// The key of `b`'s curve under the scene's light.
 pub fn key_of(scene: &Scene<'_>, b: &SceneBrdf) -> Key {
-    (b.revision, scene.incident.phi_deg.to_bits())
+    (
+        b.revision,
+        scene.incident.phi_deg.to_bits(),
+        scene.state.plots.albedo.furnace,
+    )
+}
+
+/// Whether the scene's albedo view has a curve of `b`: always, or under the
+/// furnace switch when `b` is a microfacet model.
+pub fn drawn(scene: &Scene<'_>, b: &SceneBrdf) -> bool {
+    !scene.state.plots.albedo.furnace || b.brdf.furnace().is_some()
+}
+
+/// The BRDF whose curve is computed: `b`'s own, or its furnace lobe.
+fn subject(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<dyn Brdf> {
+    if scene.state.plots.albedo.furnace
+        && let Some(f) = b.brdf.furnace()
+    {
+        return Arc::from(f);
+    }
+    b.brdf.clone()
 }
 
 fn run(scene: &Scene<'_>, b: &SceneBrdf, per_step: usize) -> Run {
     Run {
         job: AlbedoJob::new(scene.incident.phi_deg.to_radians(), per_step),
-        brdf: b.brdf.clone(),
+        brdf: subject(scene, b),
     }
 }
 

@@ -193,7 +193,11 @@ pub fn start_ui(
                 .with_context(|| "the scene's environment map")?;
         }
         let scene = figure_scene(state, &runtime, false);
-        for b in &scene.brdfs {
+        for b in scene
+            .brdfs
+            .iter()
+            .filter(|b| crate::derive::albedo::drawn(&scene, b))
+        {
             crate::derive::albedo::curve_now(&scene, b);
         }
         check_health(state, &runtime)?;

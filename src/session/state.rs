@@ -307,6 +307,19 @@ pub struct PlotSettings {
     pub snell: SnellSettings,
     /// The microfacet term view's charts.
     pub terms: TermToggles,
+    /// The albedo view's options.
+    pub albedo: AlbedoSettings,
+}
+
+/// The albedo view's options: saved with the scene, so that a deck's slide
+/// can show the white furnace (issue 29).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AlbedoSettings {
+    /// The white furnace: plot each microfacet model's lobe with F = 1,
+    /// kd = 0, ks = 1 (`bv_core::Brdf::furnace`), and the energy it loses,
+    /// `1 − E(μ)`; other models are left out.
+    pub furnace: bool,
 }
 
 impl Default for PlotSettings {
@@ -317,6 +330,7 @@ impl Default for PlotSettings {
             fixed_theta_h_deg: 0.0,
             snell: SnellSettings::default(),
             terms: TermToggles::default(),
+            albedo: AlbedoSettings::default(),
         }
     }
 }

@@ -10,12 +10,20 @@
 //! solid in its colour. For a non-absorbing dielectric the sum would be 1
 //! with every bounce counted; what it lacks is the energy a single-scattering
 //! microfacet BSDF loses (the white furnace test).
+//!
+//! The *furnace* switch (`plots.albedo.furnace`, in the toolbar and in
+//! scene files) plots, for every microfacet model shown, the albedo `E(θi)`
+//! of its lobe with F = 1, kd = 0, ks = 1 (solid) and the energy single
+//! scattering loses, `1 − E` (dashed; Kulla & Conty 2017); with
+//! `multiscatter = kulla-conty` the first is flat at 1 and the second at 0.
+//! Models that are not microfacet models are left out.
 
 use super::BrdfColor as _;
 use super::chart::{self, Band, Chart, Marker, Palette, Series};
 use super::{Scene, SceneBrdf, View};
 use crate::derive::albedo::{self, AlbedoData, BAND_SIGMAS};
 use crate::session::command::Command;
+use crate::session::state::{AlbedoSettings, PlotSettings};
 use bv_core::mean_rgb;
 use eframe::egui::{self, Ui};
 use egui_plot::{Corner, FilledArea, HLine, Line, LineStyle, Plot, PlotPoints, VLine};
@@ -34,6 +42,8 @@ struct Shown {
     brdf: SceneBrdf,
     data: Arc<AlbedoData>,
     stale: bool,
+    /// The furnace curve (the lobe with F = 1, kd = 0, ks = 1).
+    furnace: bool,
 }
 
 impl AlbedoView {
@@ -44,7 +54,8 @@ impl AlbedoView {
         let mut shown = Vec::new();
         let mut done = 0;
         let mut total = 0;
-        for b in &scene.brdfs {
+        let furnace = scene.state.plots.albedo.furnace;
+        for b in scene.brdfs.iter().filter(|b| albedo::drawn(scene, b)) {
             let (data, stale) = match ctx.filter(|_| !scene.figure) {
                 None => (albedo::curve_now(scene, b), false),
                 Some(ctx) => {
@@ -64,6 +75,7 @@ impl AlbedoView {
                 brdf: b.clone(),
                 data,
                 stale,
+                furnace,
             });
         }
         self.progress = (total > 0).then_some((done, total));
@@ -87,17 +99,36 @@ fn legend_label(s: &Shown) -> String {
         _ => format!("MC ±{BAND_SIGMAS}σ"),
     };
     let mut l = format!(
-        "{}: ρhh = {:.4} ± {err_text} {method}",
+        "{}{}: ρhh = {:.4} ± {err_text} {method}",
         s.brdf.label,
+        if s.furnace { " E (F = 1)" } else { "" },
         mean_rgb(hh.value),
     );
-    if s.data.exceeds_one() {
-        l.push_str(" (ρhd > 1!)");
+    match s.data.excess_over_one() {
+        // Within a thousandth: say by how much (an approximation's error,
+        // not a model creating energy).
+        Some(e) if e < 1e-3 => l.push_str(&format!(" (ρhd ≤ 1 + {e:.0e})")),
+        Some(_) => l.push_str(" (ρhd > 1!)"),
+        None => {}
     }
     if s.stale {
         l.push_str(" (updating)");
     }
     l
+}
+
+/// The top of the y axis, leaving `legend_h` points of a plot `plot_h`
+/// points tall above ρ = 1 for the legend box under the furnace switch
+/// (where the curves to read run along 1 and a legend in a top corner would
+/// cover them).
+fn y_top_with_legend(shown: &[Shown], legend: bool, plot_h: f32) -> f64 {
+    let top = y_top(shown);
+    if !legend || !shown.iter().any(|s| s.furnace) {
+        return top;
+    }
+    let lines: usize = shown.iter().map(|s| series_of(s).len()).sum();
+    let frac = ((lines as f32 * 18.0 + 24.0) / plot_h.max(1.0)).min(0.6) as f64;
+    top.max(1.03 / (1.0 - frac))
 }
 
 fn y_top(shown: &[Shown]) -> f64 {
@@ -135,6 +166,8 @@ enum Part {
     Reflected,
     /// ρT: dotted.
     Transmitted,
+    /// The energy lost, 1 − E, under the furnace switch: short dashes.
+    Lost,
 }
 
 impl Part {
@@ -143,6 +176,7 @@ impl Part {
             Part::Total => None,
             Part::Reflected => Some(10.0),
             Part::Transmitted => Some(3.0),
+            Part::Lost => Some(5.0),
         }
     }
 }
@@ -165,7 +199,15 @@ fn series_of(s: &Shown) -> Vec<PartSeries> {
     let total: Vec<[f64; 2]> = (0..s.data.rho.len())
         .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
         .collect();
+    let lost: Vec<[f64; 2]> = total.iter().map(|p| [p[0], 1.0 - p[1]]).collect();
     let mut out = vec![(Part::Total, legend_label(s), split(total))];
+    if s.furnace {
+        out.push((
+            Part::Lost,
+            format!("{} 1 − E (lost)", s.brdf.label),
+            split(lost),
+        ));
+    }
     if s.data.has_parts() {
         out.push((
             Part::Reflected,
@@ -220,9 +262,36 @@ fn legend_corner(shown: &[Shown], top: f64, size: egui::Vec2) -> Corner {
 }
 
 const Y_LABEL: &str = "ρhd (mean of r, g, b)";
+const Y_LABEL_FURNACE: &str = "E (F = 1, kd = 0) and 1 − E";
+
+fn y_label(scene: &Scene<'_>) -> &'static str {
+    if scene.state.plots.albedo.furnace {
+        Y_LABEL_FURNACE
+    } else {
+        Y_LABEL
+    }
+}
 const X_LABEL: &str = "θi (°)";
 
 impl View for AlbedoView {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let before = scene.state.plots.albedo;
+        if super::toolbar_toggle(
+            ui,
+            before.furnace,
+            "furnace",
+            "White furnace: each microfacet model's lobe with F = 1, kd = 0, ks = 1, \
+             and the energy single scattering loses, 1 − E (others left out)",
+        ) {
+            out.push(Command::SetPlots(PlotSettings {
+                albedo: AlbedoSettings {
+                    furnace: !before.furnace,
+                },
+                ..scene.state.plots
+            }));
+        }
+    }
+
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let dark = ui.visuals().dark_mode;
         let shown = self.update(scene, (!scene.figure).then(|| ui.ctx()));
@@ -235,8 +304,8 @@ impl View for AlbedoView {
                     .text(format!("computing ρhd: {done}/{total} steps")),
             );
         }
-        let top = y_top(&shown);
         let size = ui.available_size();
+        let top = y_top_with_legend(&shown, !scene.presenting, size.y);
         let light = super::light_color(dark);
         // Presenting, the legend is a column beside the plot: its long
         // lines (ρhh of each) covered a curve in every corner of a plot
@@ -285,7 +354,7 @@ impl View for AlbedoView {
             .width(plot_w.max(50.0))
             .height(size.y.max(50.0))
             .x_axis_label(X_LABEL)
-            .y_axis_label(Y_LABEL)
+            .y_axis_label(y_label(scene))
             .y_axis_min_width(36.0)
             .include_x(0.0)
             .include_x(x_max(&shown))
@@ -373,11 +442,11 @@ impl View for AlbedoView {
 
     fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
         let shown = self.update(scene, None);
-        let top = y_top(&shown);
+        let top = y_top_with_legend(&shown, true, size[1]);
         let xm = x_max(&shown);
         let mut c = Chart {
             x_label: X_LABEL.into(),
-            y_label: Y_LABEL.into(),
+            y_label: y_label(scene).into(),
             x_range: (0.0, xm),
             y_range: (0.0, top),
             x_ticks: chart::angle_ticks(0.0, xm),

@@ -166,6 +166,16 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         None
     }
 
+    /// The model's microfacet lobe under a white furnace: the same D, G,
+    /// roughness and multiple-scattering choice with F = 1, no diffuse base
+    /// and full weight, so that its directional albedo `E(μ)` is what the
+    /// lobe keeps of the light and `1 − E(μ)` what single scattering loses
+    /// (the albedo view's furnace switch; Kulla & Conty 2017). `None` for
+    /// models that are not microfacet models.
+    fn furnace(&self) -> Option<Box<dyn Brdf>> {
+        None
+    }
+
     /// The model's Fresnel term, for the Fresnel view: what multiplies its
     /// specular (or delta) lobe as a function of the angle of incidence.
     /// `None` for models without one.

@@ -24,6 +24,7 @@ pub mod microfacet;
 pub mod microsurface;
 pub mod model;
 pub mod models;
+pub mod multiscatter;
 pub mod optics;
 pub mod params;
 pub mod presets;

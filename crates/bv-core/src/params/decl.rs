@@ -178,6 +178,12 @@ pub enum Applies {
         /// The choices under which this parameter matters.
         any_of: &'static [&'static str],
     },
+    /// Only while the float parameter `param` of the same record is above 0
+    /// (a lobe's option that matters only while the lobe has weight).
+    Positive {
+        /// Id of a [`ParamKind::Float`] parameter declared beside this one.
+        param: &'static str,
+    },
 }
 
 impl ParamDecl {
@@ -198,6 +204,7 @@ impl ParamDecl {
         match self.applies {
             Applies::Always => None,
             Applies::When { param, any_of } => Some(format!("{param} is {}", any_of.join(" or "))),
+            Applies::Positive { param } => Some(format!("{param} > 0")),
         }
     }
 
@@ -210,6 +217,10 @@ impl ParamDecl {
             Applies::Always => true,
             Applies::When { param, any_of } => match values.get(param) {
                 Ok(ParamValue::Text(v)) => any_of.contains(&v.as_str()),
+                _ => true,
+            },
+            Applies::Positive { param } => match values.get(param) {
+                Ok(ParamValue::Float(x)) => *x > 0.0,
                 _ => true,
             },
         }
@@ -279,6 +290,16 @@ mod tests {
             for d in decls {
                 if let ParamKind::List { fields, .. } = d.kind {
                     n += check(model, fields);
+                }
+                if let Applies::Positive { param } = d.applies {
+                    let owner = decls.iter().find(|o| o.id == param);
+                    assert!(
+                        matches!(owner.map(|o| o.kind), Some(ParamKind::Float(_))),
+                        "{model}: `{}` depends on `{param}` > 0, not a float beside it",
+                        d.id
+                    );
+                    n += 1;
+                    continue;
                 }
                 let Applies::When { param, any_of } = d.applies else {
                     continue;
