@@ -109,11 +109,19 @@ impl View for MicrosurfaceView {
         if let Some((a, b)) = shown.progress.filter(|_| shown.busy) {
             lines.push(format!("simulating: {a}/{b} batches"));
         }
-        let line_h = 20.0;
         let text_w = 330.0;
+        // Lines 20 points apart, closer (down to 16, for 14-point text) in
+        // a short pane such as presentation mode's; blank separators go
+        // before any number does.
+        let spacing = |n: usize| ((rect.height() - 24.0) / n.max(1) as f32).min(20.0);
+        let fits = |lines: &[String]| spacing(lines.len()) >= 16.0;
+        if !fits(&lines) {
+            lines.retain(|l| !l.is_empty());
+        }
+        let line_h = spacing(lines.len());
         // Beside the drawing when there is room for the text; else the
         // drawing with one line under it (small figures, the overview).
-        if rect.width() < 2.0 * text_w || rect.height() < lines.len() as f32 * line_h + 24.0 {
+        if rect.width() < text_w + 280.0 || !fits(&lines) {
             let small = FontId::proportional(11.0);
             let draw_rect =
                 Rect::from_min_max(rect.min, Pos2::new(rect.max.x, rect.max.y - 16.0)).shrink(6.0);
