@@ -36,8 +36,13 @@ pub const BATCH: usize = 4096;
 /// The tile is cut into `TILES × TILES` start tiles for the surface-aware
 /// error bars (see [`Gonio::single_sigma_surface`]).
 pub const TILES: usize = 4;
-/// Most rays one measurement accepts.
-pub const MAX_RAYS: usize = 1 << 34;
+/// Most rays one measurement accepts: 2³⁴, or what a 32-bit `usize` (wasm32)
+/// holds.
+pub const MAX_RAYS: usize = if usize::BITS >= 64 {
+    1 << (34 % usize::BITS)
+} else {
+    usize::MAX
+};
 
 /// Slope statistics of a surface's triangles (per unit projected area: every
 /// triangle has the same projected area).
