@@ -106,6 +106,47 @@ fn wrap_near(phi: f64, c: f64) -> f64 {
     c + d
 }
 
+/// The panels of a polar axis from its sorted `breaks`, graded towards the
+/// pole (0), from `theta_full` upwards (where the arc below the horizon
+/// starts to shrink like a square root) and towards `theta_end` (where it
+/// closes): the reflected part's θh and the transmitted part's θ.
+fn polar_segments(breaks: &[f64], theta_full: f64, theta_end: f64) -> Vec<Segment> {
+    breaks
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let start = a == 0.0 || (a == theta_full && theta_full > 0.0);
+            let end = b == theta_end;
+            let grading = match (start, end) {
+                (true, true) => gauss_kronrod::Grading::Both,
+                (true, false) => gauss_kronrod::Grading::Start,
+                (false, true) => gauss_kronrod::Grading::End,
+                (false, false) => gauss_kronrod::Grading::Linear,
+            };
+            Segment { a, b, grading }
+        })
+        .collect()
+}
+
+/// One inner (azimuthal) integral over the arc cut at `breaks`: graded at
+/// the arc's ends unless it is the `full` circle, and with `half` only the
+/// side from the plane of incidence, doubled (to half the tolerance).
+fn arc_integral(
+    f: &mut impl FnMut(f64) -> (Rgb, Rgb),
+    breaks: &[f64],
+    full: bool,
+    half: bool,
+    tol: f64,
+    panels: usize,
+) -> gauss_kronrod::Integral<Rgb> {
+    let segs = gauss_kronrod::segments(breaks, !full && !half, !full);
+    let (tol, scale) = if half { (0.5 * tol, 2.0) } else { (tol, 1.0) };
+    let mut r = gauss_kronrod::integrate(f, &segs, tol, 0.0, panels, false);
+    r.value *= scale;
+    r.error *= scale;
+    r
+}
+
 /// Whether azimuth `p` lies in the plane of incidence at azimuth `phi_i`
 /// (on either side of the normal).
 fn in_plane(p: f64, phi_i: f64) -> bool {
@@ -372,19 +413,7 @@ fn reflected(
     // inside any lobe the contract covers, so bisection finds it), at
     // θ_full from above and towards the end (square-root points of the arc
     // width).
-    let mut segs = Vec::with_capacity(breaks.len());
-    for w in breaks.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let start = a == 0.0 || (a == theta_full && theta_full > 0.0);
-        let end = b == theta_end;
-        let grading = match (start, end) {
-            (true, true) => gauss_kronrod::Grading::Both,
-            (true, false) => gauss_kronrod::Grading::Start,
-            (false, true) => gauss_kronrod::Grading::End,
-            (false, false) => gauss_kronrod::Grading::Linear,
-        };
-        segs.push(Segment { a, b, grading });
-    }
+    let segs = polar_segments(&breaks, theta_full, theta_end);
     let anisotropic = !brdf.claims().isotropic;
     let mut fixed_phis: Vec<f64> = Vec::new();
     if anisotropic {
@@ -437,15 +466,9 @@ fn reflected(
             (wo.z > 0.0).then(|| wo.normalize())
         };
         kink_roots(&kinks, dir, lo, hi, &mut br);
-        let segs = gauss_kronrod::segments(&br, !full && !half, !full);
-        let (tol, scale) = if half {
-            (0.5 * inner_tol, 2.0)
-        } else {
-            (inner_tol, 1.0)
-        };
-        let r = gauss_kronrod::integrate(&mut inner, &segs, tol, 0.0, opts.inner_panels, false);
+        let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
         inner_evals += r.evaluations;
-        (r.value * scale, r.error * scale)
+        (r.value, r.error)
     };
     let mut r = gauss_kronrod::integrate(
         &mut outer,
@@ -538,19 +561,7 @@ fn transmitted(
     breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
-    let mut segs = Vec::with_capacity(breaks.len());
-    for w in breaks.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let start = a == 0.0 || (a == theta_full && theta_full > 0.0);
-        let end = b == theta_end;
-        let grading = match (start, end) {
-            (true, true) => gauss_kronrod::Grading::Both,
-            (true, false) => gauss_kronrod::Grading::Start,
-            (false, true) => gauss_kronrod::Grading::End,
-            (false, false) => gauss_kronrod::Grading::Linear,
-        };
-        segs.push(Segment { a, b, grading });
-    }
+    let segs = polar_segments(&breaks, theta_full, theta_end);
     let anisotropic = !brdf.claims().isotropic;
     // One side of the plane of incidence, doubled, when the model is
     // symmetric about it (see `reflected`) and p lies in it.
@@ -621,15 +632,9 @@ fn transmitted(
             }
             (brdf.eval(wi, wo) * (-wo.z * st), Rgb::ZERO)
         };
-        let segs = gauss_kronrod::segments(&br, !full && !half, !full);
-        let (tol, scale) = if half {
-            (0.5 * inner_tol, 2.0)
-        } else {
-            (inner_tol, 1.0)
-        };
-        let r = gauss_kronrod::integrate(&mut inner, &segs, tol, 0.0, opts.inner_panels, false);
+        let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
         inner_evals += r.evaluations;
-        (r.value * scale, r.error * scale)
+        (r.value, r.error)
     };
     let mut r = gauss_kronrod::integrate(
         &mut outer,
