@@ -17,6 +17,7 @@
 pub mod albedo;
 pub mod compare;
 pub mod factor;
+pub mod gonio;
 pub mod interface;
 pub mod jobs;
 pub mod microsurface;

@@ -309,6 +309,10 @@ pub struct PlotSettings {
     pub terms: TermToggles,
     /// The albedo view's options.
     pub albedo: AlbedoSettings,
+    /// The polar view's *gonio* overlay: a virtual gonioreflectometer's
+    /// readings of the primary BRDF, dots with error bars over its curve
+    /// (LECTURE.md N8; `derive::gonio`).
+    pub gonio: bool,
 }
 
 /// The albedo view's options: saved with the scene, so that a deck's slide
@@ -331,6 +335,7 @@ impl Default for PlotSettings {
             snell: SnellSettings::default(),
             terms: TermToggles::default(),
             albedo: AlbedoSettings::default(),
+            gonio: false,
         }
     }
 }

@@ -188,6 +188,26 @@ impl View for PolarView {
             scene,
             crate::derive::factor::request(&super::waker(ui.ctx()), scene).as_ref(),
         );
+        let plots = scene.state.plots;
+        if super::toolbar_toggle(
+            ui,
+            plots.gonio,
+            "gonio",
+            "Virtual gonioreflectometer: photons from the selected BRDF's own sampler, \
+             counted by a detector (1.5° aperture) stopping every 5° in the plane of \
+             incidence; dots with 2σ error bars over the curve",
+        ) {
+            out.push(Command::SetPlots(crate::session::state::PlotSettings {
+                gonio: !plots.gonio,
+                ..plots
+            }));
+        }
+        if let Some(shown) = crate::derive::gonio::request(&super::waker(ui.ctx()), scene)
+            && shown.busy
+            && let Some((a, b)) = shown.progress
+        {
+            ui.label(format!("measuring {a}/{b}"));
+        }
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
@@ -235,6 +255,7 @@ impl View for PolarView {
                 Some((format!("{} factor K = {}", b.label, r.terms), pts))
             });
         self.factor_curve = factor.as_ref().map(|f| f.1.clone());
+        let gonio = gonio_dots(scene, &super::waker(ui.ctx()));
         let factor_color = if dark {
             egui::Color32::from_rgb(255, 184, 51)
         } else {
@@ -281,6 +302,12 @@ impl View for PolarView {
             }
             if let Some((label, _)) = &factor {
                 l.push(entry(label, factor_color, 2.0, Some(12.0)));
+            }
+            if let Some(g) = &gonio {
+                l.push(entry(&g.label, text_col, 4.0, None));
+                // Presenting, the counter is a line of the legend column:
+                // under the plot it ran wider than the circle.
+                l.push(entry(&g.counter, Color32::TRANSPARENT, 0.0, None));
             }
             for s in delta_spikes(scene, outer) {
                 l.push(entry(&format!("{} δ", s.label), s.color, 1.8, None));
@@ -479,6 +506,35 @@ impl View for PolarView {
                         .width(scene.stroke(2.0)),
                 );
             }
+            // The gonioreflectometer's readings: 2σ bars, then the dots.
+            if let Some(g) = &gonio {
+                for bar in &g.bars {
+                    pui.line(
+                        Line::new("", PlotPoints::from(bar.to_vec()))
+                            .color(text_col)
+                            .width(scene.stroke(1.5))
+                            .allow_hover(false),
+                    );
+                }
+                pui.points(
+                    egui_plot::Points::new(g.label.clone(), PlotPoints::from(g.dots.clone()))
+                        .color(text_col)
+                        .filled(true)
+                        .radius(scene.stroke(3.5)),
+                );
+                if !scene.presenting {
+                    pui.text(
+                        Text::new(
+                            "",
+                            PlotPoint::new(0.0, counter_y(transmits, outer)),
+                            RichText::new(g.counter.clone()).size(13.0),
+                        )
+                        .color(text_col)
+                        .anchor(egui::Align2::CENTER_BOTTOM)
+                        .allow_hover(false),
+                    );
+                }
+            }
             // Delta lobes in the plane, as labelled spikes.
             for s in delta_spikes(scene, outer) {
                 pui.arrows(
@@ -638,6 +694,86 @@ pub enum Mark {
 }
 
 /// The point at radius `r` along the signed in-plane angle `a`.
+/// The gonio overlay in plot coordinates: a dot per detector stop at the
+/// reading's radius, a radial bar over ±2σ, the legend label and the
+/// counter line.
+struct GonioDots {
+    label: String,
+    dots: Vec<[f64; 2]>,
+    bars: Vec<[[f64; 2]; 2]>,
+    counter: String,
+}
+
+/// The gonioreflectometer's readings of the primary BRDF as the polar plot
+/// draws them (`None` with the overlay off or nothing measured yet).
+fn gonio_dots(scene: &Scene<'_>, waker: &crate::derive::jobs::Waker) -> Option<GonioDots> {
+    let shown = crate::derive::gonio::request(waker, scene)?;
+    let done = shown.done?;
+    let m = &done.value;
+    let b = scene.primary()?;
+    let d = scene.state.display;
+    let shown_value = |f: f64, theta_s: f64| {
+        let v = if d.cosine { f * theta_s.cos().abs() } else { f };
+        v.max(0.0)
+    };
+    let mut dots = Vec::new();
+    let mut bars = Vec::new();
+    for r in &m.readings {
+        if !(r.f.is_finite() && r.sigma.is_finite()) {
+            continue;
+        }
+        let v = shown_value(r.f, r.theta_s);
+        let rad = radius(v, d.log);
+        dots.push(polar_point(rad, r.theta_s));
+        let lo = radius(shown_value(r.f - 2.0 * r.sigma, r.theta_s), d.log);
+        let hi = radius(shown_value(r.f + 2.0 * r.sigma, r.theta_s), d.log);
+        bars.push([polar_point(lo, r.theta_s), polar_point(hi, r.theta_s)]);
+    }
+    let step = m.setup.step_deg;
+    let photons = m.photons as f64;
+    let photons = if photons >= 1e6 {
+        format!("{:.1} M", photons / 1e6)
+    } else {
+        format!("{:.0} k", photons / 1e3)
+    };
+    Some(GonioDots {
+        label: format!("{} measured ({photons} photons)", b.label),
+        counter: format!(
+            "{} detector stops, {step}° apart, in one plane\n\
+             an isotropic sample at 1°: 90 θi × 90 θo × 180 Δφ = {} cells",
+            m.readings.len(),
+            grouped(bv_core::analysis::gonio::isotropic_grid_cells(1.0))
+        ),
+        dots,
+        bars,
+    })
+}
+
+/// Where the gonio counter's two lines end (their bottom, so that the
+/// plot's bounds take them in): under the surface line, or
+/// under the whole circle (and Snell's window label) for a transmitting
+/// model.
+fn counter_y(transmits: bool, outer: f64) -> f64 {
+    if transmits {
+        -outer * 1.52
+    } else {
+        -outer * 0.24
+    }
+}
+
+/// An integer with its digits in groups of three (`1 458 000`).
+fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
 fn polar_point(r: f64, a: f64) -> [f64; 2] {
     [r * a.sin(), r * a.cos()]
 }
@@ -827,10 +963,17 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
     }
     // Data extents (plot units) and a uniform scale that fits them.
     let (x0, x1) = (-1.3 * outer, 1.3 * outer);
+    let gonio = gonio_dots(scene, &crate::derive::jobs::Waker::none());
+    // Room under the plot for the gonio counter's two lines.
+    let counter_room = match (&gonio, transmits) {
+        (None, _) => 0.0,
+        (Some(_), false) => 0.12 * outer,
+        (Some(_), true) => 0.25 * outer,
+    };
     let (y0, y1) = if transmits {
-        (-1.3 * outer, 1.3 * outer)
+        (-1.3 * outer - counter_room, 1.3 * outer)
     } else {
-        (-0.15 * outer, 1.3 * outer)
+        (-0.15 * outer - counter_room, 1.3 * outer)
     };
     let k = ((w - 20.0) as f64 / (x1 - x0)).min((h - 20.0) as f64 / (y1 - y0));
     let cx = w as f64 * 0.5 - (x0 + x1) * 0.5 * k;
@@ -949,6 +1092,42 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
             color: *color,
             points: Vec::new(),
             width,
+            dash: None,
+        });
+    }
+    if let Some(g) = &gonio {
+        for bar in &g.bars {
+            svg.line(at(bar[0]), at(bar[1]), pal.text, 1.5, None);
+        }
+        for p in &g.dots {
+            let c = at(*p);
+            let r = 3.5;
+            let ring: Vec<[f32; 2]> = (0..12)
+                .map(|j| {
+                    let a = j as f32 * std::f32::consts::TAU / 12.0;
+                    [c[0] + r * a.cos(), c[1] + r * a.sin()]
+                })
+                .collect();
+            svg.polygon(&ring, pal.text);
+        }
+        let [x, y] = at([0.0, counter_y(transmits, outer)]);
+        let lines: Vec<&str> = g.counter.lines().collect();
+        for (i, line) in lines.iter().enumerate() {
+            svg.text(
+                [x, y - 14.0 * (lines.len() - 1 - i) as f32],
+                line,
+                11.0,
+                pal.text,
+                Anchor::Middle,
+                Baseline::Bottom,
+                None,
+            );
+        }
+        series.push(Series {
+            label: g.label.clone(),
+            color: pal.text,
+            points: Vec::new(),
+            width: 4.0,
             dash: None,
         });
     }

@@ -8,12 +8,14 @@
 //! - [`isotropy`]: max change of f under a common rotation about the normal.
 //! - [`albedo`]: ρhd(θi) curves with errors, their maximum, ρhh, the verdict.
 //! - [`ndf`]: `∫ D cos θh dωh` for microfacet models.
+//! - [`gonio`]: a virtual gonioreflectometer (photons from the model's sampler, a detector swept through the plane of incidence).
 
 pub mod albedo;
 pub mod chi2;
 pub mod directions;
 pub mod estimate;
 pub mod gauss_kronrod;
+pub mod gonio;
 pub mod isotropy;
 pub mod ndf;
 pub mod positivity;
