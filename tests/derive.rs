@@ -95,3 +95,67 @@ fn figures_in_a_row_compute_each_result_once() {
     // adds exactly one, which `cached_curve` found twice as the same object.
     assert!(albedo::slots().computed() > before);
 }
+
+/// The microsurface view's specimen follows the selected BRDF when it names
+/// its slopes (Beckmann or GGX, anisotropic kept), falls back to the view's
+/// own settings for a model without them or with "from model" off, and
+/// never hands the generator a roughness out of range or not finite.
+#[test]
+fn the_microsurface_specimen_comes_from_the_model_or_the_settings() {
+    use bv::derive::microsurface::specimen;
+    use bv_core::microsurface::SlopeDistribution;
+    let mut rt = runtime::shared();
+    let with = |model: &str, p: serde_json::Value| {
+        let mut s = AppState::default();
+        s.add(bv_core::ModelSpec::from_json(model, &p).unwrap());
+        s.selected = Some(s.brdfs[0].id);
+        s
+    };
+    let mut s = with(
+        "cook-torrance",
+        serde_json::json!({"distribution": "ggx", "alpha_x": 0.25, "alpha_y": 0.7}),
+    );
+    rt.sync(&s);
+    let sp = specimen(&build_scene(&s, &rt, false));
+    assert_eq!(sp.distribution, SlopeDistribution::Ggx);
+    assert_eq!((sp.alpha_x, sp.alpha_y), (0.25, 0.7));
+    assert!(sp.from.is_some());
+    s.plots.microsurface.from_model = false;
+    s.plots.microsurface.alpha = f64::NAN;
+    let sp = specimen(&build_scene(&s, &rt, false));
+    assert_eq!(sp.distribution, SlopeDistribution::Beckmann);
+    assert_eq!((sp.alpha_x, sp.alpha_y, sp.from.clone()), (0.5, 0.5, None));
+    let mut s = with("lambert", serde_json::json!({}));
+    s.plots.microsurface.distribution = SlopeDistribution::Ggx;
+    s.plots.microsurface.alpha = 9.0;
+    rt.sync(&s);
+    let sp = specimen(&build_scene(&s, &rt, false));
+    assert_eq!(sp.distribution, SlopeDistribution::Ggx);
+    assert_eq!((sp.alpha_x, sp.from.clone()), (1.5, None));
+    // The settings travel in a scene file.
+    let text = toml::to_string(&s.plots).unwrap();
+    assert!(text.contains("distribution = \"ggx\""), "{text}");
+}
+
+/// The polar view's gonio overlay in a figure: one dot per detector stop
+/// (35 for a reflection model, 70 round the whole circle for a
+/// transmitting one), the grid counter, and nothing with the toggle off.
+#[test]
+fn the_gonio_overlay_draws_its_readings_in_figures() {
+    let entry = bv::views::entry("polar").unwrap();
+    for (model, stops) in [("lambert", 35), ("rough-dielectric", 70)] {
+        let mut s = AppState::default();
+        s.add(bv_core::ModelSpec::from_json(model, &serde_json::json!({})).unwrap());
+        s.selected = Some(s.brdfs[0].id);
+        let off = bv::export::view_svg(&s, entry, [800.0, 600.0], false).unwrap();
+        assert!(!off.contains("detector stops"));
+        s.plots.gonio = true;
+        let svg = bv::export::view_svg(&s, entry, [800.0, 600.0], false).unwrap();
+        assert!(
+            svg.contains(&format!("{stops} detector stops")),
+            "{model}: no counter"
+        );
+        assert!(svg.contains("1 458 000 cells"));
+        assert!(svg.contains("measured ("), "{model}: no legend entry");
+    }
+}

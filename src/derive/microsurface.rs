@@ -6,6 +6,7 @@
 
 use super::jobs::{self, Shown, Slots, Steps, Waker};
 use crate::session::frame::Scene;
+use crate::session::state::MicrosurfaceSettings;
 use bv_core::microsurface::measure::{self, G1Point, Gonio, GonioJob, GonioOptions};
 use bv_core::microsurface::trace::{Walk, walk};
 use bv_core::microsurface::{SimFresnel, SlopeDistribution, Surface, SurfaceOptions};
@@ -21,8 +22,77 @@ pub const RAYS: usize = 200_000;
 /// Ray paths drawn.
 pub const PATHS: usize = 12;
 
-/// What a result was computed for: distribution, α (bits), θi and φi (bits).
-pub type Key = (SlopeDistribution, u64, u64, u64);
+/// What a result was computed for: distribution, αx and αy (bits), θi and
+/// φi (bits).
+pub type Key = (SlopeDistribution, u64, u64, u64, u64);
+
+/// Roughness range of the view's specimens (a 128² surface at 4 cells of
+/// correlation resolves these; see `SIZE`).
+pub const ALPHA_RANGE: std::ops::RangeInclusive<f64> = 0.05..=1.5;
+
+/// The surface the view simulates for a scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Specimen {
+    /// Slope distribution.
+    pub distribution: SlopeDistribution,
+    /// Roughness along x, in [`ALPHA_RANGE`].
+    pub alpha_x: f64,
+    /// Roughness along y, in [`ALPHA_RANGE`].
+    pub alpha_y: f64,
+    /// The BRDF it was taken from (its label), or `None` for the view's
+    /// own settings.
+    pub from: Option<String>,
+}
+
+impl Specimen {
+    /// `GGX α 0.30` or `Beckmann αx 0.20, αy 0.50`.
+    pub fn describe(&self) -> String {
+        let d = self.distribution.label();
+        if self.alpha_x == self.alpha_y {
+            format!("{d} α {:.2}", self.alpha_x)
+        } else {
+            format!("{d} αx {:.2}, αy {:.2}", self.alpha_x, self.alpha_y)
+        }
+    }
+}
+
+/// The scene's specimen: the selected BRDF's distribution and roughness
+/// when the settings say so and it names them (`bv_core::Ndf::slopes`),
+/// else the settings' own (α clamped to [`ALPHA_RANGE`], 0.5 when not
+/// finite).
+pub fn specimen(scene: &Scene<'_>) -> Specimen {
+    specimen_with(scene, &scene.state.plots.microsurface)
+}
+
+/// The specimen `set` gives for a scene (see [`specimen`]).
+pub fn specimen_with(scene: &Scene<'_>, set: &MicrosurfaceSettings) -> Specimen {
+    let clamp = |a: f64| {
+        if a.is_finite() {
+            a.clamp(*ALPHA_RANGE.start(), *ALPHA_RANGE.end())
+        } else {
+            0.5
+        }
+    };
+    if set.from_model
+        && let Some(b) = scene.primary()
+        && let Some((d, ax, ay)) = b.brdf.ndf().and_then(|n| n.slopes())
+        && let Some(distribution) = SlopeDistribution::from_distribution(d)
+    {
+        return Specimen {
+            distribution,
+            alpha_x: clamp(ax),
+            alpha_y: clamp(ay),
+            from: Some(b.label.clone()),
+        };
+    }
+    let a = clamp(set.alpha);
+    Specimen {
+        distribution: set.distribution,
+        alpha_x: a,
+        alpha_y: a,
+        from: None,
+    }
+}
 
 /// A finished simulation for the view.
 #[derive(Debug, Clone)]
@@ -108,23 +178,28 @@ impl Steps<Arc<Simulation>> for Job {
     }
 }
 
-/// A few rays from the light, started over the middle of the tile (where
-/// the view draws), their paths recorded.
+/// A few rays from the light aimed at the middle of the tile (where the
+/// view draws), their paths recorded.
 fn trace_paths(s: &Surface, wi: DVec3) -> Vec<(Vec<DVec3>, DVec3)> {
     let (dx, dy) = s.cell();
-    let n = s.size() as f64;
+    let n = s.size();
     let (_, hmax) = s.height_range();
     let mut out = Vec::new();
     for k in 0..PATHS {
-        // A fixed spread of start points (golden-ratio sequence) over the
-        // central 16 × 16 cells.
+        // A fixed spread of targets (golden-ratio sequence) over the
+        // central 16 × 16 cells. Each ray starts at the top of the tile's
+        // heights on the line through its target, not straight above it: a
+        // rough or steep surface's highest point lies far above the patch,
+        // and a ray dropped from there at a low light travels many cells
+        // (off the drawn patch) before it lands.
         let u = (k as f64 * 0.618_034).fract();
         let v = (k as f64 + 0.5) / PATHS as f64;
-        let p = DVec3::new(
-            (n / 2.0 - 8.0 + 16.0 * u) * dx,
-            (n / 2.0 - 8.0 + 16.0 * v) * dy,
-            hmax,
+        let (i, j) = (
+            n / 2 - 8 + (16.0 * u) as usize,
+            n / 2 - 8 + (16.0 * v) as usize,
         );
+        let target = DVec3::new(i as f64 * dx, j as f64 * dy, s.height(i, j));
+        let p = target + wi * ((hmax - target.z) / wi.z.max(1e-3));
         let mut path = Vec::new();
         if let Walk::Left { dir, .. } = walk(s, p, -wi, None, SimFresnel::None, 64, Some(&mut path))
         {
@@ -139,8 +214,7 @@ fn trace_paths(s: &Surface, wi: DVec3) -> Vec<(Vec<DVec3>, DVec3)> {
 pub fn request(
     waker: &Waker,
     scene: &Scene<'_>,
-    distribution: SlopeDistribution,
-    alpha: f64,
+    specimen: &Specimen,
 ) -> Shown<Key, Arc<Simulation>> {
     let wi = scene.wi();
     let wi = if wi.z > 0.017 {
@@ -149,14 +223,15 @@ pub fn request(
         // The gonioreflectometer takes light from above the horizon.
         DVec3::new(wi.x, wi.y, 0.017).normalize()
     };
-    let alpha = alpha.clamp(0.05, 1.5);
+    let (ax, ay) = (specimen.alpha_x, specimen.alpha_y);
     let key = (
-        distribution,
-        alpha.to_bits(),
+        specimen.distribution,
+        ax.to_bits(),
+        ay.to_bits(),
         scene.incident.theta_deg.to_bits(),
         scene.incident.phi_deg.to_bits(),
     );
-    let opts = SurfaceOptions::new(distribution, alpha, alpha, SIZE, 1);
+    let opts = SurfaceOptions::new(specimen.distribution, ax, ay, SIZE, 1);
     slots().for_frame(
         waker,
         0,

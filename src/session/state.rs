@@ -8,6 +8,7 @@
 //! validate is dropped with a note instead of failing the whole session.
 
 use bv_core::ModelSpec;
+use bv_core::microsurface::SlopeDistribution;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_json::Value;
 
@@ -309,6 +310,8 @@ pub struct PlotSettings {
     pub terms: TermToggles,
     /// The albedo view's options.
     pub albedo: AlbedoSettings,
+    /// The microsurface view's specimen.
+    pub microsurface: MicrosurfaceSettings,
     /// The polar view's *gonio* overlay: a virtual gonioreflectometer's
     /// readings of the primary BRDF, dots with error bars over its curve
     /// (LECTURE.md N8; `derive::gonio`).
@@ -335,7 +338,33 @@ impl Default for PlotSettings {
             snell: SnellSettings::default(),
             terms: TermToggles::default(),
             albedo: AlbedoSettings::default(),
+            microsurface: MicrosurfaceSettings::default(),
             gonio: false,
+        }
+    }
+}
+
+/// The microsurface view's specimen (issue 29): saved with the scene, so
+/// that a deck's slide shows the surface it means.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct MicrosurfaceSettings {
+    /// Generate the surface from the selected BRDF's distribution and
+    /// roughness when it names them (`bv_core::Ndf::slopes`); otherwise,
+    /// or when it does not, from the two settings below.
+    pub from_model: bool,
+    /// The specimen's slope distribution when not taken from the model.
+    pub distribution: SlopeDistribution,
+    /// Its roughness α when not taken from the model.
+    pub alpha: f64,
+}
+
+impl Default for MicrosurfaceSettings {
+    fn default() -> Self {
+        Self {
+            from_model: true,
+            distribution: SlopeDistribution::Beckmann,
+            alpha: 0.5,
         }
     }
 }

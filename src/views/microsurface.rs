@@ -7,14 +7,18 @@
 //! single-scattering Cook–Torrance model with the same D — the energy such a
 //! model loses is the multiple-bounce share.
 //!
-//! The distribution and α are the view's own (its toolbar), not a model's
-//! parameters: the surface is a specimen, not the drawn BRDF. The drawing
+//! The specimen is the selected BRDF's distribution and roughness when it
+//! names them (`bv_core::Ndf::slopes`: Beckmann or GGX, one scale), else the
+//! view's own distribution and α; both are saved with the scene
+//! (`plots.microsurface`), so a deck's slide shows the surface it means. The
+//! drawing
 //! sorts triangles back to front; the rays are drawn over the surface
 //! (a ray behind a ridge is still shown).
 
 use super::{Scene, View};
-use crate::derive::microsurface::{self, Simulation};
+use crate::derive::microsurface::{self, Simulation, Specimen};
 use crate::session::command::Command;
+use crate::session::state::{MicrosurfaceSettings, PlotSettings};
 use bv_core::microsurface::SlopeDistribution;
 use eframe::egui::{self, Align2, Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, epaint::Mesh};
 use glam::DVec3;
@@ -24,22 +28,9 @@ use std::any::Any;
 const PATCH: usize = 28;
 
 /// The microsurface view.
+#[derive(Default)]
 pub struct MicrosurfaceView {
-    /// Slope distribution of the specimen.
-    pub distribution: SlopeDistribution,
-    /// Its roughness α.
-    pub alpha: f64,
     busy: bool,
-}
-
-impl Default for MicrosurfaceView {
-    fn default() -> Self {
-        Self {
-            distribution: SlopeDistribution::Beckmann,
-            alpha: 0.5,
-            busy: false,
-        }
-    }
 }
 
 /// An orthographic camera looking down at the patch from θ = 55°.
@@ -64,33 +55,53 @@ impl Camera {
 }
 
 impl View for MicrosurfaceView {
-    fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
-        egui::ComboBox::from_id_salt("microsurface distribution")
-            .selected_text(match self.distribution {
-                SlopeDistribution::Beckmann => "Beckmann",
-                SlopeDistribution::Ggx => "GGX",
-            })
-            .show_ui(ui, |ui| {
-                ui.selectable_value(
-                    &mut self.distribution,
-                    SlopeDistribution::Beckmann,
-                    "Beckmann",
-                );
-                ui.selectable_value(&mut self.distribution, SlopeDistribution::Ggx, "GGX");
-            });
-        ui.add(egui::Slider::new(&mut self.alpha, 0.05..=1.5).text("α"));
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let plots = scene.state.plots;
+        let before = plots.microsurface;
+        let mut set = before;
+        let named = microsurface::specimen_with(
+            scene,
+            &MicrosurfaceSettings {
+                from_model: true,
+                ..before
+            },
+        );
+        if super::toolbar_toggle(
+            ui,
+            set.from_model,
+            "from model",
+            "Generate the surface with the selected BRDF's distribution and roughness \
+             (Beckmann or GGX); off, or for a model without them, with the settings here",
+        ) {
+            set.from_model = !set.from_model;
+        }
+        if set.from_model && named.from.is_some() {
+            ui.label(named.describe());
+        } else {
+            egui::ComboBox::from_id_salt("microsurface distribution")
+                .selected_text(set.distribution.label())
+                .show_ui(ui, |ui| {
+                    for d in [SlopeDistribution::Beckmann, SlopeDistribution::Ggx] {
+                        ui.selectable_value(&mut set.distribution, d, d.label());
+                    }
+                });
+            let range = microsurface::ALPHA_RANGE;
+            ui.add(egui::Slider::new(&mut set.alpha, range).text("α"));
+        }
+        if set != before {
+            out.push(Command::SetPlots(PlotSettings {
+                microsurface: set,
+                ..plots
+            }));
+        }
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let rect = ui.available_rect_before_wrap();
         ui.allocate_rect(rect, Sense::hover());
         let painter = ui.painter_at(rect);
-        let shown = microsurface::request(
-            &super::waker(ui.ctx()),
-            scene,
-            self.distribution,
-            self.alpha,
-        );
+        let specimen = microsurface::specimen(scene);
+        let shown = microsurface::request(&super::waker(ui.ctx()), scene, &specimen);
         self.busy = shown.busy;
         let text = ui.visuals().text_color();
         let font = FontId::proportional(14.0);
@@ -105,7 +116,7 @@ impl View for MicrosurfaceView {
             return;
         };
         let sim = &done.value;
-        let mut lines = summary(sim);
+        let mut lines = summary(sim, &specimen);
         if let Some((a, b)) = shown.progress.filter(|_| shown.busy) {
             lines.push(format!("simulating: {a}/{b} batches"));
         }
@@ -165,19 +176,15 @@ impl View for MicrosurfaceView {
 }
 
 /// The numbers beside the drawing.
-fn summary(sim: &Simulation) -> Vec<String> {
+fn summary(sim: &Simulation, specimen: &Specimen) -> Vec<String> {
     let o = sim.surface.options();
     let g = &sim.gonio;
+    let from = specimen
+        .from
+        .as_ref()
+        .map_or(String::new(), |l| format!(" ({l}'s)"));
     vec![
-        format!(
-            "{} surface, α = {:.2}, {}²",
-            match o.distribution {
-                SlopeDistribution::Beckmann => "Beckmann",
-                SlopeDistribution::Ggx => "GGX",
-            },
-            o.alpha_x,
-            o.size
-        ),
+        format!("{} surface{from}, {}²", specimen.describe(), o.size),
         format!("light θi = {:.1}°", g.opts.theta_i.to_degrees()),
         String::new(),
         "masking G1(θi)".into(),
@@ -221,10 +228,10 @@ fn draw_surface(painter: &egui::Painter, rect: Rect, sim: &Simulation, wi: DVec3
     // bounce, each `reach` long) into the rectangle.
     let reach = 0.35 * PATCH as f64 * dx.max(dy);
     let mut points: Vec<DVec3> = Vec::new();
-    for j in [c0, c0 + PATCH] {
-        for i in c0..=c0 + PATCH {
-            points.push(point(i, j));
-            points.push(point(j, i));
+    for edge in [c0, c0 + PATCH] {
+        for k in c0..=c0 + PATCH {
+            points.push(point(k, edge));
+            points.push(point(edge, k));
         }
     }
     for (path, dir) in &sim.paths {

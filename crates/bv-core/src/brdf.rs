@@ -53,6 +53,15 @@ pub struct DeltaLobe {
 pub trait Ndf: Send + Sync {
     /// D(h) for a unit `h` in the upper hemisphere (1/sr).
     fn d(&self, h: DVec3) -> f64;
+
+    /// The family and roughness (αx, αy) when the distribution is one
+    /// scale of a family with a slope distribution (Beckmann or GGX), so
+    /// that a simulated microsurface can be made with the same slopes
+    /// (`microsurface`, issue 29). `None` for mixtures of scales, Blinn's
+    /// θh Gaussian and anything else.
+    fn slopes(&self) -> Option<(crate::microfacet::Distribution, f64, f64)> {
+        None
+    }
 }
 
 /// A bidirectional scattering distribution function: `wi` towards the light,

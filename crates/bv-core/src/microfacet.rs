@@ -500,6 +500,12 @@ impl Ndf for Microfacet {
     fn d(&self, h: DVec3) -> f64 {
         Microfacet::d(self, h)
     }
+
+    fn slopes(&self) -> Option<(Distribution, f64, f64)> {
+        let f = &self.first;
+        (self.w2 == 0.0 && matches!(f.dist, Distribution::Beckmann | Distribution::Ggx))
+            .then_some((f.dist, f.ax, f.ay))
+    }
 }
 
 /// Largest f64 below 1, to keep remapped uniform numbers in [0, 1).

@@ -36,6 +36,13 @@ impl Ndf for RotatedNdf {
             .ndf()
             .map_or(0.0, |n| n.d(rotate(h, self.cos, -self.sin)))
     }
+
+    /// The inner slopes when they are isotropic (a turn changes nothing);
+    /// an anisotropic one turned is no longer aligned with x and y.
+    fn slopes(&self) -> Option<(crate::microfacet::Distribution, f64, f64)> {
+        let s = self.inner.ndf()?.slopes()?;
+        (s.1 == s.2).then_some(s)
+    }
 }
 
 #[inline]

@@ -369,3 +369,67 @@ fn bad_input_is_refused() {
     assert!(measure::measure_g1(&s, &[1.0], 0.0, 0, 1).is_err());
     assert!(measure::measure_g1(&s, &[2.0], 0.0, 10, 1).is_err());
 }
+
+/// Every model that names its slopes (`Ndf::slopes`, what the microsurface
+/// view and the gonioreflectometer generate a specimen from) has exactly
+/// that D: checked against the closed forms of anisotropic Beckmann and GGX
+/// written here, over directions of the upper hemisphere. Blinn's θh
+/// Gaussian and a two-scale mixture name none.
+#[test]
+fn named_slopes_are_the_models_own_distribution() {
+    use bv_core::ModelSpec;
+    use serde_json::json;
+    use std::f64::consts::PI;
+    let d_closed = |dist: Distribution, ax: f64, ay: f64, h: glam::DVec3| {
+        let (x, y, z) = (h.x / ax, h.y / ay, h.z);
+        let c2 = z * z;
+        match dist {
+            Distribution::Beckmann => (-(x * x + y * y) / c2).exp() / (PI * ax * ay * c2 * c2),
+            Distribution::Ggx => 1.0 / (PI * ax * ay * (x * x + y * y + c2).powi(2)),
+            Distribution::Blinn => unreachable!(),
+        }
+    };
+    let cases = [
+        (
+            "cook-torrance",
+            json!({"distribution": "ggx", "alpha": 0.3}),
+            true,
+        ),
+        (
+            "cook-torrance",
+            json!({"distribution": "beckmann", "alpha_x": 0.2, "alpha_y": 0.5}),
+            true,
+        ),
+        (
+            "cook-torrance",
+            json!({"distribution": "blinn", "alpha": 0.3}),
+            false,
+        ),
+        (
+            "disney",
+            json!({"roughness": 0.6, "anisotropic": 0.8}),
+            true,
+        ),
+        ("rough-dielectric", json!({"alpha": 0.4}), true),
+        ("lambert", json!({}), false),
+    ];
+    for (id, p, named) in cases {
+        let b = ModelSpec::from_json(id, &p).unwrap().build().unwrap();
+        let slopes = b.ndf().and_then(|n| n.slopes());
+        assert_eq!(slopes.is_some(), named, "{id} {p}");
+        let Some((dist, ax, ay)) = slopes else {
+            continue;
+        };
+        let ndf = b.ndf().unwrap();
+        for i in 0..200 {
+            let t = (i as f64 + 0.5) / 200.0 * 1.4;
+            let f = i as f64 * 2.399;
+            let h = glam::DVec3::new(t.sin() * f.cos(), t.sin() * f.sin(), t.cos());
+            let (a, e) = (ndf.d(h), d_closed(dist, ax, ay, h));
+            assert!(
+                (a - e).abs() <= 1e-9 * e.max(1e-12),
+                "{id} {p} h {h}: {a} vs {e}"
+            );
+        }
+    }
+}

@@ -57,8 +57,10 @@ pub const MAX_SIZE: usize = 4096;
 /// Cap on GGX's local roughness scale `1/√E` (see the module doc).
 pub const GGX_MAX_SCALE: f64 = 30.0;
 
-/// The slope distribution a surface is generated for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The slope distribution a surface is generated for (saved in scenes as
+/// `beckmann` or `ggx`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SlopeDistribution {
     /// Gaussian slopes (a Gaussian random surface).
     Beckmann,
@@ -83,6 +85,24 @@ impl SlopeDistribution {
         match self {
             Self::Beckmann => Distribution::Beckmann,
             Self::Ggx => Distribution::Ggx,
+        }
+    }
+
+    /// The slope distribution of a microfacet family, if a surface can be
+    /// generated for it (Beckmann and GGX; not Blinn's θh Gaussian).
+    pub fn from_distribution(d: Distribution) -> Option<Self> {
+        match d {
+            Distribution::Beckmann => Some(Self::Beckmann),
+            Distribution::Ggx => Some(Self::Ggx),
+            Distribution::Blinn => None,
+        }
+    }
+
+    /// Display name (`Beckmann`, `GGX`).
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Beckmann => "Beckmann",
+            Self::Ggx => "GGX",
         }
     }
 }

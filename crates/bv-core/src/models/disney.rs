@@ -152,6 +152,10 @@ impl Ndf for Gtr2 {
     fn d(&self, h: DVec3) -> f64 {
         self.0.d(h)
     }
+
+    fn slopes(&self) -> Option<(crate::microfacet::Distribution, f64, f64)> {
+        self.0.slopes()
+    }
 }
 
 /// Burley's principled BRDF.
