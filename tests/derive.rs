@@ -159,3 +159,29 @@ fn the_gonio_overlay_draws_its_readings_in_figures() {
         assert!(svg.contains("measured ("), "{model}: no legend entry");
     }
 }
+
+/// The gonio overlay on a simulated surface: for a model with slopes the
+/// figure has both reading sets and the single-scattering curve; for one
+/// without, no readings (and no other specimen measured in its place).
+#[test]
+fn the_gonio_surface_overlay_measures_only_models_with_slopes() {
+    let entry = bv::views::entry("polar").unwrap();
+    for (model, params, has) in [
+        (
+            "cook-torrance",
+            serde_json::json!({"distribution": "beckmann", "alpha": 0.45}),
+            true,
+        ),
+        ("lambert", serde_json::json!({}), false),
+    ] {
+        let mut s = AppState::default();
+        s.add(bv_core::ModelSpec::from_json(model, &params).unwrap());
+        s.selected = Some(s.brdfs[0].id);
+        s.plots.gonio = true;
+        s.plots.gonio_surface = true;
+        let svg = bv::export::view_svg(&s, entry, [800.0, 600.0], false).unwrap();
+        assert_eq!(svg.contains("surface, one bounce"), has, "{model}");
+        assert_eq!(svg.contains("F = 1: one bounce"), has, "{model}");
+        assert!(!svg.contains("measured ("), "{model}");
+    }
+}

@@ -316,6 +316,10 @@ pub struct PlotSettings {
     /// readings of the primary BRDF, dots with error bars over its curve
     /// (LECTURE.md N8; `derive::gonio`).
     pub gonio: bool,
+    /// The gonio overlay measures a simulated microsurface with the
+    /// primary BRDF's slopes (F = 1; single and all bounces) instead of
+    /// the BRDF itself (issue 29).
+    pub gonio_surface: bool,
 }
 
 /// The albedo view's options: saved with the scene, so that a deck's slide
@@ -340,6 +344,7 @@ impl Default for PlotSettings {
             albedo: AlbedoSettings::default(),
             microsurface: MicrosurfaceSettings::default(),
             gonio: false,
+            gonio_surface: false,
         }
     }
 }

@@ -202,6 +202,31 @@ impl View for PolarView {
                 ..plots
             }));
         }
+        if plots.gonio
+            && super::toolbar_toggle(
+                ui,
+                plots.gonio_surface,
+                "surface",
+                "Measure a simulated microsurface with the selected BRDF's slopes \
+                 (Beckmann or GGX, F = 1) instead of the BRDF: filled dots all bounces, \
+                 hollow dots one bounce, dashed the model's lobe with F = 1",
+            )
+        {
+            out.push(Command::SetPlots(crate::session::state::PlotSettings {
+                gonio_surface: !plots.gonio_surface,
+                ..plots
+            }));
+        }
+        if plots.gonio
+            && plots.gonio_surface
+            && let Some(b) = scene.primary()
+            && crate::derive::gonio::specimen(scene, b.brdf.as_ref()).is_none()
+        {
+            ui.label(format!(
+                "{} names no Beckmann or GGX slopes to simulate",
+                b.label
+            ));
+        }
         if let Some(shown) = crate::derive::gonio::request(&super::waker(ui.ctx()), scene)
             && shown.busy
             && let Some((a, b)) = shown.progress
@@ -304,7 +329,13 @@ impl View for PolarView {
                 l.push(entry(label, factor_color, 2.0, Some(12.0)));
             }
             if let Some(g) = &gonio {
-                l.push(entry(&g.label, text_col, 4.0, None));
+                if let Some(c) = &g.reference {
+                    l.push(entry(&c.label, c.color, 2.0, Some(10.0)));
+                }
+                for set in &g.sets {
+                    let width = if set.filled { 4.0 } else { 1.5 };
+                    l.push(entry(&set.label, text_col, width, None));
+                }
                 // Presenting, the counter is a line of the legend column:
                 // under the plot it ran wider than the circle.
                 l.push(entry(&g.counter, Color32::TRANSPARENT, 0.0, None));
@@ -508,20 +539,33 @@ impl View for PolarView {
             }
             // The gonioreflectometer's readings: 2σ bars, then the dots.
             if let Some(g) = &gonio {
-                for bar in &g.bars {
+                if let Some(c) = &g.reference {
                     pui.line(
-                        Line::new("", PlotPoints::from(bar.to_vec()))
-                            .color(text_col)
-                            .width(scene.stroke(1.5))
-                            .allow_hover(false),
+                        Line::new(c.label.clone(), PlotPoints::from(c.points.clone()))
+                            .color(c.color)
+                            .style(LineStyle::Dashed { length: 10.0 })
+                            .width(scene.stroke(2.0)),
                     );
                 }
-                pui.points(
-                    egui_plot::Points::new(g.label.clone(), PlotPoints::from(g.dots.clone()))
+                for set in &g.sets {
+                    for bar in &set.bars {
+                        pui.line(
+                            Line::new("", PlotPoints::from(bar.to_vec()))
+                                .color(text_col)
+                                .width(scene.stroke(1.5))
+                                .allow_hover(false),
+                        );
+                    }
+                    pui.points(
+                        egui_plot::Points::new(
+                            set.label.clone(),
+                            PlotPoints::from(set.dots.clone()),
+                        )
                         .color(text_col)
-                        .filled(true)
+                        .filled(set.filled)
                         .radius(scene.stroke(3.5)),
-                );
+                    );
+                }
                 if !scene.presenting {
                     pui.text(
                         Text::new(
@@ -694,59 +738,144 @@ pub enum Mark {
 }
 
 /// The point at radius `r` along the signed in-plane angle `a`.
-/// The gonio overlay in plot coordinates: a dot per detector stop at the
-/// reading's radius, a radial bar over ±2σ, the legend label and the
-/// counter line.
-struct GonioDots {
+/// One set of gonio readings in plot coordinates: a dot per detector stop
+/// at the reading's radius, a radial bar over ±2σ.
+struct DotSet {
     label: String,
+    filled: bool,
     dots: Vec<[f64; 2]>,
     bars: Vec<[[f64; 2]; 2]>,
+}
+
+/// A curve the readings are set against (a surface's single-scattering
+/// model, dashed).
+struct RefCurve {
+    label: String,
+    color: Color32,
+    points: Vec<[f64; 2]>,
+}
+
+/// The gonio overlay: the reading sets, the curve they are set against
+/// when it is not the drawn BRDF's own, and the counter (two lines).
+struct GonioDots {
+    sets: Vec<DotSet>,
+    reference: Option<RefCurve>,
     counter: String,
 }
 
-/// The gonioreflectometer's readings of the primary BRDF as the polar plot
-/// draws them (`None` with the overlay off or nothing measured yet).
-fn gonio_dots(scene: &Scene<'_>, waker: &crate::derive::jobs::Waker) -> Option<GonioDots> {
-    let shown = crate::derive::gonio::request(waker, scene)?;
-    let done = shown.done?;
-    let m = &done.value;
-    let b = scene.primary()?;
-    let d = scene.state.display;
+/// The readings as dots and bars on the plot's radius scale.
+fn dot_set(
+    label: String,
+    filled: bool,
+    readings: &[bv_core::analysis::gonio::Reading],
+    d: crate::session::state::Display,
+) -> DotSet {
     let shown_value = |f: f64, theta_s: f64| {
         let v = if d.cosine { f * theta_s.cos().abs() } else { f };
         v.max(0.0)
     };
     let mut dots = Vec::new();
     let mut bars = Vec::new();
-    for r in &m.readings {
+    for r in readings {
         if !(r.f.is_finite() && r.sigma.is_finite()) {
             continue;
         }
-        let v = shown_value(r.f, r.theta_s);
-        let rad = radius(v, d.log);
+        let rad = radius(shown_value(r.f, r.theta_s), d.log);
         dots.push(polar_point(rad, r.theta_s));
         let lo = radius(shown_value(r.f - 2.0 * r.sigma, r.theta_s), d.log);
         let hi = radius(shown_value(r.f + 2.0 * r.sigma, r.theta_s), d.log);
         bars.push([polar_point(lo, r.theta_s), polar_point(hi, r.theta_s)]);
     }
-    let step = m.setup.step_deg;
-    let photons = m.photons as f64;
-    let photons = if photons >= 1e6 {
-        format!("{:.1} M", photons / 1e6)
-    } else {
-        format!("{:.0} k", photons / 1e3)
-    };
-    Some(GonioDots {
-        label: format!("{} measured ({photons} photons)", b.label),
-        counter: format!(
-            "{} detector stops, {step}° apart, in one plane\n\
-             an isotropic sample at 1°: 90 θi × 90 θo × 180 Δφ = {} cells",
-            m.readings.len(),
-            grouped(bv_core::analysis::gonio::isotropic_grid_cells(1.0))
-        ),
+    DotSet {
+        label,
+        filled,
         dots,
         bars,
-    })
+    }
+}
+
+/// The gonioreflectometer's readings of the primary BRDF (or of a surface
+/// with its slopes) as the polar plot draws them; `None` with the overlay
+/// off or nothing measured yet.
+fn gonio_dots(scene: &Scene<'_>, waker: &crate::derive::jobs::Waker) -> Option<GonioDots> {
+    use crate::derive::gonio::Specimen;
+    let shown = crate::derive::gonio::request(waker, scene)?;
+    let done = shown.done?;
+    let m = &done.value;
+    let b = scene.primary()?;
+    let d = scene.state.display;
+    let step = m.setup.step_deg;
+    let count = |n: u64| {
+        let n = n as f64;
+        if n >= 1e6 {
+            format!("{:.1} M", n / 1e6)
+        } else {
+            format!("{:.0} k", n / 1e3)
+        }
+    };
+    let grid = format!(
+        "an isotropic sample at 1°: 90 θi × 90 θo × 180 Δφ = {} cells",
+        grouped(bv_core::analysis::gonio::isotropic_grid_cells(1.0))
+    );
+    match (m.specimen, &m.single) {
+        (Specimen::Surface(dist, ax, ay), Some(single)) => {
+            let alpha = if ax == ay {
+                format!("α {ax:.2}")
+            } else {
+                format!("αx {ax:.2}, αy {ay:.2}")
+            };
+            let reference = b.brdf.furnace().map(|f| {
+                let n = 2 * SAMPLES;
+                let points = slices::plane_of_incidence(
+                    f.as_ref(),
+                    m.setup.theta_i,
+                    m.setup.phi_i,
+                    n,
+                    d.cosine,
+                )
+                .iter()
+                .map(|s| polar_point(radius(s.value, d.log), s.x))
+                .collect();
+                RefCurve {
+                    label: format!("{}, F = 1: one bounce", b.label),
+                    color: b.color(),
+                    points,
+                }
+            });
+            Some(GonioDots {
+                sets: vec![
+                    dot_set(
+                        format!("surface, all bounces ({} rays)", count(m.photons)),
+                        true,
+                        &m.readings,
+                        d,
+                    ),
+                    dot_set("surface, one bounce".into(), false, single, d),
+                ],
+                reference,
+                counter: format!(
+                    "{} stops of {step}° over a simulated {} {alpha} surface \
+                     ({}², F = 1)\n{grid}",
+                    m.readings.len(),
+                    dist.label(),
+                    crate::derive::gonio::SURFACE_SIZE
+                ),
+            })
+        }
+        _ => Some(GonioDots {
+            sets: vec![dot_set(
+                format!("{} measured ({} photons)", b.label, count(m.photons)),
+                true,
+                &m.readings,
+                d,
+            )],
+            reference: None,
+            counter: format!(
+                "{} detector stops, {step}° apart, in one plane\n{grid}",
+                m.readings.len()
+            ),
+        }),
+    }
 }
 
 /// Where the gonio counter's two lines end (their bottom, so that the
@@ -1096,19 +1225,43 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
         });
     }
     if let Some(g) = &gonio {
-        for bar in &g.bars {
-            svg.line(at(bar[0]), at(bar[1]), pal.text, 1.5, None);
+        if let Some(c) = &g.reference {
+            let p: Vec<[f32; 2]> = c.points.iter().map(|p| at(*p)).collect();
+            svg.polyline(&p, c.color, 2.0, Some(10.0));
+            series.push(Series {
+                label: c.label.clone(),
+                color: c.color,
+                points: Vec::new(),
+                width: 2.0,
+                dash: Some(10.0),
+            });
         }
-        for p in &g.dots {
-            let c = at(*p);
-            let r = 3.5;
-            let ring: Vec<[f32; 2]> = (0..12)
-                .map(|j| {
-                    let a = j as f32 * std::f32::consts::TAU / 12.0;
-                    [c[0] + r * a.cos(), c[1] + r * a.sin()]
-                })
-                .collect();
-            svg.polygon(&ring, pal.text);
+        for set in &g.sets {
+            for bar in &set.bars {
+                svg.line(at(bar[0]), at(bar[1]), pal.text, 1.5, None);
+            }
+            for p in &set.dots {
+                let c = at(*p);
+                let r = 3.5;
+                let ring: Vec<[f32; 2]> = (0..=12)
+                    .map(|j| {
+                        let a = j as f32 * std::f32::consts::TAU / 12.0;
+                        [c[0] + r * a.cos(), c[1] + r * a.sin()]
+                    })
+                    .collect();
+                if set.filled {
+                    svg.polygon(&ring, pal.text);
+                } else {
+                    svg.polyline(&ring, pal.text, 1.5, None);
+                }
+            }
+            series.push(Series {
+                label: set.label.clone(),
+                color: pal.text,
+                points: Vec::new(),
+                width: if set.filled { 4.0 } else { 1.5 },
+                dash: None,
+            });
         }
         let [x, y] = at([0.0, counter_y(transmits, outer)]);
         let lines: Vec<&str> = g.counter.lines().collect();
@@ -1123,13 +1276,6 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
                 None,
             );
         }
-        series.push(Series {
-            label: g.label.clone(),
-            color: pal.text,
-            points: Vec::new(),
-            width: 4.0,
-            dash: None,
-        });
     }
     for s in delta_spikes(scene, outer) {
         svg.line(at([0.0, 0.0]), at(s.tip), s.color, 2.0, None);
