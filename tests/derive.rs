@@ -185,3 +185,49 @@ fn the_gonio_surface_overlay_measures_only_models_with_slopes() {
         assert!(!svg.contains("measured ("), "{model}");
     }
 }
+
+/// The albedo view's swapped curve (LECTURE N12): for a reciprocal BRDF it
+/// is its ρhd within the quadrature's error at every θ; for classical Phong
+/// (1/cos θi) it parts from it towards the horizon; the figure draws it only
+/// with the switch on.
+#[test]
+fn the_swapped_albedo_curve_follows_reciprocity() {
+    use bv::derive::albedo::{Which, curve_now_of};
+    for (model, reciprocal) in [("modified-phong", true), ("phong", false)] {
+        let mut s = AppState::default();
+        s.add(
+            bv_core::ModelSpec::from_json(
+                model,
+                &serde_json::json!({"kd": 0.0, "ks": 0.8, "e": 21.0}),
+            )
+            .unwrap(),
+        );
+        s.selected = Some(s.brdfs[0].id);
+        s.plots.albedo.swapped = true;
+        let (hd, dh) = {
+            // The shared runtime is released before the figures take it.
+            let mut rt = runtime::shared();
+            rt.sync(&s);
+            let scene = build_scene(&s, &rt, false);
+            let b = &scene.brdfs[0];
+            (
+                curve_now_of(&scene, b, Which::Hd),
+                curve_now_of(&scene, b, Which::Dh),
+            )
+        };
+        let gap = (0..hd.rho.len())
+            .map(|k| (hd.mean_and_band(k).0 - dh.mean_and_band(k).0).abs())
+            .fold(0.0, f64::max);
+        if reciprocal {
+            assert!(gap < 1e-4, "{model}: {gap}");
+        } else {
+            assert!(gap > 0.05, "{model}: {gap}");
+        }
+        let entry = bv::views::entry("albedo").unwrap();
+        let svg = bv::export::view_svg(&s, entry, [800.0, 500.0], false).unwrap();
+        assert!(svg.contains("ρdh"), "{model}");
+        s.plots.albedo.swapped = false;
+        let svg = bv::export::view_svg(&s, entry, [800.0, 500.0], false).unwrap();
+        assert!(!svg.contains("ρdh"), "{model}");
+    }
+}

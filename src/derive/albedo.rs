@@ -246,8 +246,31 @@ impl AlbedoData {
 pub const STEPS: usize = N_THETA + 1;
 
 /// What a curve is keyed by: the BRDF's build revision (a turned surface
-/// has its own), φi's bits and whether it is the furnace curve.
-pub type Key = (u64, u64, bool);
+/// has its own), φi's bits, whether it is the furnace curve and whether it
+/// is the swapped integral ρdh.
+pub type Key = (u64, u64, bool, bool);
+
+/// Which of a BRDF's curves: its ρhd, or (`plots.albedo.swapped`, LECTURE
+/// N12) its hemispherical-directional reflectance ρdh, the ρhd of the BRDF
+/// with light and view exchanged (`bv_core::swapped::Swapped`), which has
+/// its own slot beside the BRDF's (`slot_of`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Which {
+    /// ρhd (or E under the furnace switch).
+    Hd,
+    /// ρdh = ∫ f(ωi, ωo) cos θi dωi against θo.
+    Dh,
+}
+
+/// The slot bit of a swapped curve (a BRDF id is far below it).
+const SWAPPED_SLOT: u64 = 1 << 62;
+
+fn slot_of(b: &SceneBrdf, which: Which) -> u64 {
+    match which {
+        Which::Hd => b.id,
+        Which::Dh => b.id | SWAPPED_SLOT,
+    }
+}
 
 /// A job computing the curve of one BRDF in steps, with progress.
 struct Run {
@@ -272,11 +295,25 @@ pub fn slots() -> Arc<Slots<Key, Arc<AlbedoData>>> {
 
 /// The key of `b`'s curve under the scene's light.
 pub fn key_of(scene: &Scene<'_>, b: &SceneBrdf) -> Key {
+    key_for(scene, b, Which::Hd)
+}
+
+fn key_for(scene: &Scene<'_>, b: &SceneBrdf, which: Which) -> Key {
     (
         b.revision,
         scene.incident.phi_deg.to_bits(),
         scene.state.plots.albedo.furnace,
+        which == Which::Dh,
     )
+}
+
+/// Whether the scene's albedo view has a swapped curve of `b`: with the
+/// switch on, outside the furnace, for a model that reflects only (for a
+/// transmitting one reciprocity carries the η² factor of the whole-sphere
+/// form, and the curve would not be the one the lecture means).
+pub fn drawn_swapped(scene: &Scene<'_>, b: &SceneBrdf) -> bool {
+    let a = scene.state.plots.albedo;
+    a.swapped && !a.furnace && !b.brdf.transmits()
 }
 
 /// Whether the scene's albedo view has a curve of `b`: always, or under the
@@ -285,8 +322,12 @@ pub fn drawn(scene: &Scene<'_>, b: &SceneBrdf) -> bool {
     !scene.state.plots.albedo.furnace || b.brdf.furnace().is_some()
 }
 
-/// The BRDF whose curve is computed: `b`'s own, or its furnace lobe.
-fn subject(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<dyn Brdf> {
+/// The BRDF whose curve is computed: `b`'s own, or its furnace lobe, or
+/// `b` with its directions exchanged.
+fn subject(scene: &Scene<'_>, b: &SceneBrdf, which: Which) -> Arc<dyn Brdf> {
+    if which == Which::Dh {
+        return Arc::new(bv_core::swapped::Swapped(b.brdf.clone()));
+    }
     if scene.state.plots.albedo.furnace
         && let Some(f) = b.brdf.furnace()
     {
@@ -295,18 +336,24 @@ fn subject(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<dyn Brdf> {
     b.brdf.clone()
 }
 
-fn run(scene: &Scene<'_>, b: &SceneBrdf, per_step: usize) -> Run {
+fn run(scene: &Scene<'_>, b: &SceneBrdf, which: Which, per_step: usize) -> Run {
     Run {
         job: AlbedoJob::new(scene.incident.phi_deg.to_radians(), per_step),
-        brdf: subject(scene, b),
+        brdf: subject(scene, b, which),
     }
 }
 
 /// The curve of `b`, computed now (blocking) unless it is cached or a job
 /// is computing it (then waited for): figures, `bv render`, scripts.
 pub fn curve_now(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<AlbedoData> {
+    curve_now_of(scene, b, Which::Hd)
+}
+
+/// [`curve_now`] of either curve.
+pub fn curve_now_of(scene: &Scene<'_>, b: &SceneBrdf, which: Which) -> Arc<AlbedoData> {
     // Every θi in one parallel step: the one-shot computation.
-    let value = slots().now(b.id, key_of(scene, b), run(scene, b, N_THETA));
+    let key = key_for(scene, b, which);
+    let value = slots().now(slot_of(b, which), key, run(scene, b, which, N_THETA));
     value.value.clone()
 }
 
@@ -319,10 +366,21 @@ pub fn curve_now(scene: &Scene<'_>, b: &SceneBrdf) -> Arc<AlbedoData> {
 /// — a figure of a deck while the window shows its own — may share, and two
 /// scenes cancelling each other's jobs would never finish one.)
 pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<AlbedoData>> {
-    let key = key_of(scene, b);
+    curve_of(waker, scene, b, Which::Hd)
+}
+
+/// [`curve`] of either curve.
+pub fn curve_of(
+    waker: &Waker,
+    scene: &Scene<'_>,
+    b: &SceneBrdf,
+    which: Which,
+) -> Shown<Key, Arc<AlbedoData>> {
+    let key = key_for(scene, b, which);
+    let slot = slot_of(b, which);
     if scene.figure {
         return Shown {
-            done: Some(slots().now(b.id, key, run(scene, b, N_THETA))),
+            done: Some(slots().now(slot, key, run(scene, b, which, N_THETA))),
             stale: false,
             busy: false,
             progress: None,
@@ -330,16 +388,16 @@ pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<
     }
     let slots = slots();
     let done = if scene.interacting {
-        slots.latest(b.id)
+        slots.latest(slot)
     } else {
         slots.request(
-            b.id,
+            slot,
             key,
-            run(scene, b, rayon::current_num_threads()),
+            run(scene, b, which, rayon::current_num_threads()),
             waker,
         )
     };
-    let busy = slots.busy(b.id);
+    let busy = slots.busy(slot);
     if busy {
         waker.wake_after(std::time::Duration::from_millis(100));
     }
@@ -347,7 +405,7 @@ pub fn curve(waker: &Waker, scene: &Scene<'_>, b: &SceneBrdf) -> Shown<Key, Arc<
         stale: done.as_ref().is_some_and(|d| d.key != key),
         done,
         busy,
-        progress: slots.progress(b.id),
+        progress: slots.progress(slot),
     }
 }
 

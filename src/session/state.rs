@@ -331,6 +331,10 @@ pub struct AlbedoSettings {
     /// kd = 0, ks = 1 (`bv_core::Brdf::furnace`), and the energy it loses,
     /// `1 − E(μ)`; other models are left out.
     pub furnace: bool,
+    /// Beside each ρhd, dashed, the swapped integral
+    /// `ρdh(θ) = ∫ f(ωi, ωo) cos θi dωi` at θo = θ (LECTURE.md N12): equal
+    /// to ρhd for a reciprocal BRDF, apart for one that is not.
+    pub swapped: bool,
 }
 
 impl Default for PlotSettings {

@@ -21,7 +21,7 @@
 use super::BrdfColor as _;
 use super::chart::{self, Band, Chart, Marker, Palette, Series};
 use super::{Scene, SceneBrdf, View};
-use crate::derive::albedo::{self, AlbedoData, BAND_SIGMAS};
+use crate::derive::albedo::{self, AlbedoData, BAND_SIGMAS, Which};
 use crate::session::command::Command;
 use crate::session::state::{AlbedoSettings, PlotSettings};
 use bv_core::mean_rgb;
@@ -44,6 +44,8 @@ struct Shown {
     stale: bool,
     /// The furnace curve (the lobe with F = 1, kd = 0, ks = 1).
     furnace: bool,
+    /// The swapped integral ρdh (LECTURE.md N12), dashed.
+    swapped: bool,
 }
 
 impl AlbedoView {
@@ -55,11 +57,19 @@ impl AlbedoView {
         let mut done = 0;
         let mut total = 0;
         let furnace = scene.state.plots.albedo.furnace;
-        for b in scene.brdfs.iter().filter(|b| albedo::drawn(scene, b)) {
+        let wanted = scene
+            .brdfs
+            .iter()
+            .filter(|b| albedo::drawn(scene, b))
+            .flat_map(|b| {
+                let dh = albedo::drawn_swapped(scene, b).then_some((b, Which::Dh));
+                std::iter::once((b, Which::Hd)).chain(dh)
+            });
+        for (b, which) in wanted {
             let (data, stale) = match ctx.filter(|_| !scene.figure) {
-                None => (albedo::curve_now(scene, b), false),
+                None => (albedo::curve_now_of(scene, b, which), false),
                 Some(ctx) => {
-                    let s = albedo::curve(&super::waker(ctx), scene, b);
+                    let s = albedo::curve_of(&super::waker(ctx), scene, b, which);
                     if s.busy || s.stale || s.done.is_none() {
                         let (d, t) = s.progress.unwrap_or((0, albedo::STEPS));
                         total += t;
@@ -71,11 +81,18 @@ impl AlbedoView {
                     }
                 }
             };
+            let mut brdf = b.clone();
+            if which == Which::Dh {
+                // Paler dashes, so that over a curve it equals (a
+                // reciprocal BRDF) the dashes show on the solid line.
+                brdf.rgb = brdf.rgb.map(|c| c / 2 + 128);
+            }
             shown.push(Shown {
-                brdf: b.clone(),
+                brdf,
                 data,
                 stale,
                 furnace,
+                swapped: which == Which::Dh,
             });
         }
         self.progress = (total > 0).then_some((done, total));
@@ -168,6 +185,8 @@ enum Part {
     Transmitted,
     /// The energy lost, 1 − E, under the furnace switch: short dashes.
     Lost,
+    /// The swapped integral ρdh: long dashes.
+    Swapped,
 }
 
 impl Part {
@@ -177,6 +196,7 @@ impl Part {
             Part::Reflected => Some(10.0),
             Part::Transmitted => Some(3.0),
             Part::Lost => Some(5.0),
+            Part::Swapped => Some(14.0),
         }
     }
 }
@@ -199,6 +219,10 @@ fn series_of(s: &Shown) -> Vec<PartSeries> {
     let total: Vec<[f64; 2]> = (0..s.data.rho.len())
         .map(|k| [s.data.theta_deg[k], s.data.mean_and_band(k).0])
         .collect();
+    if s.swapped {
+        let label = format!("{} ρdh = ∫ f cos θi dωi (at θo)", s.brdf.label);
+        return vec![(Part::Swapped, label, split(total))];
+    }
     let lost: Vec<[f64; 2]> = total.iter().map(|p| [p[0], 1.0 - p[1]]).collect();
     let mut out = vec![(Part::Total, legend_label(s), split(total))];
     if s.furnace {
@@ -278,6 +302,22 @@ impl View for AlbedoView {
         let before = scene.state.plots.albedo;
         if super::toolbar_toggle(
             ui,
+            before.swapped,
+            "ρdh",
+            "Beside each ρhd, dashed: ρdh(θo) = ∫ f(ωi, ωo) cos θi dωi, the light a viewer \
+             at θo gets from a uniform sky. Equal to ρhd for a reciprocal BRDF \
+             (Helmholtz), apart for one that is not",
+        ) {
+            out.push(Command::SetPlots(PlotSettings {
+                albedo: AlbedoSettings {
+                    swapped: !before.swapped,
+                    ..before
+                },
+                ..scene.state.plots
+            }));
+        }
+        if super::toolbar_toggle(
+            ui,
             before.furnace,
             "furnace",
             "White furnace: each microfacet model's lobe with F = 1, kd = 0, ks = 1, \
@@ -286,6 +326,7 @@ impl View for AlbedoView {
             out.push(Command::SetPlots(PlotSettings {
                 albedo: AlbedoSettings {
                     furnace: !before.furnace,
+                    ..before
                 },
                 ..scene.state.plots
             }));

@@ -33,6 +33,7 @@ pub mod registry;
 pub mod represent;
 pub mod rotated;
 pub mod sampling;
+pub mod swapped;
 pub mod text;
 pub mod user;
 
