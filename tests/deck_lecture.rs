@@ -380,8 +380,13 @@ fn delta_spikes_carry_their_weights_and_stay_visible() {
     assert!((refr.weight - (1.0 - f)).abs() < 1e-9);
     assert!((angle(refl) - 60.0).abs() < 1e-9);
     assert!((180.0 - angle(refr).abs() - theta_t).abs() < 1e-9);
-    assert_eq!(format!("δ {:.3}", refl.weight), "δ 0.089");
-    assert_eq!(format!("δ {:.3}", refr.weight), "δ 0.911");
+    assert_eq!(refl.text(), "δ 0.089");
+    // The transmitted lobe's label also gives its radiance factor
+    // (ηo/ηi)² (1 − F) = 2.25 × 0.911 (LECTURE.md N3).
+    let radiance = 1.5f64.powi(2) * (1.0 - f);
+    assert_eq!(refr.text(), format!("δ 0.911, radiance × {radiance:.3}"));
+    assert_eq!(refr.text(), "δ 0.911, radiance × 2.049");
+    assert!(refr.legend().ends_with("δ transmitted") && refl.legend().ends_with("δ reflected"));
     // The small one is drawn at the shortest length, not as a dot.
     let len = |s: &bv::views::polar::Spike| s.tip[0].hypot(s.tip[1]);
     assert!((len(refl) - MIN_SPIKE * outer).abs() < 1e-12);

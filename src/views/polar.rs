@@ -341,7 +341,7 @@ impl View for PolarView {
                 l.push(entry(&g.counter, Color32::TRANSPARENT, 0.0, None));
             }
             for s in delta_spikes(scene, outer) {
-                l.push(entry(&format!("{} δ", s.label), s.color, 1.8, None));
+                l.push(entry(&s.legend(), s.color, 1.8, None));
             }
             l
         } else {
@@ -583,7 +583,7 @@ impl View for PolarView {
             for s in delta_spikes(scene, outer) {
                 pui.arrows(
                     egui_plot::Arrows::new(
-                        format!("{} δ", s.label),
+                        s.legend(),
                         PlotPoints::from(vec![[0.0, 0.0]]),
                         PlotPoints::from(vec![s.tip]),
                     )
@@ -593,7 +593,7 @@ impl View for PolarView {
                     Text::new(
                         "",
                         PlotPoint::new(s.tip[0] * 1.08, s.tip[1] * 1.08),
-                        RichText::new(format!("δ {:.3}", s.weight)).size(11.0),
+                        RichText::new(s.text()).size(11.0),
                     )
                     .color(s.color)
                     .allow_hover(false),
@@ -924,6 +924,31 @@ pub struct Spike {
     pub tip: [f64; 2],
     /// The lobe's flux weight (mean of r, g, b): what its label reads.
     pub weight: f64,
+    /// For a transmitted lobe, the factor on radiance along it,
+    /// `(ηo/ηi)² (1 − F)` (mean of r, g, b): radiance is compressed
+    /// entering a denser medium, so it differs from the flux weight.
+    pub radiance: Option<f64>,
+}
+
+impl Spike {
+    /// The legend entry: `glass δ reflected` or `glass δ transmitted`.
+    pub fn legend(&self) -> String {
+        let kind = if self.radiance.is_some() {
+            "transmitted"
+        } else {
+            "reflected"
+        };
+        format!("{} δ {kind}", self.label)
+    }
+
+    /// The label: `δ 0.050`, or for a transmitted lobe
+    /// `δ 0.950, radiance × 2.138` (LECTURE.md N3).
+    pub fn text(&self) -> String {
+        match self.radiance {
+            Some(r) => format!("δ {:.3}, radiance × {r:.3}", self.weight),
+            None => format!("δ {:.3}", self.weight),
+        }
+    }
 }
 
 /// The δ lobes of the scene's BRDFs that lie in the plane of incidence: each
@@ -948,6 +973,8 @@ pub fn delta_spikes(scene: &Scene<'_>, outer: f64) -> Vec<Spike> {
                 color: b.color(),
                 tip: [len * a.sin(), len * a.cos()],
                 weight,
+                radiance: (dl.kind == bv_core::DeltaKind::Transmission)
+                    .then(|| bv_core::mean_rgb(dl.radiance_scale)),
             });
         }
     }
@@ -1281,7 +1308,7 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
         svg.line(at([0.0, 0.0]), at(s.tip), s.color, 2.0, None);
         svg.text(
             at([s.tip[0] * 1.08, s.tip[1] * 1.08]),
-            &format!("δ {:.3}", s.weight),
+            &s.text(),
             10.5,
             s.color,
             Anchor::Middle,
