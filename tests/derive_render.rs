@@ -7,13 +7,13 @@
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bv::derive::{albedo, factor, reciprocity, sampling, sh};
+use bv::derive::{albedo, factor, hemi, reciprocity, sampling, sh};
 use bv::export::{Frame, Offscreen, render_view};
 use bv::session::state::AppState;
 use bv::views::REGISTRY;
 
 /// Results computed so far, per kind.
-fn computed() -> [u64; 7] {
+fn computed() -> [u64; 8] {
     [
         albedo::slots().computed(),
         sh::slots().computed(),
@@ -22,6 +22,7 @@ fn computed() -> [u64; 7] {
         factor::view_slots().computed(),
         sampling::slots().computed(),
         reciprocity::slots().computed(),
+        hemi::slots().computed(),
     ]
 }
 
@@ -51,16 +52,17 @@ fn every_view_rendered_computes_each_derived_result_once() {
         dark: true,
         transparent: false,
     };
-    assert_eq!(computed(), [0; 7]);
+    assert_eq!(computed(), [0; 8]);
     for e in REGISTRY.iter() {
         render_view(&mut off, &s, e, frame).unwrap_or_else(|err| panic!("{}: {err:#}", e.id));
     }
     // Albedo curve, SH projection, factor overlay, factorisation,
-    // factorisation-view data, sampling histogram, reciprocity map: one each.
-    assert_eq!(computed(), [1; 7]);
+    // factorisation-view data, sampling histogram, reciprocity map,
+    // hemisphere map: one each.
+    assert_eq!(computed(), [1; 8]);
     // A second `--view all` in the same process computes nothing.
     for e in REGISTRY.iter() {
         render_view(&mut off, &s, e, frame).unwrap();
     }
-    assert_eq!(computed(), [1; 7]);
+    assert_eq!(computed(), [1; 8]);
 }

@@ -18,6 +18,7 @@ pub mod albedo;
 pub mod compare;
 pub mod factor;
 pub mod gonio;
+pub mod hemi;
 pub mod interface;
 pub mod jobs;
 pub mod microsurface;

@@ -116,6 +116,13 @@ pub const MICROSURFACE: ViewInfo = ViewInfo {
     in_grid: false,
 };
 
+/// f(ωi, ·) over the outgoing hemisphere from above, one disc per BRDF.
+pub const HEMI: ViewInfo = ViewInfo {
+    id: "hemi",
+    title: "Hemisphere (from above)",
+    in_grid: false,
+};
+
 /// Every view, in layout order (the first two share the top row, the others
 /// fill the rows below).
 pub const VIEWS: &[ViewInfo] = &[
@@ -133,6 +140,7 @@ pub const VIEWS: &[ViewInfo] = &[
     SAMPLING,
     FACTOR,
     MICROSURFACE,
+    HEMI,
 ];
 
 /// Other names a view answers to on the command line (`bv render --view

@@ -21,6 +21,7 @@ pub mod factor_overlay;
 pub mod fonts;
 pub mod fresnel;
 pub mod gpu_image;
+pub mod hemi;
 pub mod image_slice;
 pub mod lit_sphere;
 pub mod lobe3d;
@@ -190,6 +191,7 @@ const CONSTRUCTORS: &[(views::ViewInfo, MakeView)] = &[
     (views::MICROSURFACE, || {
         Box::new(microsurface::MicrosurfaceView::default())
     }),
+    (views::HEMI, || Box::new(hemi::HemiView::default())),
 ];
 
 /// The constructor of the view `v`.

@@ -16,6 +16,7 @@ pub mod directions;
 pub mod estimate;
 pub mod gauss_kronrod;
 pub mod gonio;
+pub mod hemi_map;
 pub mod isotropy;
 pub mod ndf;
 pub mod positivity;
