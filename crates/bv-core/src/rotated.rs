@@ -171,6 +171,12 @@ impl Brdf for Rotated {
         self.ndf.as_ref().map(|n| n as &dyn Ndf)
     }
 
+    /// The inner model's furnace lobe, turned the same way.
+    fn furnace(&self) -> Option<Box<dyn Brdf>> {
+        let f: Arc<dyn Brdf> = Arc::from(self.inner.furnace()?);
+        Some(Box::new(Rotated::new(f, self.angle)))
+    }
+
     // No batch kernel: the inner one would evaluate in the unrotated frame;
     // the default `eval_batch` goes through `eval`.
 

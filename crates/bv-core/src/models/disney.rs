@@ -165,6 +165,7 @@ pub struct Disney {
     metallic: f64,
     subsurface: f64,
     roughness: f64,
+    anisotropic: f64,
     sheen: f64,
     clearcoat: f64,
     /// mix(0.08 · specular · mix(1, Ctint, specular_tint), base, metallic).
@@ -312,6 +313,7 @@ impl Disney {
             metallic,
             subsurface,
             roughness,
+            anisotropic,
             sheen,
             clearcoat,
             cspec0,
@@ -374,6 +376,26 @@ impl Brdf for Disney {
 
     fn batch_kernel(&self) -> Option<&dyn Kernel> {
         Some(&self.kernel)
+    }
+
+    /// The specular lobe in a white furnace: metallic with a white base,
+    /// so that Schlick's F with F0 = 1 is 1 and the diffuse, sheen and
+    /// subsurface terms (weighted by 1 − metallic) vanish; no clearcoat;
+    /// the same roughness and anisotropy.
+    fn furnace(&self) -> Option<Box<dyn Brdf>> {
+        Some(Box::new(Disney::new(
+            Rgb::ONE,
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            self.roughness,
+            self.anisotropic,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        )))
     }
 
     fn fresnel_term(&self) -> Option<FresnelTerm> {

@@ -455,6 +455,18 @@ impl Brdf for RoughDielectric {
         frame::refract(wi, self.eta).into_iter().collect()
     }
 
+    /// The interface in a white furnace: the same distribution, roughness,
+    /// index and Smith term with a white tint. A dielectric's Fresnel term
+    /// only splits the light between reflection and transmission, so the
+    /// whole-sphere albedo ρR + ρT of this lobe is what single scattering
+    /// keeps, and 1 − (ρR + ρT) what it loses (Walter et al. 2007 §5.2).
+    fn furnace(&self) -> Option<Box<dyn Brdf>> {
+        let s = &self.ndf.first;
+        RoughDielectric::new(s.dist, s.ax, s.ay, self.eta, self.geometry, Rgb::ONE)
+            .ok()
+            .map(|b| Box::new(b) as Box<dyn Brdf>)
+    }
+
     fn ndf(&self) -> Option<&dyn Ndf> {
         Some(&self.ndf)
     }
