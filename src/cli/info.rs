@@ -62,9 +62,9 @@ fn pairs_count(s: &str) -> Result<usize, String> {
 pub fn run(args: &InfoArgs) -> Result<()> {
     let name = args.file.to_string_lossy();
     if let Some((info, _)) = bv_core::registry::file_model(&name)
-        && info.file_param().is_some_and(|(_, f)| {
-            !std::ptr::addr_eq(f, &bv_core::models::merl::MERL_FILES)
-        })
+        && info
+            .file_param()
+            .is_some_and(|(_, f)| !std::ptr::addr_eq(f, &bv_core::models::merl::MERL_FILES))
     {
         return run_other(args);
     }
@@ -140,7 +140,9 @@ fn run_other(args: &InfoArgs) -> Result<()> {
     let name = args.file.to_string_lossy().into_owned();
     let start = Instant::now();
     let spec = bv_core::ModelSpec::new(&name)?;
-    let brdf = spec.build().with_context(|| format!("cannot read `{name}`"))?;
+    let brdf = spec
+        .build()
+        .with_context(|| format!("cannot read `{name}`"))?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let data = brdf.file_data();
     let summary = data.as_ref().map(|d| d.summary()).unwrap_or_default();
@@ -157,11 +159,7 @@ fn run_other(args: &InfoArgs) -> Result<()> {
             })
         })
         .collect();
-    let recip = reciprocity::check(
-        brdf.as_ref(),
-        &directions::upper_pairs(args.pairs, 7),
-        1e-6,
-    );
+    let recip = reciprocity::check(brdf.as_ref(), &directions::upper_pairs(args.pairs, 7), 1e-6);
     let bytes = std::fs::metadata(&args.file).map(|m| m.len()).unwrap_or(0);
     let report = json!({
         "file": name,
@@ -189,8 +187,18 @@ fn run_other(args: &InfoArgs) -> Result<()> {
         int(&report["rho_hd"][0]["samples"])
     );
     for x in report["rho_hd"].as_array().into_iter().flatten() {
-        let v: Vec<f64> = x["value"].as_array().into_iter().flatten().map(num).collect();
-        let e: Vec<f64> = x["stderr"].as_array().into_iter().flatten().map(num).collect();
+        let v: Vec<f64> = x["value"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(num)
+            .collect();
+        let e: Vec<f64> = x["stderr"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(num)
+            .collect();
         if v.len() == 3 && e.len() == 3 {
             let _ = writeln!(
                 out,

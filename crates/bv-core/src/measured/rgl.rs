@@ -51,6 +51,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
+/// The smallest `cos θo` that [`RglMaterial::eval`] divides by (θo within
+/// 0.06° of the horizon): `f cos θo` agrees with Mitsuba's everywhere, `f`
+/// is bounded.
+pub const GRAZING_COS: f64 = 1e-3;
+
 /// An RGL material in memory, ready to evaluate and sample.
 #[derive(Debug, Clone)]
 pub struct RglMaterial {
@@ -526,12 +531,16 @@ impl RglMaterial {
         v
     }
 
-    /// `f(wi, wo)` (1/sr): [`Self::eval_cos`] over `cos θo`.
+    /// `f(wi, wo)` (1/sr): [`Self::eval_cos`] over `cos θo`, the cosine
+    /// taken no smaller than [`GRAZING_COS`]: the tables resolve `f cos θo`,
+    /// which interpolation does not bring to 0 exactly at the horizon, so
+    /// dividing by a vanishing cosine would turn that residue into an
+    /// unbounded `f` (and rotations of a grazing pair into large changes).
     pub fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
         if !(wi.z > 0.0 && wo.z > 0.0) {
             return Rgb::ZERO;
         }
-        self.eval_cos(wi, wo) / wo.z
+        self.eval_cos(wi, wo) / wo.z.max(GRAZING_COS)
     }
 
     /// Draws `wo` for light from `wi` as Mitsuba's `sample` does: the

@@ -228,7 +228,15 @@ pub fn tabulate_rgl(brdf: &dyn Brdf, opts: &RglWriteOptions) -> Result<Vec<u8>> 
         for y in 0..n {
             for x in 0..n {
                 let sp = [x as f64 / (n - 1) as f64, y as f64 / (n - 1) as f64];
-                let (u_m, _) = warp.sample(sp, &[0.0]);
+                let (mut u_m, _) = warp.sample(sp, &[0.0]);
+                // The first column is the pole of the square (m = the
+                // normal, where φm is undefined): the warp's clamped sample
+                // lands a little off it, in a direction that depends on the
+                // row; store the pole's value in every row, so that a half
+                // vector on the normal reads the same whatever its φ.
+                if x == 0 {
+                    u_m[0] = 0.0;
+                }
                 let tm = u2theta(u_m[0]);
                 let phi = u2phi(u_m[1]);
                 let m = DVec3::new(tm.sin() * phi.cos(), tm.sin() * phi.sin(), tm.cos());
