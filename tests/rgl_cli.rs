@@ -59,27 +59,52 @@ fn tabulate_info_and_eval_an_rgl_file() {
     let f = file.to_str().unwrap();
     let out = bv(
         &[
-            "tabulate", "--model", "lambert", "--param", "albedo=0.5", "--format", "rgl", "--out", f,
+            "tabulate",
+            "--model",
+            "lambert",
+            "--param",
+            "albedo=0.5",
+            "--format",
+            "rgl",
+            "--out",
+            f,
         ],
         "",
     );
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("RGL material"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("RGL material"),
+        "{}",
+        text(&out.stdout)
+    );
 
     let out = bv(&["info", "--samples", "20000", "--pairs", "2000", f], "");
     assert!(out.status.success(), "{}", text(&out.stderr));
     let report = text(&out.stdout);
-    for want in ["rgl model", "16 θi", "isotropic", "Jacobian on", "ρhd", "reciprocity"] {
+    for want in [
+        "rgl model",
+        "16 θi",
+        "isotropic",
+        "Jacobian on",
+        "ρhd",
+        "reciprocity",
+    ] {
         assert!(report.contains(want), "missing `{want}` in\n{report}");
     }
-    let out = bv(&["info", "--json", "--samples", "20000", "--pairs", "2000", f], "");
+    let out = bv(
+        &["info", "--json", "--samples", "20000", "--pairs", "2000", f],
+        "",
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let j: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(j["model"], "rgl");
     // ρhd of the round-tripped Lambert at normal incidence: 0.5 up to the
     // round trip (< 1 %) and the Monte Carlo error.
     let rho = &j["rho_hd"][0];
-    let (v, e) = (rho["value"][1].as_f64().unwrap(), rho["stderr"][1].as_f64().unwrap());
+    let (v, e) = (
+        rho["value"][1].as_f64().unwrap(),
+        rho["stderr"][1].as_f64().unwrap(),
+    );
     assert!((v - 0.5).abs() < 0.005 + 4.0 * e, "{v} ± {e}");
 
     // By path as the model, and as `rgl` + `path`: the same value, near
@@ -107,7 +132,15 @@ fn a_binary_path_is_a_model_and_bad_files_are_named() {
     let f = file.to_str().unwrap();
     let out = bv(
         &[
-            "tabulate", "--model", "lambert", "--param", "albedo=0.3", "--out", f, "--dims", "8,6,12",
+            "tabulate",
+            "--model",
+            "lambert",
+            "--param",
+            "albedo=0.3",
+            "--out",
+            f,
+            "--dims",
+            "8,6,12",
         ],
         "",
     );
@@ -124,6 +157,9 @@ fn a_binary_path_is_a_model_and_bad_files_are_named() {
     let v = r[0].clone().unwrap();
     assert!((v[0] - 0.3 / PI).abs() < 1e-6, "{v:?}");
     let e = r[1].clone().unwrap_err();
-    assert!(e.contains("bad.bsdf") && e.contains("not a tensor file"), "{e}");
+    assert!(
+        e.contains("bad.bsdf") && e.contains("not a tensor file"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -31,11 +31,20 @@ pub struct TabulateArgs {
     /// File format: `merl` (a `.binary` half/difference table) or `rgl` (an
     /// isotropic RGB `.bsdf` tensor file: 16 θi up to 85°, NDF and σ on 128
     /// nodes, VNDF 128², values 32²; `--dims` does not apply).
-    #[arg(long, default_value = "merl", value_parser = ["merl", "rgl"])]
-    pub format: String,
+    #[arg(long, value_enum, default_value_t = TableFormat::Merl)]
+    pub format: TableFormat,
     /// The `description` field of an RGL file (default: the model spec).
     #[arg(long)]
     pub description: Option<String>,
+}
+
+/// The file formats `bv tabulate` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableFormat {
+    /// A MERL `.binary` half/difference-angle table.
+    Merl,
+    /// An isotropic RGB RGL `.bsdf` tensor file.
+    Rgl,
 }
 
 /// Builds the model from `--model` and `--param`s (the same parsing and
@@ -46,7 +55,7 @@ pub fn model_spec(model: &str, params: &[String]) -> Result<ModelSpec> {
 
 /// Runs `bv tabulate`.
 pub fn run(args: &TabulateArgs) -> Result<()> {
-    if args.format == "rgl" {
+    if args.format == TableFormat::Rgl {
         return run_rgl(args);
     }
     let dims = MerlDims::parse(&args.dims).context("--dims")?;

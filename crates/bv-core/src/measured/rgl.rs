@@ -155,7 +155,7 @@ pub fn spectral_weights(nm: &[f64]) -> std::result::Result<[Vec<f64>; 3], String
     }
     for (c, wc) in w.iter_mut().enumerate() {
         let s: f64 = wc.iter().sum();
-        if !(s > 1e-6) {
+        if s.is_nan() || s <= 1e-6 {
             return Err(format!(
                 "the wavelengths ({:.0}–{:.0} nm) do not cover the visible range: channel {c} has no weight",
                 nm.first().copied().unwrap_or(0.0),
@@ -547,7 +547,7 @@ impl RglMaterial {
     /// luminance warp, then the VNDF warp, then reflection about the drawn
     /// normal. `None` below the horizon.
     pub fn sample(&self, wi: DVec3, u: DVec2) -> Option<DVec3> {
-        if !(wi.z > 0.0) {
+        if wi.z.is_nan() || wi.z <= 0.0 {
             return None;
         }
         let mut wi = wi;
