@@ -30,7 +30,8 @@
 //! result is `f cos θo` (Mitsuba's `eval` includes the cosine): bv's
 //! [`RglMaterial::eval`] divides by `cos θo` to return `f`. Anisotropic
 //! files whose `phi_i` covers a half or a quarter turn are folded by the
-//! symmetry Mitsuba assumes (`m_reduction`).
+//! symmetry Mitsuba assumes (`m_reduction`); isotropic files by a half turn,
+//! as Mitsuba 3.9.1 does (measured against it; a symmetry of isotropic data).
 //!
 //! # Spectra
 //! Spectral files are turned into linear sRGB once, at load: the CIE 1931 2°
@@ -70,6 +71,7 @@ pub struct RglMaterial {
     luminance: Marginal2D,
     rgb: Marginal2D,
     isotropic: bool,
+    phi_free: bool,
     jacobian: bool,
     reduction: i64,
     wavelengths: Option<(usize, f64, f64)>,
@@ -337,6 +339,17 @@ impl RglMaterial {
             }
         });
 
+        // Whether the NDF and σ tables are constant along φ: then an
+        // isotropic file's evaluation depends on φi − φo only (σ is read at
+        // the absolute φi).
+        let flat_rows = |v: &[f64], nx: usize| {
+            v.chunks(nx.max(1)).all(|r| {
+                r.iter()
+                    .zip(&v[..nx])
+                    .all(|(a, b)| (a - b).abs() <= 1e-6 * b.abs())
+            })
+        };
+        let phi_free = flat_rows(&ndf, x.dim(ndf_f, 1)) && flat_rows(&sigma, x.dim(sigma_f, 1));
         let mut warnings = Vec::new();
         let (ny, nx) = (x.dim(ndf_f, 0), x.dim(ndf_f, 1));
         let ndf = Marginal2D::new(&ndf, nx, ny, vec![], false, false)
@@ -401,7 +414,12 @@ impl RglMaterial {
 
         let isotropic = nphi <= 2;
         let reduction = if isotropic {
-            0
+            // Mitsuba 3 (3.9.1, measured against it) folds isotropic data
+            // too, as a half-turn symmetry: a pair with wi.y ≥ 0 is rotated
+            // by π about the normal. Rotations are a symmetry of isotropic
+            // data, so this matters only where σ varies with φi; it is done
+            // here so that bv and Mitsuba agree on any file.
+            2
         } else {
             let span = phi_i[nphi - 1] - phi_i[0];
             (2.0 * PI / span).round() as i64
@@ -419,6 +437,7 @@ impl RglMaterial {
             luminance,
             rgb,
             isotropic,
+            phi_free: isotropic && nphi == 1 && phi_free,
             jacobian,
             reduction,
             wavelengths: wl_info,
@@ -448,9 +467,18 @@ impl RglMaterial {
         &self.phi_i
     }
 
-    /// Whether the data is isotropic (at most two `phi_i`).
+    /// Whether the data is isotropic in the file's sense (at most two
+    /// `phi_i`: half-vector azimuths relative to φi).
     pub fn is_isotropic(&self) -> bool {
         self.isotropic
+    }
+
+    /// Whether evaluation is invariant under rotations about the normal:
+    /// isotropic data with one `phi_i` whose NDF and σ tables do not vary
+    /// with φ (σ is read at the absolute φi, and two `phi_i` slices are
+    /// interpolated by it).
+    pub fn is_rotation_invariant(&self) -> bool {
+        self.phi_free
     }
 
     /// Whether the stored values carry the Jacobian `4σ/D` (§6).
@@ -468,8 +496,10 @@ impl RglMaterial {
         (self.vndf.size(), self.rgb.size())
     }
 
-    /// Folds `(wi, wo)` by the symmetry of an anisotropic file whose `phi_i`
-    /// covers a half or quarter turn (Mitsuba's `m_reduction`); returns the
+    /// Folds `(wi, wo)` by the symmetry of a file whose `phi_i` covers a
+    /// half or quarter turn, or of isotropic data (Mitsuba's `m_reduction`:
+    /// `wi` is brought to y ≤ 0, and x ≤ 0 for a quarter turn, by flipping
+    /// the signs of x and y together or separately); returns the
     /// signs to unfold a sampled direction.
     fn fold(&self, wi: &mut DVec3, wo: Option<&mut DVec3>) -> (f64, f64) {
         if self.reduction < 2 {

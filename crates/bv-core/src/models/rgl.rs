@@ -113,7 +113,9 @@ impl Brdf for Rgl {
             reciprocal: false,
             // Measured data makes no promise.
             energy_conserving: false,
-            isotropic: self.material.is_isotropic(),
+            // Rotation invariance needs more than the file's "isotropic"
+            // layout: σ and the NDF must not vary with φ, and one φi slice.
+            isotropic: self.material.is_rotation_invariant(),
         }
     }
 
