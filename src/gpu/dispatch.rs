@@ -168,19 +168,13 @@ mod tests {
             );
         }
         // Every analytic built-in model but the mix (drawn by the loop over
-        // its components) has a port; a file-backed model may not have one
-        // yet (the RGL reader's VNDF warp is CPU-only: the GPU views draw it
-        // as 0, the CPU views and analyses draw it).
+        // its components) has a port.
         for m in catalogue.iter() {
             let is_mix = m
                 .params
                 .iter()
                 .any(|d| matches!(d.kind, bv_core::ParamKind::Components { .. }));
-            if is_mix {
-                assert!(m.gpu.is_none(), "{}", m.id);
-            } else if m.file_param().is_none() {
-                assert!(m.gpu.is_some(), "{}", m.id);
-            }
+            assert_eq!(m.gpu.is_some(), !is_mix, "{}", m.id);
         }
     }
 }

@@ -164,6 +164,22 @@ impl Marginal2D {
         self.slices
     }
 
+    /// The (normalised) node values, slice after slice.
+    pub fn data(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// The marginal CDFs over rows, `ny` per slice (empty without a CDF).
+    pub fn marginal(&self) -> &[f64] {
+        &self.marginal
+    }
+
+    /// The conditional CDFs along each row, `nx · ny` per slice (empty
+    /// without a CDF).
+    pub fn conditional(&self) -> &[f64] {
+        &self.conditional
+    }
+
     fn weights(&self, param: &[f64]) -> Weights {
         let mut slice = 0;
         let mut w = Vec::with_capacity(self.params.len());

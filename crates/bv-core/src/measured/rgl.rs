@@ -78,7 +78,12 @@ pub struct RglMaterial {
     valid: Option<f64>,
     warnings: Vec<String>,
     bytes: usize,
+    gpu: Vec<f32>,
+    gpu_slots: [f32; GPU_SLOTS],
 }
+
+/// Number of values [`RglMaterial::gpu_slots`] returns.
+pub const GPU_SLOTS: usize = 15;
 
 fn file_err(name: &str, reason: impl Into<String>) -> BvError {
     BvError::File {
@@ -425,6 +430,7 @@ impl RglMaterial {
             (2.0 * PI / span).round() as i64
         };
         let _ = name;
+        let (gpu, gpu_slots) = gpu_blob(nphi, &theta_i, &vndf, &rgb, &ndf, &sigma, jacobian);
         Ok(Self {
             name: tf.name().to_string(),
             description,
@@ -444,6 +450,8 @@ impl RglMaterial {
             valid,
             warnings,
             bytes: 0,
+            gpu,
+            gpu_slots,
         })
     }
 
@@ -677,10 +685,86 @@ impl RglMaterial {
     }
 }
 
+/// The tables a GPU port reads, in one `f32` vector, and where each starts
+/// (see [`RglMaterial::gpu_slots`]). Files with one `phi_i` only (the
+/// isotropic ones of the database); others get an empty blob, which the port
+/// draws as 0.
+fn gpu_blob(
+    nphi: usize,
+    theta_i: &[f64],
+    vndf: &Marginal2D,
+    rgb: &Marginal2D,
+    ndf: &Marginal2D,
+    sigma: &Marginal2D,
+    jacobian: bool,
+) -> (Vec<f32>, [f32; GPU_SLOTS]) {
+    let mut slots = [0.0f32; GPU_SLOTS];
+    if nphi != 1 {
+        return (Vec::new(), slots);
+    }
+    let mut out: Vec<f32> = Vec::new();
+    let section = |v: &[f64], out: &mut Vec<f32>| -> f32 {
+        out.resize(out.len().next_multiple_of(crate::model::TABLE_ALIGN), 0.0);
+        let at = out.len();
+        out.extend(v.iter().map(|x| *x as f32));
+        at as f32
+    };
+    let (vx, vy) = vndf.size();
+    let (n, _) = rgb.size();
+    let (nx, ny) = ndf.size();
+    let (sx, sy) = sigma.size();
+    slots[0] = theta_i.len() as f32;
+    slots[1] = vx as f32;
+    slots[2] = vy as f32;
+    slots[3] = n as f32;
+    slots[4] = nx as f32;
+    slots[5] = ny as f32;
+    slots[6] = sx as f32;
+    slots[7] = sy as f32;
+    slots[8] = f32::from(u8::from(jacobian));
+    slots[9] = section(theta_i, &mut out);
+    slots[10] = section(vndf.data(), &mut out);
+    slots[11] = section(vndf.marginal(), &mut out);
+    slots[12] = section(vndf.conditional(), &mut out);
+    // The plain interpolants store values over (nx−1)(ny−1) (Mitsuba's
+    // unnormalised Marginal2D); the port reads them as values.
+    let values = |m: &Marginal2D| -> Vec<f64> {
+        let (x, y) = m.size();
+        let k = ((x - 1) * (y - 1)) as f64;
+        m.data().iter().map(|v| v * k).collect()
+    };
+    slots[13] = section(&values(rgb), &mut out);
+    let ndf_at = section(&values(ndf), &mut out);
+    let sigma_at = section(&values(sigma), &mut out);
+    // Both fit one slot: σ directly follows the NDF's rounded-up end.
+    slots[14] = ndf_at;
+    debug_assert_eq!(
+        sigma_at as usize,
+        (ndf_at as usize + nx * ny).next_multiple_of(crate::model::TABLE_ALIGN)
+    );
+    (out, slots)
+}
+
+impl RglMaterial {
+    /// What the GPU port reads besides the blob (`shaders/models/rgl.wgsl`,
+    /// in this order): nθ, VNDF nx and ny, value nodes n, NDF nx and ny, σ
+    /// nx and ny, the Jacobian flag, and the offsets in the blob of θi, the
+    /// VNDF's values, marginal and conditional CDFs, the RGB values and the
+    /// NDF (σ follows it at the next multiple of 4). All zero for a file the
+    /// port cannot draw (more than one `phi_i`).
+    pub fn gpu_slots(&self) -> [f32; GPU_SLOTS] {
+        self.gpu_slots
+    }
+
+    /// Floats in the GPU blob (0 when the port cannot draw the file).
+    pub fn gpu_data_len(&self) -> usize {
+        self.gpu.len()
+    }
+}
+
 impl crate::model::GpuBlob for RglMaterial {
-    /// Nothing: the RGL model has no GPU port.
     fn gpu_data(&self) -> &[f32] {
-        &[]
+        &self.gpu
     }
 }
 

@@ -3,8 +3,11 @@
 //! Dupuy & Jakob 2018 ([`crate::measured::rgl`]).
 
 use crate::measured::rgl::{self as material, RglMaterial};
-use crate::model::{Build, FileData, FileFormat, ModelInfo, Progress};
+use crate::model::{
+    Build, FileData, FileFormat, GpuPort, GpuTables, ModelInfo, Progress, TABLE_ALIGN,
+};
 use crate::params::decl::{Applies, ParamDecl, ParamKind};
+use crate::params::value::ModelSpec;
 use crate::params::value::Params;
 use crate::{Brdf, BvError, Claims, Result, Rgb};
 use glam::{DVec2, DVec3};
@@ -23,8 +26,9 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
     applies: Applies::Always,
 }];
 
-/// Catalogue entry. It has no GPU port: the GPU views cannot draw it (the
-/// CPU views and every analysis can).
+/// Catalogue entry. The GPU port draws files with one `phi_i` (the
+/// isotropic ones); others draw as 0 on the GPU (the CPU views and every
+/// analysis draw them).
 pub static INFO: ModelInfo = ModelInfo {
     id: "rgl",
     name: "RGL measured",
@@ -33,8 +37,51 @@ pub static INFO: ModelInfo = ModelInfo {
     params: PARAMS,
     aliases: &[],
     build: Build::Static(build),
-    gpu: None,
+    gpu: Some(
+        GpuPort::new(
+            "bv::models::rgl",
+            "shaders/models/rgl.wgsl",
+            include_str!("../../../../shaders/models/rgl.wgsl"),
+        )
+        .with_derived(DERIVED_SLOTS, derive_slots),
+    ),
 };
+
+/// Derived GPU slots of `rgl` (read by `shaders/models/rgl.wgsl`): the
+/// blob's offset in the frame's table buffer (units of [`TABLE_ALIGN`]
+/// floats), then [`RglMaterial::gpu_slots`].
+const DERIVED_SLOTS: &[&str] = &[
+    "table",
+    "n_theta",
+    "vndf_x",
+    "vndf_y",
+    "values",
+    "ndf_x",
+    "ndf_y",
+    "sigma_x",
+    "sigma_y",
+    "jacobian",
+    "at_theta",
+    "at_vndf",
+    "at_marginal",
+    "at_conditional",
+    "at_rgb",
+    "at_ndf",
+];
+
+fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
+    // Through the cache: the same material as the built model's.
+    let m = material::read_cached(spec.params().text("path")?, &mut |_, _| {})?;
+    let slots = m.gpu_slots();
+    let offset = if m.gpu_data_len() > 0 {
+        tables.offset_of(m) / TABLE_ALIGN
+    } else {
+        0
+    };
+    let mut out = vec![offset as f32];
+    out.extend_from_slice(&slots);
+    Ok(out)
+}
 
 /// RGL `.bsdf` files as a file format (reader and cache in
 /// [`crate::measured::rgl`]).
