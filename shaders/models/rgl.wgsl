@@ -116,13 +116,9 @@ fn eval(o: u32, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
     if (wi_in.z <= 0.0 || wo_in.z <= 0.0 || nt == 0u) {
         return vec3<f32>(0.0);
     }
-    // The half-turn fold Mitsuba applies to isotropic data: wi to y ≤ 0.
-    var wi = wi_in;
-    var wo = wo_in;
-    if (wi.y >= 0.0) {
-        wi = vec3<f32>(-wi.x, -wi.y, wi.z);
-        wo = vec3<f32>(-wo.x, -wo.y, wo.z);
-    }
+    // Isotropic data (one φi) is not folded (bv_core's `fold`).
+    let wi = wi_in;
+    let wo = wo_in;
     let hs = wi + wo;
     let hl = length(hs);
     if (hl <= 0.0) {

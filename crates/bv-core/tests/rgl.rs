@@ -747,12 +747,11 @@ fn random_file(seed: u64, nphi: usize, span: f64) -> Vec<u8> {
 
 #[test]
 fn anisotropic_and_folded_files_sample_as_they_evaluate() {
-    // Quarter-turn, half-turn and full-turn anisotropic files and an
-    // isotropic one with φ-dependent σ (all checked against Mitsuba 3.9.1
-    // during development: 100 % of 3000 pairs within 2 %): the sampler's
-    // histogram matches its pdf, values are finite, and the isotropic file
-    // has the half-turn symmetry Mitsuba gives it but is not claimed
-    // rotation invariant.
+    // Quarter-turn, half-turn and full-turn anisotropic files (checked
+    // against Mitsuba 3.9.1 during development: 100 % of 3000 pairs within
+    // 2 %) and an isotropic one with φ-dependent σ: the sampler's histogram
+    // matches its pdf, values are finite, and none is claimed rotation
+    // invariant.
     for (seed, nphi, span) in [(1, 5, PI / 2.0), (2, 5, PI), (3, 9, 2.0 * PI), (5, 1, 0.0)] {
         let m = Rgl::new(Arc::new(
             RglMaterial::parse(random_file(seed, nphi, span), "t.bsdf").unwrap(),
@@ -785,11 +784,6 @@ fn anisotropic_and_folded_files_sample_as_they_evaluate() {
             let wo = dir(rng.random_range(0.0..1.5), rng.random_range(0.0..2.0 * PI));
             let f = m.eval(wi, wo);
             assert!(f.is_finite() && f.min_element() >= 0.0);
-            if nphi == 1 {
-                let half = |w: DVec3| DVec3::new(-w.x, -w.y, w.z);
-                let g = m.eval(half(wi), half(wo));
-                assert!((f - g).abs().max_element() <= 1e-9 * f.max_element().max(1e-9));
-            }
         }
     }
 }

@@ -30,8 +30,7 @@
 //! result is `f cos θo` (Mitsuba's `eval` includes the cosine): bv's
 //! [`RglMaterial::eval`] divides by `cos θo` to return `f`. Anisotropic
 //! files whose `phi_i` covers a half or a quarter turn are folded by the
-//! symmetry Mitsuba assumes (`m_reduction`); isotropic files by a half turn,
-//! as Mitsuba 3.9.1 does (measured against it; a symmetry of isotropic data).
+//! symmetry Mitsuba assumes (`m_reduction`); isotropic files are not folded.
 //!
 //! # Spectra
 //! Spectral files are turned into linear sRGB once, at load: the CIE 1931 2°
@@ -419,12 +418,13 @@ impl RglMaterial {
 
         let isotropic = nphi <= 2;
         let reduction = if isotropic {
-            // Mitsuba 3 (3.9.1, measured against it) folds isotropic data
-            // too, as a half-turn symmetry: a pair with wi.y ≥ 0 is rotated
-            // by π about the normal. Rotations are a symmetry of isotropic
-            // data, so this matters only where σ varies with φi; it is done
-            // here so that bv and Mitsuba agree on any file.
-            2
+            // No fold, as the paper and `powitacq`: the reduction describes
+            // anisotropic data. (Mitsuba 3.9.1 leaves `m_reduction`
+            // uninitialised for isotropic files: measured, the same file
+            // folded by a half turn in some runs and not in others. With
+            // one φi and NDF and σ constant along φ, as in the files
+            // measured and written, the fold changes nothing.)
+            0
         } else {
             let span = phi_i[nphi - 1] - phi_i[0];
             (2.0 * PI / span).round() as i64
@@ -504,8 +504,8 @@ impl RglMaterial {
         (self.vndf.size(), self.rgb.size())
     }
 
-    /// Folds `(wi, wo)` by the symmetry of a file whose `phi_i` covers a
-    /// half or quarter turn, or of isotropic data (Mitsuba's `m_reduction`:
+    /// Folds `(wi, wo)` by the symmetry of an anisotropic file whose `phi_i`
+    /// covers a half or quarter turn (Mitsuba's `m_reduction`:
     /// `wi` is brought to y ≤ 0, and x ≤ 0 for a quarter turn, by flipping
     /// the signs of x and y together or separately); returns the
     /// signs to unfold a sampled direction.
