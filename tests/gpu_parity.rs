@@ -41,7 +41,10 @@ const REL_TOL: f64 = 1e-3;
 const NOT_PORTED: &[(&str, &str)] = &[];
 
 /// Models tested by their own test below (they need files).
-const OWN_TEST: &[(&str, &str)] = &[("merl", "see merl_port_matches_bv_core")];
+const OWN_TEST: &[(&str, &str)] = &[
+    ("merl", "see merl_port_matches_bv_core"),
+    ("rgl", "see rgl_port_matches_bv_core"),
+];
 
 /// The f32 vector closest to unit length near `w` rounded: two components
 /// move by up to ±2 ulps and the third is re-solved from |w|² = 1 (taking the
@@ -659,4 +662,107 @@ fn merl_port_matches_bv_core() {
         "the merl port disagrees with bv-core:\n{}",
         failures.join("\n")
     );
+}
+
+/// The RGL port's tolerance on f cos θo, looser than [`ABS_TOL`]/[`REL_TOL`]: its
+/// lookup goes through f32 `asin`/`atan2` (which Vulkan allows to be loose:
+/// lavapipe's moved f by up to 0.7 % at ordinary pairs) into a warp whose
+/// inverse and values are steep where the lobe is.
+const RGL_REL_TOL: f64 = 1e-2;
+/// Absolute part of the RGL port's tolerance (on f cos θo).
+const RGL_ABS_TOL: f64 = 1e-4;
+
+#[test]
+fn rgl_port_matches_bv_core() {
+    use bv_core::measured::rgl_write::{RglWriteOptions, tabulate_rgl};
+    let Some(gpu) = gpu_for_test() else { return };
+    let mut lib = ShaderLibrary::new().unwrap();
+    let eval = GpuEvaluator::new(gpu, &mut lib).unwrap();
+    let dir = std::env::temp_dir().join(format!("bv-gpu-rgl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = [
+        (
+            "lambert",
+            serde_json::json!({"albedo": [0.2, 0.5, 0.8]}),
+            RglWriteOptions::default(),
+        ),
+        (
+            "cook-torrance",
+            serde_json::json!({"kd": [0.1, 0.2, 0.3], "ks": 0.8, "distribution": "ggx", "alpha": 0.3}),
+            RglWriteOptions::default(),
+        ),
+        (
+            "cook-torrance",
+            serde_json::json!({"distribution": "ggx", "alpha": 0.6}),
+            RglWriteOptions {
+                theta_i: 5,
+                ndf: 20,
+                vndf: 24,
+                values: 12,
+                ..RglWriteOptions::default()
+            },
+        ),
+    ];
+    let pairs = pairs();
+    let mut failures = Vec::new();
+    for (k, (model, params, opts)) in models.iter().enumerate() {
+        let b = ModelSpec::from_json(model, params)
+            .unwrap()
+            .build()
+            .unwrap();
+        let path = dir.join(format!("m{k}.bsdf"));
+        std::fs::write(&path, tabulate_rgl(b.as_ref(), opts).unwrap()).unwrap();
+        let spec = ModelSpec::from_json(
+            "rgl",
+            &serde_json::json!({"path": path.display().to_string()}),
+        )
+        .unwrap();
+        let cpu = spec.build().unwrap();
+        let gpu_values = eval.eval(&spec, &pairs).unwrap();
+        let (mut worst, mut what, mut over, mut grazing) = (0.0f64, String::new(), 0usize, 0usize);
+        for ((wi, wo), g) in pairs.iter().zip(&gpu_values) {
+            let (wi, wo) = (to_d(*wi), to_d(*wo));
+            // Within 0.6° of the horizon the f32 angles of the lookup move
+            // a steep grazing lobe by more than the tolerance: there the
+            // GPU value need only be finite and non-negative.
+            if wo.z < 1e-2 || wi.z < 1e-2 {
+                grazing += 1;
+                assert!(
+                    g.iter().all(|x| x.is_finite() && *x >= 0.0),
+                    "{model}: wi {wi} wo {wo}: {g:?}"
+                );
+                continue;
+            }
+            // Compared as f cos θo, what the tables resolve.
+            let z = wo.z;
+            let c = cpu.eval(wi, wo) * z;
+            let r = (0..3)
+                .map(|i| {
+                    let gi = f64::from(g[i]) * z;
+                    if !gi.is_finite() {
+                        return f64::INFINITY;
+                    }
+                    (gi - c[i]).abs() / (RGL_ABS_TOL + RGL_REL_TOL * c[i].abs())
+                })
+                .fold(0.0, f64::max);
+            if r > 1.0 {
+                over += 1;
+            }
+            if r > worst {
+                worst = r;
+                what = format!("wi {wi} wo {wo}: cpu {c} gpu {g:?}");
+            }
+        }
+        println!(
+            "rgl {model} {params}: worst {worst:.3} tolerances, {over} of {} over, {grazing} grazing pairs only checked finite",
+            pairs.len()
+        );
+        if worst > 1.0 {
+            failures.push(format!(
+                "{model} {params}: {worst} at {what} ({over} pairs over)"
+            ));
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -19,10 +19,11 @@ pub const MERL_FILES: Filter = Filter {
     extensions: &["binary"],
 };
 
-/// What the open dialog offers: measured tables and user BRDF files.
+/// What the open dialog offers: measured data (MERL tables, RGL materials)
+/// and user BRDF files.
 pub const OPENABLE_FILES: Filter = Filter {
-    name: "MERL table (.binary) or BRDF file (.brdf)",
-    extensions: &["binary", "brdf"],
+    name: "Measured data (.binary, .bsdf) or BRDF file (.brdf)",
+    extensions: &["binary", "bsdf", "brdf"],
 };
 
 /// Progress bars of the reads in flight (nothing when idle).

@@ -1,4 +1,6 @@
-//! `bv info FILE`: what is in a MERL `.binary` table.
+//! `bv info FILE`: what is in a MERL `.binary` table, or in any other
+//! measured file a model of the catalogue reads (an RGL `.bsdf`): its
+//! reader's summary, ρhd and reciprocity.
 
 use anyhow::Result;
 use bv_core::analysis::{albedo, directions, reciprocity};
@@ -23,7 +25,7 @@ pub const MAX_PAIRS: usize = 2_000_000;
 /// Arguments of `bv info`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct InfoArgs {
-    /// A MERL .binary file.
+    /// A measured file: a MERL .binary table, an RGL .bsdf material.
     pub file: PathBuf,
     /// Print one JSON object instead of the report.
     #[arg(long)]
@@ -58,6 +60,14 @@ fn pairs_count(s: &str) -> Result<usize, String> {
 
 /// Runs `bv info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
+    let name = args.file.to_string_lossy();
+    if let Some((info, _)) = bv_core::registry::file_model(&name)
+        && info
+            .file_param()
+            .is_some_and(|(_, f)| !std::ptr::addr_eq(f, &bv_core::models::merl::MERL_FILES))
+    {
+        return run_other(args);
+    }
     let mode = Interpolation::from_name(&args.interpolation)?;
     let start = Instant::now();
     let table = Arc::new(MerlTable::read(&args.file)?);
@@ -120,6 +130,98 @@ fn report(table: &Arc<MerlTable>, args: &InfoArgs, mode: Interpolation, load_ms:
         },
         "warnings": table.warnings().messages(),
     })
+}
+
+/// `bv info` of a file another model of the catalogue reads (chosen by the
+/// extension its format declares): the reader's own summary, ρhd by Monte
+/// Carlo through the model's sampler and the reciprocity check.
+fn run_other(args: &InfoArgs) -> Result<()> {
+    use anyhow::Context as _;
+    let name = args.file.to_string_lossy().into_owned();
+    let start = Instant::now();
+    let spec = bv_core::ModelSpec::new(&name)?;
+    let brdf = spec
+        .build()
+        .with_context(|| format!("cannot read `{name}`"))?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    let data = brdf.file_data();
+    let summary = data.as_ref().map(|d| d.summary()).unwrap_or_default();
+    let warnings = data.as_ref().map(|d| d.warnings()).unwrap_or_default();
+    let rho: Vec<Value> = THETA_I_DEG
+        .iter()
+        .map(|&deg| {
+            let e = albedo::rho_hd(brdf.as_ref(), deg.to_radians(), 0.0, args.samples, 1000);
+            json!({
+                "theta_i_deg": deg,
+                "value": e.value.to_array(),
+                "stderr": e.std_error.to_array(),
+                "samples": e.samples,
+            })
+        })
+        .collect();
+    let recip = reciprocity::check(brdf.as_ref(), &directions::upper_pairs(args.pairs, 7), 1e-6);
+    let bytes = std::fs::metadata(&args.file).map(|m| m.len()).unwrap_or(0);
+    let report = json!({
+        "file": name,
+        "model": spec.id(),
+        "bytes": bytes,
+        "load_ms": load_ms,
+        "summary": summary,
+        "rho_hd": rho,
+        "reciprocity": {"max_rel_error": recip.max_rel_err, "pairs": recip.pairs},
+        "warnings": warnings,
+    });
+    if args.json {
+        return super::output::print(&format!("{report}\n"));
+    }
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let _ = writeln!(out, "file:        {name} ({} model)", spec.id());
+    let _ = writeln!(out, "size:        {bytes} bytes, read in {load_ms:.0} ms");
+    for line in &summary {
+        let _ = writeln!(out, "  {line}");
+    }
+    let _ = writeln!(
+        out,
+        "ρhd(θi) = ∫ f cosθo dωo (Monte Carlo through the model's sampler ± standard error, {} samples each):",
+        int(&report["rho_hd"][0]["samples"])
+    );
+    for x in report["rho_hd"].as_array().into_iter().flatten() {
+        let v: Vec<f64> = x["value"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(num)
+            .collect();
+        let e: Vec<f64> = x["stderr"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(num)
+            .collect();
+        if v.len() == 3 && e.len() == 3 {
+            let _ = writeln!(
+                out,
+                "  θi = {:>4.0}°  r {} ± {}  g {} ± {}  b {} ± {}",
+                num(&x["theta_i_deg"]),
+                fixed(v[0], 4),
+                fixed(e[0], 4),
+                fixed(v[1], 4),
+                fixed(e[1], 4),
+                fixed(v[2], 4),
+                fixed(e[2], 4)
+            );
+        }
+    }
+    let _ = writeln!(
+        out,
+        "reciprocity: max |f(wi,wo) − f(wo,wi)| / max f = {:.3e} over {} pairs",
+        recip.max_rel_err, recip.pairs
+    );
+    for w in &warnings {
+        let _ = writeln!(out, "warning:     {w}");
+    }
+    super::output::print(&out)
 }
 
 fn num(v: &Value) -> f64 {

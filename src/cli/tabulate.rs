@@ -1,11 +1,14 @@
-//! `bv tabulate`: samples any model into a MERL-layout `.binary` table
-//!, so that users can build tables and tests can build
-//! realistic full-size files.
+//! `bv tabulate`: samples any model into a MERL-layout `.binary` table, or
+//! (`--format rgl`) writes it as an isotropic RGB RGL `.bsdf` material
+//! (Dupuy & Jakob 2018; the writer is bv-core's `measured::rgl_write`), so
+//! that users can build tables, share a model with Mitsuba 3's `measured`
+//! plugin, and tests can build realistic files.
 
 use super::output::{print, warn};
 use anyhow::{Context as _, Result};
 use bv_core::ModelSpec;
 use bv_core::measured::merl::{self, MerlDims};
+use bv_core::measured::rgl_write::{self, RglWriteOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -25,6 +28,23 @@ pub struct TabulateArgs {
     /// 384 MiB file).
     #[arg(long, default_value = "90,90,180", value_name = "NθH,NθD,NΦD")]
     pub dims: String,
+    /// File format: `merl` (a `.binary` half/difference table) or `rgl` (an
+    /// isotropic RGB `.bsdf` tensor file: 16 θi up to 85°, NDF and σ on 128
+    /// nodes, VNDF 128², values 32²; `--dims` does not apply).
+    #[arg(long, value_enum, default_value_t = TableFormat::Merl)]
+    pub format: TableFormat,
+    /// The `description` field of an RGL file (default: the model spec).
+    #[arg(long)]
+    pub description: Option<String>,
+}
+
+/// The file formats `bv tabulate` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableFormat {
+    /// A MERL `.binary` half/difference-angle table.
+    Merl,
+    /// An isotropic RGB RGL `.bsdf` tensor file.
+    Rgl,
 }
 
 /// Builds the model from `--model` and `--param`s (the same parsing and
@@ -35,6 +55,9 @@ pub fn model_spec(model: &str, params: &[String]) -> Result<ModelSpec> {
 
 /// Runs `bv tabulate`.
 pub fn run(args: &TabulateArgs) -> Result<()> {
+    if args.format == TableFormat::Rgl {
+        return run_rgl(args);
+    }
     let dims = MerlDims::parse(&args.dims).context("--dims")?;
     let spec = model_spec(&args.model, &args.params)?;
     let brdf = spec.build()?;
@@ -71,6 +94,54 @@ pub fn run(args: &TabulateArgs) -> Result<()> {
         spec.params().to_json(),
         dims,
         dims.file_len(),
+        tab_s
+    ))
+}
+
+/// `bv tabulate --format rgl`.
+fn run_rgl(args: &TabulateArgs) -> Result<()> {
+    let spec = model_spec(&args.model, &args.params)?;
+    let brdf = spec.build()?;
+    if !brdf.claims().isotropic {
+        warn(&format!(
+            "`{}` is anisotropic; the file is isotropic (φi = 0 slice, relative azimuths kept)",
+            args.model
+        ));
+    }
+    if !brdf.deltas(glam::DVec3::Z).is_empty() {
+        warn(&format!(
+            "`{}` has delta lobes, which a table cannot hold (they tabulate as 0)",
+            args.model
+        ));
+    }
+    let opts = RglWriteOptions {
+        description: args
+            .description
+            .clone()
+            .unwrap_or_else(|| format!("bv: {} {}", spec.id(), spec.params().to_json())),
+        ..RglWriteOptions::default()
+    };
+    let work = super::budget::Work {
+        serial: (opts.theta_i * (opts.vndf * opts.vndf + opts.values * opts.values)) as u64,
+        parallel: 0,
+        threads: 1,
+    };
+    super::budget::start(brdf.as_ref(), "bv tabulate", work, super::budget::LONG)?;
+    let start = Instant::now();
+    let bytes = rgl_write::tabulate_rgl(brdf.as_ref(), &opts)
+        .with_context(|| format!("writing `{}` as an RGL file", spec.id()))?;
+    super::budget::finish(brdf.as_ref(), "tabulate")?;
+    let tab_s = start.elapsed().as_secs_f64();
+    bv_core::fsio::write_atomic(&args.out, |w| w.write_all(&bytes))?;
+    print(&format!(
+        "wrote {}: {} {} as an RGL material ({} θi, VNDF {}², values {}², {} bytes), tabulated in {:.2} s\n",
+        args.out.display(),
+        spec.id(),
+        spec.params().to_json(),
+        opts.theta_i,
+        opts.vndf,
+        opts.values,
+        bytes.len(),
         tab_s
     ))
 }

@@ -90,14 +90,16 @@ pub fn model_names_for_save(v: &mut serde_json::Value) {
 }
 
 /// A spec's JSON as it is read: inside [`with_scene_dir`], every relative
-/// `.brdf` path (mix components included) is taken relative to the scene's
-/// folder, not the current directory.
+/// model path (a `.brdf` file, or a measured file named by its extension,
+/// mix components included) is taken relative to the scene's folder, not
+/// the current directory.
 pub fn model_names_for_load(v: &mut serde_json::Value) {
     let Some(dir) = scene_dir() else {
         return;
     };
     map_model_names(v, &|name| {
-        bv_user::is_file_name(name).then(|| resolve_in(&dir, name))
+        (bv_user::is_file_name(name) || bv_core::registry::file_model(name).is_some())
+            .then(|| resolve_in(&dir, name))
     });
 }
 

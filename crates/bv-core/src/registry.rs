@@ -66,6 +66,29 @@ pub fn find(id: &str) -> Result<&'static ModelInfo> {
     })
 }
 
+/// The file-backed model whose file format declares the extension of
+/// `name` (`a/steel.bsdf`, `gold.binary`), with its file parameter's id:
+/// how a path stands for a model wherever a model id is taken (`--model`,
+/// `bv eval`'s `"model"`, scene files). `None` when `name` is a catalogue id
+/// or its extension is no format's.
+pub fn file_model(name: &str) -> Option<(&'static ModelInfo, &'static str)> {
+    let c = catalogue();
+    if c.iter().any(|m| m.id == name) {
+        return None;
+    }
+    let ext = std::path::Path::new(name)
+        .extension()?
+        .to_string_lossy()
+        .to_ascii_lowercase();
+    c.iter().find_map(|m| {
+        let (decl, format) = m.file_param()?;
+        format
+            .extensions()
+            .contains(&ext.as_str())
+            .then_some((*m, decl.id))
+    })
+}
+
 /// Adds a model built at run time to the catalogue, or replaces the run-time
 /// model with the same id (a reloaded file), keeping its place. Returns the
 /// catalogue entry. A built-in id cannot be replaced.

@@ -82,6 +82,38 @@ fn synthetic_table(full: bool) -> String {
     path.to_string_lossy().into_owned()
 }
 
+/// A synthetic RGL `.bsdf` material for `Path` parameters of that format:
+/// a coloured GGX Cook-Torrance written by bv-core's RGL writer at small
+/// resolutions (6 θi, NDF 32, VNDF 32², values 16²), written on first use.
+fn synthetic_rgl() -> String {
+    use bv_core::measured::rgl_write::{RglWriteOptions, tabulate_rgl};
+    static PATH: OnceLock<PathBuf> = OnceLock::new();
+    let path = PATH.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+        let path = dir.join("bv-properties-ggx.bsdf");
+        let b = ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"distribution": "ggx", "alpha": 0.4, "kd": [0.3, 0.1, 0.05]}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        let opts = RglWriteOptions {
+            theta_i: 6,
+            ndf: 32,
+            vndf: 32,
+            values: 16,
+            ..RglWriteOptions::default()
+        };
+        let bytes = tabulate_rgl(b.as_ref(), &opts).unwrap();
+        let tmp = dir.join(format!("bv-properties-ggx.bsdf.{}", std::process::id()));
+        std::fs::write(&tmp, bytes).unwrap();
+        std::fs::rename(&tmp, &path).unwrap();
+        path
+    });
+    path.to_string_lossy().into_owned()
+}
+
 /// Whether a model can be a `mix` component in these tests: not a mix itself
 /// (the brief's "non-mix components") and without a file parameter, so that
 /// random mixes do not reload a measured table each case.
@@ -131,6 +163,9 @@ fn random_params(decls: &[ParamDecl], rng: &mut BvRng) -> Params {
             } => {
                 let n = rng.random_range(1..=3usize).clamp(min_items, max_items);
                 ParamValue::List((0..n).map(|_| random_params(fields, rng)).collect())
+            }
+            ParamKind::Path { format, .. } if format.extensions().contains(&"bsdf") => {
+                ParamValue::Text(synthetic_rgl())
             }
             ParamKind::Path { .. } => ParamValue::Text(synthetic_table(false)),
             ParamKind::Components {

@@ -23,6 +23,7 @@ pub mod mix;
 pub mod modified_phong;
 pub mod oren_nayar;
 pub mod phong;
+pub mod rgl;
 pub mod rough_dielectric;
 pub mod ward;
 
@@ -48,5 +49,6 @@ pub static BUILT_IN: &[&ModelInfo] = &[
     &rough_dielectric::INFO,
     &coated::INFO,
     &merl::INFO,
+    &rgl::INFO,
     &mix::INFO,
 ];

@@ -12,8 +12,17 @@ use crate::{BvError, Result, registry};
 use serde_json::{Map, Value};
 
 impl ModelSpec {
-    /// The model with all defaults.
+    /// The model with all defaults. A path whose extension a file format
+    /// declares (`steel.bsdf`, `gold.binary`) stands for the model that
+    /// reads it, with its file parameter set to the path
+    /// ([`registry::file_model`]).
     pub fn new(model: &str) -> Result<Self> {
+        if let Some((info, param)) = registry::file_model(model) {
+            let mut spec = Self::defaults(info);
+            spec.params_mut()
+                .insert(param.to_string(), ParamValue::Text(model.to_string()));
+            return Ok(spec);
+        }
         Ok(Self::defaults(registry::find(model)?))
     }
 
