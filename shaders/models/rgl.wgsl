@@ -14,8 +14,9 @@
 
 const RGL_PI: f32 = 3.14159265358979323846;
 
-// Below this cos θo, f is f cos θo over this (bv_core GRAZING_COS).
-const RGL_GRAZING_COS: f32 = 1e-3;
+// Below this cos θo (θo = 87°), f is held at its value there on the same
+// azimuth (bv_core GRAZING_COS, `grazing_held`).
+const RGL_GRAZING_COS: f32 = 0.052335956;
 
 fn rgl_t(i: u32) -> f32 {
     return merl_data[i];
@@ -112,6 +113,24 @@ fn rgl_invert(o: u32, base: u32, pos: vec2<f32>, w: vec2<f32>) -> vec2<f32> {
 }
 
 fn eval(o: u32, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
+    if (wi_in.z <= 0.0 || wo_in.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    var wo = wo_in;
+    if (wo.z < RGL_GRAZING_COS) {
+        let l = length(wo.xy);
+        let sin_c = sqrt(1.0 - RGL_GRAZING_COS * RGL_GRAZING_COS);
+        if (l > 0.0) {
+            wo = vec3<f32>(wo.xy / l * sin_c, RGL_GRAZING_COS);
+        } else {
+            wo = vec3<f32>(0.0, 0.0, 1.0);
+        }
+    }
+    return rgl_eval_cos(o, wi_in, wo) / wo.z;
+}
+
+// f cos θo as the file stores it (bv_core `eval_cos`).
+fn rgl_eval_cos(o: u32, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
     let nt = pu(o + RGL_N_THETA);
     if (wi_in.z <= 0.0 || wo_in.z <= 0.0 || nt == 0u) {
         return vec3<f32>(0.0);
@@ -158,5 +177,5 @@ fn eval(o: u32, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
             v = vec3<f32>(0.0);
         }
     }
-    return v / max(wo.z, RGL_GRAZING_COS);
+    return v;
 }
