@@ -723,7 +723,7 @@ fn presented_polar_legend_is_beside_the_circle_clear_of_its_labels() {
     let h = presented(s, "polar");
     let rect = bv::app::viewer::view_rect(&h.ctx, "polar").expect("drawn");
     let drawn = drawn_in(&h, rect);
-    let names = ["Cook-Torrance", "Lambert", "Mirror", "Mirror δ"];
+    let names = ["Cook-Torrance", "Lambert", "Mirror", "Mirror δ reflected"];
     let legend: Vec<&Drawn> = drawn
         .iter()
         .filter(|d| names.contains(&d.text.as_str()))
