@@ -69,6 +69,15 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// What the model claims for its current parameters.
     fn claims(&self) -> Claims;
 
+    /// Whether [`Brdf::claims`] are promises the model's author made (every
+    /// catalogue formula), rather than what a file's data was observed to do
+    /// when it was loaded (a MERL table, a user `.brdf`): a file promises
+    /// nothing, so its `claims` only steer the analysis (one azimuth for an
+    /// isotropic table) and reports show "no claim" (issue 30). Default: true.
+    fn claims_declared(&self) -> bool {
+        true
+    }
+
     /// The delta lobes for light arriving from `wi` (empty for non-delta models).
     fn deltas(&self, _wi: DVec3) -> Vec<DeltaLobe> {
         Vec::new()
