@@ -60,11 +60,32 @@ pub struct CheckArgs {
 /// `--strict` when the report fails.
 pub fn run(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     let spec = args.model.spec()?;
+    let report = report(&spec, args.albedo)?;
+    if args.json {
+        let v = report_json(&report, &spec)?;
+        print(&format!("{}\n", serde_json::to_string_pretty(&v)?))?;
+    } else {
+        print(&format!("{report}"))?;
+    }
+    Ok(if args.strict && report.strict_failure() {
+        ExitCode::from(STRICT_FAILURE)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The property report of `spec` with the albedo integrated as `albedo`
+/// says, within the command's time budget (what `bv check` prints, and the
+/// Python module's `Model.check()` returns).
+pub fn report(
+    spec: &bv_core::ModelSpec,
+    albedo: AlbedoChoice,
+) -> anyhow::Result<analysis::PropertyReport> {
     let brdf = spec
         .build()
         .with_context(|| format!("building model `{}`", spec.id()))?;
     let opts = CheckOptions {
-        albedo_method: match args.albedo {
+        albedo_method: match albedo {
             AlbedoChoice::Auto => AlbedoMethod::Auto,
             AlbedoChoice::Quadrature => AlbedoMethod::Quadrature,
             AlbedoChoice::MonteCarlo => AlbedoMethod::MonteCarlo,
@@ -80,17 +101,7 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<ExitCode> {
     super::budget::start(brdf.as_ref(), "bv check", work, super::budget::CHECK)?;
     let report = analysis::check(brdf.as_ref(), &opts);
     super::budget::finish(brdf.as_ref(), "check")?;
-    if args.json {
-        let v = report_json(&report, &spec)?;
-        print(&format!("{}\n", serde_json::to_string_pretty(&v)?))?;
-    } else {
-        print(&format!("{report}"))?;
-    }
-    Ok(if args.strict && report.strict_failure() {
-        ExitCode::from(STRICT_FAILURE)
-    } else {
-        ExitCode::SUCCESS
-    })
+    Ok(report)
 }
 
 /// The report as `bv check --json` prints it: the core's report with the

@@ -1045,7 +1045,7 @@ mod tests {
     fn wrap_keeps_words_and_width() {
         let text =
             "max ρhd 0.4970 ± 0.04100 at θi = 88°, φi = 0° (45 + 3 grazing θi × 1 azimuth(s))";
-        for width in [10, 24, 54] {
+        for width in [12, 24, 54] {
             let lines = wrap(text, width);
             assert!(
                 lines.iter().all(|l| l.chars().count() <= width),
