@@ -26,6 +26,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// enough for the structure-of-arrays buffers to stay in L1/L2.
 const CHUNK: usize = 4096;
 
+/// Two `(N, 3)` float64 arrays handed to Python (albedo's values and errors).
+type ArrayPair<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// A `ValueError` carrying the command line's message for `e`.
 fn value_error(e: &anyhow::Error) -> PyErr {
     PyValueError::new_err(bv::cli::output::message(e))
@@ -310,7 +313,7 @@ impl Model {
         py: Python<'py>,
         theta_i_deg: PyReadonlyArray1<'py, f64>,
         phi_i_deg: f64,
-    ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    ) -> PyResult<ArrayPair<'py>> {
         let t = theta_i_deg.as_array();
         let max = if self.brdf.transmits() { 180.0 } else { 90.0 };
         if let Some(bad) = t
@@ -458,11 +461,43 @@ fn eval_f32(
     Ok(out)
 }
 
+/// One view of `model` as an `(H, W, 4)` uint8 RGBA array, drawn as `bv
+/// render --view …` draws it: `args` are `bv render`'s options (`--view`,
+/// `--width`, `--theta-i`, …; parsed and checked by its own parser).
+#[pyfunction]
+fn render<'py>(
+    py: Python<'py>,
+    model: &Model,
+    args: Vec<String>,
+) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+    use clap::Parser as _;
+    let argv = ["bv", "render"]
+        .into_iter()
+        .map(String::from)
+        .chain(args)
+        // Required by the parser; nothing is written.
+        .chain(["--out".to_string(), "figure.png".to_string()]);
+    let cli = bv::cli::Cli::try_parse_from(argv)
+        .map_err(|e| PyValueError::new_err(e.render().to_string().trim().to_string()))?;
+    let Some(bv::cli::Command::Render(a)) = cli.command else {
+        return Err(PyValueError::new_err("internal: not a render command"));
+    };
+    let spec = model.spec.clone();
+    let img = py
+        .detach(|| bv::cli::render::view_image(&a, Some(spec)))
+        .map_err(|e| value_error(&e))?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let arr = numpy::ndarray::Array3::from_shape_vec((h, w, 4), img.into_raw())
+        .map_err(|e| PyValueError::new_err(format!("internal: image of {w}×{h}: {e}")))?;
+    Ok(arr.into_pyarray(py))
+}
+
 /// The compiled half of the `bv` package (see `bv/__init__.py`).
 #[pymodule]
 #[pyo3(name = "_native")]
 fn bv_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models_json, m)?)?;
+    m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_class::<Model>()?;
     Ok(())
 }

@@ -293,3 +293,40 @@ def test_help_is_useful():
     assert "cook-torrance" in bv.__doc__
     for f in [bv.Model, bv.Model.eval, bv.Model.sample, bv.Model.pdf, bv.Model.albedo, bv.Model.check, bv.models]:
         assert f.__doc__ and len(f.__doc__) > 60, f
+
+
+def test_render_returns_the_size_asked_and_not_blank(tmp_path):
+    m = bv.Model("cook-torrance", alpha=0.3)
+    for view in ["lobe3d", "polar"]:
+        fig = bv.render(m, view=view, width=320, height=240, theta_i=30, theme="light")
+        assert isinstance(fig, bv.Figure) and isinstance(fig, np.ndarray)
+        assert fig.shape == (240, 320, 4) and fig.dtype == np.uint8
+        # Not blank: many distinct colours, not one background.
+        colours = np.unique(fig.reshape(-1, 4), axis=0)
+        assert len(colours) > 20, (view, len(colours))
+        png = fig._repr_png_()
+        assert png.startswith(b"\x89PNG\r\n\x1a\n")
+        # The PNG decodes back to the same pixels (zlib + the scanline filter byte).
+        import struct
+        import zlib
+
+        idat = b""
+        pos = 8
+        while pos < len(png):
+            (n,) = struct.unpack(">I", png[pos : pos + 4])
+            tag = png[pos + 4 : pos + 8]
+            if tag == b"IDAT":
+                idat += png[pos + 8 : pos + 8 + n]
+            pos += 12 + n
+        raw = np.frombuffer(zlib.decompress(idat), dtype=np.uint8).reshape(240, 1 + 320 * 4)
+        np.testing.assert_array_equal(raw[:, 1:].reshape(240, 320, 4), np.asarray(fig))
+    fig.save(tmp_path / "f.png")
+    assert (tmp_path / "f.png").read_bytes() == png
+    with pytest.raises(ValueError, match="view"):
+        bv.render(m, view="nope")
+    with pytest.raises(ValueError):
+        bv.render(m, width=0)
+    with pytest.raises(ValueError):
+        bv.render(m, theta_i=float("nan"))
+    with pytest.raises(ValueError):
+        bv.render("lambert")

@@ -41,3 +41,25 @@ class Model:
         """The dict `bv check --json` prints."""
     def dispatch(self) -> Tuple[bool, str]:
         """(kernel, isa) of the f32 evaluation."""
+
+class Figure(np.ndarray):
+    """An (H, W, 4) uint8 RGBA image drawn by bv, shown as a PNG in Jupyter."""
+
+    def _repr_png_(self) -> bytes: ...
+    def save(self, path: str) -> None:
+        """Writes the image as a PNG file."""
+
+def render(
+    model: Model,
+    view: str = "lobe3d",
+    width: int = 800,
+    height: int = 600,
+    theta_i: float | None = None,
+    phi_i: float | None = None,
+    theme: str | None = None,
+    log: bool = False,
+    cosine: bool = False,
+    transparent: bool = False,
+    scale: float | None = None,
+) -> Figure:
+    """One view of `model` as `bv render --view VIEW` draws it."""
