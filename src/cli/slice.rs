@@ -53,7 +53,11 @@ pub enum Curve {
     phi_d = 90 deg; the other angle is --fixed).\n  \
     albedo: theta_i_deg,rho_r,rho_g,rho_b,rho_mean,std_error_mean (the albedo view's\n    \
     estimators: Gauss-Kronrod quadrature for analytic models, std_error_mean then\n    \
-    being its error estimate; Monte Carlo for measured ones, one standard error)."
+    being its error estimate; Monte Carlo for measured ones, one standard error).\n\n\
+    Abscissae: whole multiples of --step degrees (default 1) within the curve's span, or\n\
+    --samples N intervals spanning it. Numbers print in the shortest form that reads back\n\
+    to the same double (30, 0.25, 1e-50). --json prints one object with model, params,\n\
+    curve, columns and rows (arrays in the column order; null for a non-finite value)."
 )]
 pub struct SliceArgs {
     /// The model and its parameters.

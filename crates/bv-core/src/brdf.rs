@@ -303,7 +303,9 @@ pub struct BrdfSample {
 /// Draws one sample of `brdf` for light from `wi` with the uniform point
 /// `u` (the estimator the albedo's Monte Carlo and renderers build on: the
 /// weight of importance sampling, Veach 1997 eq. 2.7); `None` when the
-/// model draws no direction.
+/// model draws no direction. Delta lobes ([`Brdf::deltas`]) are not drawn:
+/// `f` is zero at every finite pair of a pure delta model, and their weights
+/// are the lobes' own.
 pub fn sample_weighted(brdf: &dyn Brdf, wi: DVec3, u: DVec2) -> Option<BrdfSample> {
     let wo = brdf.sample(wi, u)?;
     if !wo.is_finite() {

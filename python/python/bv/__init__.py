@@ -140,7 +140,9 @@ class Model:
         points in [0, 1)². Returns ``(wo, weight, pdf)``: ``wo`` ``(N, 3)``,
         ``weight`` ``(N, 3)`` = f(wi, wo) |cos θo| / pdf (the Monte Carlo
         weight) and ``pdf`` ``(N,)``. Where the model draws no direction,
-        ``wo`` is NaN and weight and pdf are 0.
+        ``wo`` is NaN and weight and pdf are 0. Delta lobes (``mirror``,
+        ``glass``) are not sampled here: their f is zero at every finite
+        pair (:meth:`albedo` includes their weights).
         """
         try:
             uu = np.ascontiguousarray(u, dtype=np.float64)
