@@ -502,12 +502,23 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
 pub const TABLE_WIDTH: usize = 100;
 
 /// `text` broken at spaces into lines of at most `width` characters (a word
-/// longer than that is cut).
+/// longer than that is cut). A count stays with the word after it ("0
+/// non-finite", "20000 pairs"), so that a script's `grep` finds the pair.
 fn wrap(text: &str, width: usize) -> Vec<String> {
     let width = width.max(1);
+    let mut units: Vec<String> = Vec::new();
+    let mut count: Option<&str> = None;
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        match count.take() {
+            Some(n) => units.push(format!("{n} {word}")),
+            None if word.bytes().all(|b| b.is_ascii_digit()) => count = Some(word),
+            None => units.push(word.to_string()),
+        }
+    }
+    units.extend(count.map(String::from));
     let mut lines = Vec::new();
     let mut line = String::new();
-    for word in text.split(' ').filter(|w| !w.is_empty()) {
+    for word in &units {
         let mut word: Vec<char> = word.chars().collect();
         while word.len() > width {
             if !line.is_empty() {
@@ -1045,7 +1056,7 @@ mod tests {
     fn wrap_keeps_words_and_width() {
         let text =
             "max ρhd 0.4970 ± 0.04100 at θi = 88°, φi = 0° (45 + 3 grazing θi × 1 azimuth(s))";
-        for width in [12, 24, 54] {
+        for width in [14, 24, 54] {
             let lines = wrap(text, width);
             assert!(
                 lines.iter().all(|l| l.chars().count() <= width),
@@ -1059,6 +1070,18 @@ mod tests {
             ["x".repeat(10), "x".repeat(10), "x".repeat(5)]
         );
         assert_eq!(wrap("", 10), [""]);
+        // A count keeps its word: "0 non-finite" is found on one line.
+        let l = wrap(
+            "min f 0.1500 over 40000 evaluations, 0 negative, 0 non-finite",
+            54,
+        );
+        assert_eq!(
+            l,
+            [
+                "min f 0.1500 over 40000 evaluations, 0 negative,",
+                "0 non-finite"
+            ]
+        );
     }
 
     /// A file's data (claims observed, not declared) reports no claims, in
