@@ -7,8 +7,9 @@
 # CPU when there is no GPU), and the X11 libraries winit loads when it opens a
 # window (it exits at start-up without libXcursor). No -dev packages are needed.
 BV_RUN_PACKAGES=(libvulkan1 mesa-vulkan-drivers libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
-# Tests: also a virtual X server and screenshots (ImageMagick's `import`).
-BV_CI_PACKAGES=("${BV_RUN_PACKAGES[@]}" xvfb xauth imagemagick)
+# Tests: also a virtual X server and screenshots (ImageMagick's `import`),
+# and Python with venv for the Python module's tests (.ci/python.sh).
+BV_CI_PACKAGES=("${BV_RUN_PACKAGES[@]}" xvfb xauth imagemagick python3 python3-venv)
 # The web build's test: a headless browser and Node.js for its driver
 # (playwright-core, from npm, pinned in web/package-lock.json).
 BV_WEB_PACKAGES=(chromium nodejs npm)

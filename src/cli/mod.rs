@@ -117,7 +117,7 @@ pub fn main(shell: &Shell) -> ExitCode {
         None => (shell.run_viewer)(&cli.viewer).map(|()| ExitCode::SUCCESS),
         Some(Command::Eval(a)) => eval::run(a),
         Some(Command::Models(a)) => models::run(a).map(|()| ExitCode::SUCCESS),
-        Some(Command::Check(a)) => check::run(a).map(|()| ExitCode::SUCCESS),
+        Some(Command::Check(a)) => check::run(a),
         Some(Command::Bench(a)) => bench::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Tabulate(a)) => tabulate::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Info(a)) => info::run(a).map(|()| ExitCode::SUCCESS),

@@ -8,7 +8,7 @@ use bv_core::error::quote;
 use bv_core::presets::{self, Preset};
 
 /// `--model ID [--param NAME=VALUE]…` or `--preset NAME [--param …]`,
-/// flattened into `check`, `bench` and `slice`.
+/// flattened into `check`, `bench`, `slice` and `tabulate`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct ModelArgs {
     /// Model id (see `bv models`).

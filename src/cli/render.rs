@@ -278,8 +278,8 @@ impl Progress {
     }
 }
 
-/// Runs `bv render`.
-pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
+/// The image size `a` asks for, checked.
+fn size_of(a: &RenderArgs) -> Result<[u32; 2]> {
     let default_size = if a.deck.is_some() {
         [1920, 1080]
     } else {
@@ -294,6 +294,53 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
     if width > max || height > max {
         bail!("--width {width} --height {height}: at most {max} pixels on a side");
     }
+    Ok([width, height])
+}
+
+/// The pixels per point `a` asks for (default: width / 800 within 1..4).
+fn scale_of(a: &RenderArgs, width: u32) -> Result<f32> {
+    let scale = a
+        .scale
+        .unwrap_or_else(|| (width as f32 / 800.0).clamp(1.0, 4.0));
+    if !(scale.is_finite() && (0.25..=8.0).contains(&scale)) {
+        bail!("--scale {scale}: expected 0.25..=8");
+    }
+    Ok(scale)
+}
+
+/// One view (`--view`, not `all` or `window`) of the state `a` describes as
+/// an RGBA image, with `spec` (when given) as its only BRDF: what `bv
+/// render --view V --out F.png` writes, for the Python module's
+/// `bv.render`.
+pub fn view_image(a: &RenderArgs, spec: Option<bv_core::ModelSpec>) -> Result<image::RgbaImage> {
+    let [width, height] = size_of(a)?;
+    let view = a.view.as_deref().unwrap_or_default();
+    if view.trim().eq_ignore_ascii_case("all") || view.trim().eq_ignore_ascii_case("window") {
+        bail!("view {view:?}: one view of this build (lobe3d, polar, cartesian, albedo, …)");
+    }
+    let e = views_for(view)?[0];
+    let scale = scale_of(a, width)?;
+    let mut state = state_for(a)?;
+    if let Some(spec) = spec {
+        state.brdfs.clear();
+        state.solo = None;
+        state.add(spec);
+        state = state.sanitised();
+    }
+    let frame = Frame {
+        size: Vec2::new(width as f32 / scale, height as f32 / scale),
+        pixels_per_point: scale,
+        dark: export::is_dark(&state),
+        transparent: a.transparent,
+    };
+    let mut off = open_device(frame)?;
+    export::render_view(&mut off, &state, e, frame)
+        .with_context(|| format!("drawing the {} view", e.id))
+}
+
+/// Runs `bv render`.
+pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
+    let [width, height] = size_of(a)?;
     if let Some(deck) = &a.deck {
         return render_deck(a, deck, [width, height], shell.slide);
     }
@@ -301,12 +348,7 @@ pub fn run(a: &RenderArgs, shell: &super::Shell) -> Result<()> {
     let window = view.trim().eq_ignore_ascii_case("window");
     let views = if window { Vec::new() } else { views_for(view)? };
     let all = !window && (views.len() > 1 || view.trim().eq_ignore_ascii_case("all"));
-    let scale = a
-        .scale
-        .unwrap_or_else(|| (width as f32 / 800.0).clamp(1.0, 4.0));
-    if !(scale.is_finite() && (0.25..=8.0).contains(&scale)) {
-        bail!("--scale {scale}: expected 0.25..=8");
-    }
+    let scale = scale_of(a, width)?;
     let state = state_for(a)?;
     let frame = Frame {
         size: Vec2::new(width as f32 / scale, height as f32 / scale),

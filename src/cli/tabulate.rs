@@ -5,8 +5,8 @@
 //! plugin, and tests can build realistic files.
 
 use super::output::{print, warn};
+use super::params::ModelArgs;
 use anyhow::{Context as _, Result};
-use bv_core::ModelSpec;
 use bv_core::measured::merl::{self, MerlDims};
 use bv_core::measured::rgl_write::{self, RglWriteOptions};
 use std::path::PathBuf;
@@ -15,12 +15,10 @@ use std::time::Instant;
 /// Arguments of `bv tabulate`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct TabulateArgs {
-    /// Model id, e.g. `lambert` (`bv models` lists them).
-    #[arg(long)]
-    pub model: String,
-    /// A parameter as NAME=VALUE (repeatable); a colour as `kd=0.2,0.5,0.8`.
-    #[arg(long = "param", value_name = "NAME=VALUE")]
-    pub params: Vec<String>,
+    /// The model and its parameters (`-m`/`--model`, `--preset`,
+    /// `-p`/`--param`, as every sub-command takes them).
+    #[command(flatten)]
+    pub model: ModelArgs,
     /// Output file (see --help for what happens to an existing one).
     #[arg(long, value_name = "FILE.binary", long_help = super::output::OUT_HELP)]
     pub out: PathBuf,
@@ -47,30 +45,24 @@ pub enum TableFormat {
     Rgl,
 }
 
-/// Builds the model from `--model` and `--param`s (the same parsing and
-/// messages as every other command).
-pub fn model_spec(model: &str, params: &[String]) -> Result<ModelSpec> {
-    super::params::spec_from_cli(model, params)
-}
-
 /// Runs `bv tabulate`.
 pub fn run(args: &TabulateArgs) -> Result<()> {
     if args.format == TableFormat::Rgl {
         return run_rgl(args);
     }
     let dims = MerlDims::parse(&args.dims).context("--dims")?;
-    let spec = model_spec(&args.model, &args.params)?;
+    let spec = args.model.spec()?;
     let brdf = spec.build()?;
     if !brdf.claims().isotropic {
         warn(&format!(
             "`{}` is anisotropic; the MERL layout has no φh axis, so the table holds its φh = 0 slice",
-            args.model
+            spec.id()
         ));
     }
     if !brdf.deltas(glam::DVec3::Z).is_empty() {
         warn(&format!(
             "`{}` has delta lobes, which a table cannot hold (they tabulate as 0)",
-            args.model
+            spec.id()
         ));
     }
     let work = super::budget::Work {

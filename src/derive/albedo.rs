@@ -168,6 +168,19 @@ impl AlbedoJob {
     }
 }
 
+/// ρhd of `brdf` at one θi (radians; above 90° the light is below the
+/// surface, for a transmitting model) and azimuth `phi_i`, with the curve's
+/// estimators and the seed of stream `k` (`bv slice --curve albedo` on any
+/// grid, the Python module's `Model.albedo`).
+pub fn rho_hd_at(brdf: &dyn Brdf, theta_i: f64, phi_i: f64, k: u64) -> Estimate {
+    let o = options(stream_seed(SEED, k));
+    if brdf.transmits() {
+        rho_hd_parts_auto(brdf, bv_core::frame::from_spherical(theta_i, phi_i), &o).total
+    } else {
+        rho_hd_auto(brdf, theta_i, phi_i, &o)
+    }
+}
+
 impl AlbedoData {
     /// Computes the curve of `brdf` for light at azimuth `phi_i` (radians),
     /// counting finished steps in `progress` ([`AlbedoJob::steps`] in all); `None` when

@@ -159,8 +159,12 @@ fn pair(w: &PairSample) -> String {
     )
 }
 
-fn claimed(b: bool) -> String {
-    format!("the model claims: {}", if b { "yes" } else { "no" })
+fn claimed(b: Option<bool>) -> String {
+    match b {
+        Some(b) => format!("the model claims: {}", if b { "yes" } else { "no" }),
+        // A file's data (MERL, user .brdf) promises nothing.
+        None => "the model claims nothing (file data)".to_string(),
+    }
 }
 
 /// The numbers behind a badge, one line each (what `bv check` prints for

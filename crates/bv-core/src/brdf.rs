@@ -78,6 +78,15 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// What the model claims for its current parameters.
     fn claims(&self) -> Claims;
 
+    /// Whether [`Brdf::claims`] are promises the model's author made (every
+    /// catalogue formula), rather than what a file's data was observed to do
+    /// when it was loaded (a MERL table, a user `.brdf`): a file promises
+    /// nothing, so its `claims` only steer the analysis (one azimuth for an
+    /// isotropic table) and reports show "no claim" (issue 30). Default: true.
+    fn claims_declared(&self) -> bool {
+        true
+    }
+
     /// The delta lobes for light arriving from `wi` (empty for non-delta models).
     fn deltas(&self, _wi: DVec3) -> Vec<DeltaLobe> {
         Vec::new()
@@ -285,4 +294,38 @@ pub struct FresnelTerm {
     pub fresnel: crate::fresnel::Fresnel,
     /// Where it comes from, in the model's words.
     pub source: String,
+}
+
+/// One importance sample of a BRDF: the drawn direction, its weight
+/// `f(wi, wo) |cos θo| / pdf(wo)` per channel, and the density.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BrdfSample {
+    /// The outgoing direction drawn by [`Brdf::sample`].
+    pub wo: DVec3,
+    /// `f |cos θo| / pdf`, the Monte Carlo weight of the sample (zero where
+    /// the density is zero or not finite).
+    pub weight: Rgb,
+    /// [`Brdf::pdf`] at `wo`, per steradian.
+    pub pdf: f64,
+}
+
+/// Draws one sample of `brdf` for light from `wi` with the uniform point
+/// `u` (the estimator the albedo's Monte Carlo and renderers build on: the
+/// weight of importance sampling, Veach 1997 eq. 2.7); `None` when the
+/// model draws no direction. Delta lobes ([`Brdf::deltas`]) are not drawn:
+/// `f` is zero at every finite pair of a pure delta model, and their weights
+/// are the lobes' own.
+pub fn sample_weighted(brdf: &dyn Brdf, wi: DVec3, u: DVec2) -> Option<BrdfSample> {
+    let wo = brdf.sample(wi, u)?;
+    if !wo.is_finite() {
+        return None;
+    }
+    let pdf = brdf.pdf(wi, wo);
+    let f = brdf.eval(wi, wo);
+    let weight = if pdf > 0.0 && pdf.is_finite() && f.is_finite() {
+        f * (wo.z.abs() / pdf)
+    } else {
+        Rgb::ZERO
+    };
+    Some(BrdfSample { wo, weight, pdf })
 }

@@ -38,7 +38,8 @@ pub mod text;
 pub mod user;
 
 pub use brdf::{
-    Brdf, Claims, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, Kink, MicrofacetTerms, Ndf,
+    Brdf, BrdfSample, Claims, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, Kink, MicrofacetTerms,
+    Ndf, sample_weighted,
 };
 pub use error::{BvError, Result};
 pub use model::ModelInfo;

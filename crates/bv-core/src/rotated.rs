@@ -101,6 +101,10 @@ impl Brdf for Rotated {
         self.inner.claims()
     }
 
+    fn claims_declared(&self) -> bool {
+        self.inner.claims_declared()
+    }
+
     fn deltas(&self, wi: DVec3) -> Vec<DeltaLobe> {
         self.inner
             .deltas(self.to_inner(wi))

@@ -456,4 +456,10 @@ impl Brdf for FileBrdf {
     fn claims(&self) -> Claims {
         self.claims
     }
+
+    /// A `.brdf` file declares no claims: [`FileBrdf::claims`] is what a
+    /// probe observed, so reports show "no claim" beside the measurements.
+    fn claims_declared(&self) -> bool {
+        false
+    }
 }

@@ -144,14 +144,32 @@ impl PairSample {
 }
 
 /// What the model claims (copied from [`crate::Claims`] for the report).
+/// `None` (JSON `null`, "—" in the table) where the model claims nothing:
+/// a file's data (MERL, user `.brdf`) makes no promises
+/// ([`Brdf::claims_declared`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct ClaimsReport {
     /// Claims Helmholtz reciprocity.
-    pub reciprocal: bool,
+    pub reciprocal: Option<bool>,
     /// Claims ρhd ≤ 1 everywhere.
-    pub energy_conserving: bool,
+    pub energy_conserving: Option<bool>,
     /// Claims isotropy.
-    pub isotropic: bool,
+    pub isotropic: Option<bool>,
+}
+
+impl ClaimsReport {
+    /// The report's copy of `brdf`'s claims: `None` for each when they are
+    /// observations rather than promises.
+    pub fn of(brdf: &dyn Brdf) -> Self {
+        let c = brdf.claims();
+        let declared = brdf.claims_declared();
+        let claim = |b: bool| declared.then_some(b);
+        Self {
+            reciprocal: claim(c.reciprocal),
+            energy_conserving: claim(c.energy_conserving),
+            isotropic: claim(c.isotropic),
+        }
+    }
 }
 
 /// The energy section of a report.
@@ -228,11 +246,20 @@ impl PropertyReport {
     /// Whether every measured verdict agrees with a "yes" claim (a model may
     /// claim less than it measures, never more), and positivity holds.
     pub fn consistent_with_claims(&self) -> bool {
+        let yes = |c: Option<bool>| c == Some(true);
         self.positivity.ok
-            && (!self.claims.reciprocal || self.reciprocity.reciprocal)
-            && (!self.claims.energy_conserving || self.energy.conserves)
-            && (!self.claims.isotropic || self.isotropy.isotropic)
+            && (!yes(self.claims.reciprocal) || self.reciprocity.reciprocal)
+            && (!yes(self.claims.energy_conserving) || self.energy.conserves)
+            && (!yes(self.claims.isotropic) || self.isotropy.isotropic)
             && self.ndf.as_ref().is_none_or(|n| n.normalised)
+    }
+
+    /// Whether a script should treat the report as a failure (`bv check
+    /// --strict` exits 3): a verdict contradicts a claim or a property every
+    /// BRDF needs (positivity, D normalisation), or energy is violated,
+    /// claimed or not.
+    pub fn strict_failure(&self) -> bool {
+        !self.consistent_with_claims() || !self.energy.conserves
     }
 }
 
@@ -287,12 +314,7 @@ impl CheckOptions {
 
 /// Runs every property check on `brdf`.
 pub fn check(brdf: &dyn Brdf, opts: &CheckOptions) -> PropertyReport {
-    let c = brdf.claims();
-    let claims = ClaimsReport {
-        reciprocal: c.reciprocal,
-        energy_conserving: c.energy_conserving,
-        isotropic: c.isotropic,
-    };
+    let claims = ClaimsReport::of(brdf);
     let pairs = directions::upper_pairs(opts.pairs, opts.seed);
     // A transmitting model is examined on the whole sphere: pairs across the
     // surface in both orders and pairs with both directions below it (light
@@ -314,7 +336,9 @@ pub fn check(brdf: &dyn Brdf, opts: &CheckOptions) -> PropertyReport {
     let positivity = positivity::check(brdf, &pairs, &lower);
     let reciprocity = reciprocity::check(brdf, &sphere, opts.tolerance);
     let isotropy = isotropy::check(brdf, &pairs, opts.tolerance, opts.seed);
-    let isotropic = isotropy.isotropic && claims.isotropic;
+    // The (possibly only observed) claim steers the azimuths: a table with
+    // no φh axis is examined at one.
+    let isotropic = isotropy.isotropic && brdf.claims().isotropic;
     let energy = energy(brdf, opts, isotropic);
     let ndf = brdf.ndf().map(|d| {
         let integral = ndf::normalisation(d, opts.ndf_rel_tol, opts.ndf_max_evals);
@@ -476,8 +500,67 @@ fn energy(brdf: &dyn Brdf, opts: &CheckOptions, isotropic: bool) -> Energy {
 }
 
 /// A claim as text.
-fn yes_no(b: bool) -> &'static str {
-    if b { "yes" } else { "no" }
+/// The widest line of `bv check`'s table (issue 30: a terminal or a log,
+/// not 200 columns).
+pub const TABLE_WIDTH: usize = 100;
+
+/// `text` broken at spaces into lines of at most `width` characters (a word
+/// longer than that is cut). A count stays with the word after it ("0
+/// non-finite", "20000 pairs"), so that a script's `grep` finds the pair.
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let width = width.max(1);
+    let mut units: Vec<String> = Vec::new();
+    let mut count: Option<&str> = None;
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        match count.take() {
+            Some(n) => units.push(format!("{n} {word}")),
+            None if word.bytes().all(|b| b.is_ascii_digit()) => count = Some(word),
+            None => units.push(word.to_string()),
+        }
+    }
+    units.extend(count.map(String::from));
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in &units {
+        let mut word: Vec<char> = word.chars().collect();
+        while word.len() > width {
+            if !line.is_empty() {
+                lines.push(std::mem::take(&mut line));
+            }
+            lines.push(word.drain(..width).collect());
+        }
+        let word: String = word.into_iter().collect();
+        let n = line.chars().count();
+        if n > 0 && n + 1 + word.chars().count() > width {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(&word);
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+/// A note under the table, indented and wrapped to [`TABLE_WIDTH`].
+fn write_wrapped(f: &mut fmt::Formatter<'_>, text: &str) -> fmt::Result {
+    for (k, line) in wrap(text, TABLE_WIDTH - 4).iter().enumerate() {
+        let indent = if k == 0 { "  " } else { "    " };
+        writeln!(f, "{indent}{line}")?;
+    }
+    Ok(())
+}
+
+/// A claim as the table shows it; "—" where the model claims nothing.
+fn yes_no(b: Option<bool>) -> &'static str {
+    match b {
+        Some(true) => "yes",
+        Some(false) => "no",
+        None => "—",
+    }
 }
 
 /// A short number: 4 significant digits, scientific when small or large.
@@ -551,7 +634,7 @@ impl fmt::Display for PropertyReport {
             }
             .into(),
             yes_no(c.reciprocal).into(),
-            r.reciprocal || !c.reciprocal,
+            r.reciprocal || c.reciprocal != Some(true),
         ));
         rows.push((
             "isotropy".into(),
@@ -568,7 +651,7 @@ impl fmt::Display for PropertyReport {
             }
             .into(),
             yes_no(c.isotropic).into(),
-            i.isotropic || !c.isotropic,
+            i.isotropic || c.isotropic != Some(true),
         ));
         let per_angle = e.curves.first().and_then(|cv| cv.rho.first());
         let extras = match (e.has_deltas, e.transmits) {
@@ -609,7 +692,7 @@ impl fmt::Display for PropertyReport {
             }
             .into(),
             yes_no(c.energy_conserving).into(),
-            e.conserves || !c.energy_conserving,
+            e.conserves || c.energy_conserving != Some(true),
         ));
         if e.transmits {
             // ρR and ρT where ρhd peaks, and the worst case from inside.
@@ -701,55 +784,70 @@ impl fmt::Display for PropertyReport {
                 n.normalised,
             ));
         }
-        let w0 = rows.iter().map(|r| r.0.chars().count()).max().unwrap_or(0);
-        let w1 = rows.iter().map(|r| r.1.chars().count()).max().unwrap_or(0);
-        let w2 = rows.iter().map(|r| r.2.chars().count()).max().unwrap_or(0);
+        // Columns: property, verdict, claim, then the evidence wrapped so
+        // that a line fits TABLE_WIDTH (a terminal, a log, an e-mail).
+        let w0 = rows
+            .iter()
+            .map(|r| r.0.chars().count())
+            .chain(["property".len()])
+            .max()
+            .unwrap_or(0);
+        let w2 = rows
+            .iter()
+            .map(|r| r.2.chars().count())
+            .chain(["verdict".len()])
+            .max()
+            .unwrap_or(0);
+        let w3 = "claimed".len();
+        let indent = 2 + w0 + 2 + w2 + 2 + w3 + 2;
+        let w1 = TABLE_WIDTH.saturating_sub(indent).max(24);
         writeln!(f, "properties of `{}`", self.model)?;
         let pad =
             |s: &str, w: usize| format!("{s}{}", " ".repeat(w.saturating_sub(s.chars().count())));
         writeln!(
             f,
-            "  {}  {}  {}  claimed",
+            "  {}  {}  {}  measured",
             pad("property", w0),
-            pad("measured", w1),
-            pad("verdict", w2)
+            pad("verdict", w2),
+            pad("claimed", w3)
         )?;
         for (name, measured, verdict, claim, agrees) in &rows {
-            let flag = match (*agrees, claim.is_empty()) {
-                (true, _) => "",
-                (false, true) => "  <-- required of every BRDF",
-                (false, false) => "  <-- contradicts the claim",
-            };
-            let claim = if claim.is_empty() {
-                String::new()
-            } else {
-                format!("(claimed: {claim})")
-            };
-            let line = format!(
-                "  {}  {}  {}  {claim}{flag}",
-                pad(name, w0),
-                pad(measured, w1),
-                pad(verdict, w2)
-            );
-            writeln!(f, "{}", line.trim_end())?;
+            let mut lines = wrap(measured, w1);
+            match (*agrees, claim.is_empty()) {
+                (true, _) => {}
+                (false, true) => lines.push("<-- required of every BRDF".into()),
+                (false, false) => lines.push("<-- contradicts the claim".into()),
+            }
+            for (k, text) in lines.iter().enumerate() {
+                let line = if k == 0 {
+                    format!(
+                        "  {}  {}  {}  {text}",
+                        pad(name, w0),
+                        pad(verdict, w2),
+                        pad(claim, w3)
+                    )
+                } else {
+                    format!("{}{text}", " ".repeat(indent))
+                };
+                writeln!(f, "{}", line.trim_end())?;
+            }
         }
         // Where the worst cases are, for the lecture's "why".
         if let (false, Some(w)) = (r.reciprocal, &r.worst) {
-            writeln!(
-                f,
-                "  worst reciprocity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f(wi,wo) {} vs f(wo,wi) {}",
+            let text = format!(
+                "worst reciprocity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f(wi,wo) {} vs f(wo,wi) {}",
                 deg(w.wi_deg[0]),
                 deg(w.wi_deg[1]),
                 deg(w.wo_deg[0]),
                 deg(w.wo_deg[1]),
                 num(w.f.max_element()),
                 num(w.f_swapped.max_element())
-            )?;
+            );
+            write_wrapped(f, &text)?;
         }
         if let (false, Some(w)) = (p.ok, &p.worst) {
-            writeln!(
-                f,
-                "  worst positivity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f = [{}, {}, {}]",
+            let text = format!(
+                "worst positivity pair: wi (θ {}°, φ {}°), wo (θ {}°, φ {}°): f = [{}, {}, {}]",
                 deg(w.wi_deg[0]),
                 deg(w.wi_deg[1]),
                 deg(w.wo_deg[0]),
@@ -757,7 +855,8 @@ impl fmt::Display for PropertyReport {
                 num(w.f.x),
                 num(w.f.y),
                 num(w.f.z)
-            )?;
+            );
+            write_wrapped(f, &text)?;
         }
         let rejected: usize = e
             .curves
@@ -768,9 +867,11 @@ impl fmt::Display for PropertyReport {
             .sum::<usize>()
             + e.rho_hh.rejected;
         if rejected > 0 {
-            writeln!(
+            write_wrapped(
                 f,
-                "  warning: {rejected} albedo samples had a NaN or infinite value or density and were left out"
+                &format!(
+                    "warning: {rejected} albedo samples had a NaN or infinite value or density and were left out"
+                ),
             )?;
         }
         Ok(())
@@ -812,8 +913,19 @@ mod tests {
         assert!(rep.consistent_with_claims());
         let text = rep.to_string();
         assert!(text.contains("reciprocal"), "{text}");
-        assert!(text.contains("(claimed: yes)"), "{text}");
+        let recip = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("reciprocity"))
+            .unwrap();
+        assert!(
+            recip.contains(" reciprocal ") && recip.contains(" yes "),
+            "{text}"
+        );
         assert!(!text.contains("contradicts"), "{text}");
+        assert!(!rep.strict_failure());
+        for line in text.lines() {
+            assert!(line.chars().count() <= TABLE_WIDTH, "{line}");
+        }
         let json = serde_json::to_value(&rep).unwrap();
         assert_eq!(json["model"], "lambert");
         let hh = json["energy"]["rho_hh"]["value"][1]
@@ -941,5 +1053,94 @@ mod tests {
         assert_eq!(deg(89.999), "89.999");
         assert_eq!(deg(3.0), "3");
         assert_eq!(deg(87.5), "87.5");
+    }
+
+    #[test]
+    fn wrap_keeps_words_and_width() {
+        let text =
+            "max ρhd 0.4970 ± 0.04100 at θi = 88°, φi = 0° (45 + 3 grazing θi × 1 azimuth(s))";
+        for width in [14, 24, 54] {
+            let lines = wrap(text, width);
+            assert!(
+                lines.iter().all(|l| l.chars().count() <= width),
+                "{lines:?}"
+            );
+            assert_eq!(lines.join(" "), text);
+        }
+        let long = "x".repeat(25);
+        assert_eq!(
+            wrap(&long, 10),
+            ["x".repeat(10), "x".repeat(10), "x".repeat(5)]
+        );
+        assert_eq!(wrap("", 10), [""]);
+        // A count keeps its word: "0 non-finite" is found on one line.
+        let l = wrap(
+            "min f 0.1500 over 40000 evaluations, 0 negative, 0 non-finite",
+            54,
+        );
+        assert_eq!(
+            l,
+            [
+                "min f 0.1500 over 40000 evaluations, 0 negative,",
+                "0 non-finite"
+            ]
+        );
+    }
+
+    /// A file's data (claims observed, not declared) reports no claims, in
+    /// the JSON (null) and the table (—), and a violation it never claimed
+    /// otherwise is not a contradiction, though `--strict` still fails on it.
+    #[test]
+    fn undeclared_claims_show_none() {
+        #[derive(Debug)]
+        struct Bright;
+        impl Brdf for Bright {
+            fn id(&self) -> &'static str {
+                "bright-file"
+            }
+            fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+                if wi.z > 0.0 && wo.z > 0.0 {
+                    Rgb::splat(1.5 / PI)
+                } else {
+                    Rgb::ZERO
+                }
+            }
+            fn claims(&self) -> Claims {
+                Claims {
+                    reciprocal: true,
+                    energy_conserving: true,
+                    isotropic: true,
+                }
+            }
+            fn claims_declared(&self) -> bool {
+                false
+            }
+        }
+        let rep = check(&Bright, &quick());
+        assert_eq!(
+            rep.claims,
+            ClaimsReport {
+                reciprocal: None,
+                energy_conserving: None,
+                isotropic: None
+            }
+        );
+        assert!(!rep.energy.conserves);
+        assert!(rep.consistent_with_claims());
+        assert!(rep.strict_failure());
+        let json = serde_json::to_value(&rep).unwrap();
+        assert!(json["claims"]["energy_conserving"].is_null(), "{json}");
+        assert!(json["claims"]["reciprocal"].is_null(), "{json}");
+        let text = rep.to_string();
+        let energy = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("energy"))
+            .unwrap();
+        assert!(
+            energy.contains("violates energy") && energy.contains(" — "),
+            "{text}"
+        );
+        assert!(!text.contains("contradicts"), "{text}");
+        assert!(!text.contains("yes"), "{text}");
     }
 }

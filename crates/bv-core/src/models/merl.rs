@@ -238,6 +238,12 @@ impl Brdf for Merl {
         }
     }
 
+    /// A measured table promises nothing: its claims above are what the
+    /// lookup does by construction, used to steer the analysis.
+    fn claims_declared(&self) -> bool {
+        false
+    }
+
     fn file_data(&self) -> Option<Arc<dyn FileData>> {
         Some(self.table.clone())
     }

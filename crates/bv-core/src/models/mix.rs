@@ -255,6 +255,12 @@ impl Brdf for Mix {
         }
     }
 
+    /// The sum's claims are derived from its parts': promises only if every
+    /// part's are (a mix with a measured table promises nothing).
+    fn claims_declared(&self) -> bool {
+        self.parts.iter().all(|p| p.brdf.claims_declared())
+    }
+
     fn deltas(&self, wi: DVec3) -> Vec<DeltaLobe> {
         // Linearity applies to the Dirac parts too: each lobe keeps its direction
         // and kind, with weight and radiance scale multiplied by w_j.

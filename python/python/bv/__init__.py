@@ -1,0 +1,263 @@
+"""bv, the BRDF viewer, from Python.
+
+Models of bv's catalogue (and user ``.brdf`` files, MERL ``.binary`` tables)
+evaluated on numpy arrays, sampled, integrated and checked by the same Rust
+code as the ``bv`` command line::
+
+    import numpy as np
+    import bv
+
+    m = bv.Model("cook-torrance", alpha=0.3, fresnel="conductor", eta=[0.2, 0.92, 1.1])
+    wi = np.array([0.0, 0.0, 1.0])                      # one direction broadcasts
+    wo = np.array([[0.0, 0.6, 0.8], [0.6, 0.0, 0.8]])
+    f = m.eval(wi, wo)                                  # (2, 3) float32, 1/sr per RGB channel
+    rho, err = m.albedo([0, 30, 60])                    # ρhd with its error estimate
+    report = m.check()                                  # the dict of `bv check --json`
+
+Conventions (as everywhere in bv): the normal is +z, the tangent +x; ``wi``
+(towards the light) and ``wo`` (towards the viewer) point away from the
+surface; f(wi, wo) is given without the cosine factor, in 1/sr, per linear-RGB
+channel. Directions must be unit length within 1e-3 (they are normalised).
+Every error (an unknown model or parameter, a value out of range, a wrong
+array shape, a NaN direction, a missing file) is a ``ValueError`` carrying
+bv's message.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+import zlib
+from typing import Any, Dict, List, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _native
+
+__all__ = ["Figure", "Model", "models", "render"]
+
+ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
+
+
+def models() -> List[Dict[str, Any]]:
+    """The model catalogue, as ``bv models --json`` prints it.
+
+    One dict per model: ``id``, ``name``, ``summary``, ``citation`` and
+    ``params`` (each parameter's id, kind, range, default, unit and the
+    condition under which it applies).
+    """
+    return json.loads(_native.models_json())
+
+
+def _directions(name: str, a: ArrayLike) -> np.ndarray:
+    """``a`` as a C-contiguous float64 ``(N, 3)`` array (a ``(3,)`` one
+    becomes ``(1, 3)``, which broadcasts)."""
+    try:
+        arr = np.ascontiguousarray(a, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{name} must be an array of directions: {e}") from None
+    if arr.ndim == 1:
+        arr = arr.reshape(1, -1)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(f"{name} must have shape (N, 3) or (3,), found {np.shape(a)}")
+    return arr
+
+
+class Model:
+    """A BRDF of bv's catalogue, a user ``.brdf`` file or a MERL table, with
+    its parameters.
+
+    ``Model("cook-torrance", alpha=0.3, fresnel="conductor", eta=[0.2, 0.92, 1.1])``
+    builds a catalogue model (``bv.models()`` lists them with every
+    parameter's range and default; unset parameters keep their defaults, a
+    colour is three numbers or one for grey, a choice is its name).
+    ``Model("retro.brdf")`` compiles a user file; ``Model("gold.binary")``
+    loads a data file with the catalogue model that reads its format (here
+    MERL, as ``Model("merl", path="gold.binary")``). The parameters
+    are validated as the command line validates them: an unknown model or
+    parameter, a value out of range or a file that cannot be read raises
+    ``ValueError`` with bv's message.
+    """
+
+    def __init__(self, model: str, **params: Any) -> None:
+        if not isinstance(model, (str, os.PathLike)):
+            raise ValueError(f"model must be a model id or a path, found {model!r}")
+        model = os.fspath(model)
+        try:
+            text = json.dumps(
+                {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in params.items()},
+                allow_nan=False,
+            )
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"parameters of {model}: {e}") from None
+        self._m = _native.Model(model, text)
+
+    @property
+    def id(self) -> str:
+        """The model id (for a user file, the id its path registered)."""
+        return self._m.id
+
+    @property
+    def params(self) -> Dict[str, Any]:
+        """Every parameter's value, defaults filled in."""
+        return json.loads(self._m.params_json())
+
+    @property
+    def transmits(self) -> bool:
+        """Whether the model scatters below the surface (a BSDF)."""
+        return self._m.transmits
+
+    def __repr__(self) -> str:
+        return f"bv.Model({self.id!r}, **{self.params!r})"
+
+    def eval(self, wi: ArrayLike, wo: ArrayLike, precision: str = "f32") -> np.ndarray:
+        """f(wi, wo) per linear-RGB channel, 1/sr, without the cosine.
+
+        ``wi`` and ``wo`` are ``(N, 3)`` arrays (or one ``(3,)`` direction,
+        which broadcasts against the other). ``precision="f32"`` (default)
+        evaluates on all cores with the GIL released through bv's f32 SIMD
+        batch kernels (held to the f64 code within 1e-4 relative or 1e-6
+        absolute by bv's parity tests) and returns float32;
+        ``precision="f64"`` uses the f64 reference, what ``bv eval``
+        answers, and returns float64. Returns ``(N, 3)``.
+        """
+        if precision not in ("f32", "f64"):
+            raise ValueError(f'precision={precision!r}: expected "f32" or "f64"')
+        return self._m.eval(_directions("wi", wi), _directions("wo", wo), precision == "f64")
+
+    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> np.ndarray:
+        """The solid-angle density (1/sr) with which :meth:`sample` draws
+        ``wo`` for light from ``wi``; ``(N,)`` float64."""
+        return self._m.pdf(_directions("wi", wi), _directions("wo", wo))
+
+    def sample(
+        self, wi: ArrayLike, u: ArrayLike
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Importance-samples outgoing directions.
+
+        ``wi`` is ``(N, 3)`` (or one direction), ``u`` ``(N, 2)`` uniform
+        points in [0, 1)². Returns ``(wo, weight, pdf)``: ``wo`` ``(N, 3)``,
+        ``weight`` ``(N, 3)`` = f(wi, wo) |cos θo| / pdf (the Monte Carlo
+        weight) and ``pdf`` ``(N,)``. Where the model draws no direction,
+        ``wo`` is NaN and weight and pdf are 0. Delta lobes (``mirror``,
+        ``glass``) are not sampled here: their f is zero at every finite
+        pair (:meth:`albedo` includes their weights).
+        """
+        try:
+            uu = np.ascontiguousarray(u, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"u must be an array of points: {e}") from None
+        if uu.ndim == 1:
+            uu = uu.reshape(1, -1)
+        if uu.ndim != 2 or uu.shape[1] != 2:
+            raise ValueError(f"u must have shape (N, 2), found {np.shape(u)}")
+        return self._m.sample(_directions("wi", wi), uu)
+
+    def albedo(
+        self, theta_i: Union[float, ArrayLike], phi_i: float = 0.0
+    ) -> Tuple[np.ndarray, np.ndarray]:
+        """The directional albedo ρhd(θi) = ∫ f cos θo dωo (plus delta
+        lobes' weights) at each θi, **in degrees** (as on bv's command
+        line), and azimuth ``phi_i`` (degrees).
+
+        Returns ``(values, errors)``, each ``(N, 3)`` float64: deterministic
+        Gauss–Kronrod quadrature with its error estimate for analytic models,
+        Monte Carlo with one standard error for measured ones (the estimators
+        of ``bv slice --curve albedo`` and the albedo view).
+        """
+        t = np.atleast_1d(np.asarray(theta_i, dtype=np.float64))
+        if t.ndim != 1:
+            raise ValueError(f"theta_i must be a number or a 1-D array, found shape {t.shape}")
+        try:
+            phi = float(phi_i)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"phi_i must be a number: {e}") from None
+        return self._m.albedo(np.ascontiguousarray(t), phi)
+
+    def check(self, albedo: str = "auto") -> Dict[str, Any]:
+        """The properties of the model (positivity, reciprocity, isotropy,
+        energy, D normalisation), each with its sample or quadrature count
+        and error, beside what the model claims: the dict ``bv check --json``
+        prints (``albedo``: ``"auto"``, ``"quadrature"`` or
+        ``"monte-carlo"``, as ``--albedo``)."""
+        return json.loads(self._m.check_json(albedo))
+
+    def dispatch(self) -> Tuple[bool, str]:
+        """``(kernel, isa)``: whether ``eval`` in f32 runs a SIMD batch
+        kernel for this model, and on which instruction set (``"scalar"``
+        when it falls back to the f64 code lane by lane)."""
+        return self._m.dispatch()
+
+
+def _png(rgba: np.ndarray) -> bytes:
+    """An (H, W, 4) uint8 array as PNG bytes (8-bit RGBA, no filter)."""
+    h, w, _ = rgba.shape
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+    raw = b"".join(b"\x00" + np.ascontiguousarray(rgba[y]).tobytes() for y in range(h))
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 6, 0, 0, 0))
+        + chunk(b"IDAT", zlib.compress(raw, 6))
+        + chunk(b"IEND", b"")
+    )
+
+
+class Figure(np.ndarray):
+    """An ``(H, W, 4)`` uint8 RGBA image drawn by bv: a numpy array (slice
+    it, ``plt.imshow`` it) that Jupyter shows as a PNG (``_repr_png_``) and
+    :meth:`save` writes as one."""
+
+    def _repr_png_(self) -> bytes:
+        return _png(np.asarray(self, dtype=np.uint8))
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the image as a PNG file."""
+        with open(path, "wb") as f:
+            f.write(self._repr_png_())
+
+
+def render(
+    model: Model,
+    view: str = "lobe3d",
+    width: int = 800,
+    height: int = 600,
+    theta_i: Union[float, None] = None,
+    phi_i: Union[float, None] = None,
+    theme: Union[str, None] = None,
+    log: bool = False,
+    cosine: bool = False,
+    transparent: bool = False,
+    scale: Union[float, None] = None,
+) -> Figure:
+    """Draws one view of ``model`` as ``bv render --view VIEW`` draws it (the
+    viewer's own drawing code, offscreen with wgpu; Mesa's lavapipe on a
+    machine without a GPU) and returns it as a :class:`Figure`, an
+    ``(height, width, 4)`` uint8 RGBA array.
+
+    ``view``: ``lobe3d``, ``polar``, ``cartesian``, ``albedo``, ``fresnel``
+    or any view ``bv render --help`` lists. ``theta_i``/``phi_i``: the
+    light's direction in degrees. ``theme``: ``"light"`` (dark on white, for
+    slides and print) or ``"dark"``. ``log``: a logarithmic scale;
+    ``cosine``: show f·cos θo; ``scale``: pixels per point (default width /
+    800 within 1..4). Options are checked by ``bv render``'s parser: a bad
+    one raises ``ValueError`` with its message.
+    """
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a bv.Model, found {type(model).__name__}")
+    args = ["--view", str(view), "--width", str(int(width)), "--height", str(int(height))]
+    if theta_i is not None:
+        args += ["--theta-i", repr(float(theta_i))]
+    if phi_i is not None:
+        args += ["--phi-i", repr(float(phi_i))]
+    if theme is not None:
+        if theme not in ("light", "dark"):
+            raise ValueError(f'theme={theme!r}: expected "light" or "dark"')
+        args.append("--" + theme)
+    if scale is not None:
+        args += ["--scale", repr(float(scale))]
+    args += [flag for flag, on in (("--log", log), ("--cosine", cosine), ("--transparent", transparent)) if on]
+    return _native.render(model._m, args).view(Figure)

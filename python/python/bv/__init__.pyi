@@ -1,0 +1,65 @@
+"""Type stub of the `bv` package (bv, the BRDF viewer, from Python)."""
+
+from typing import Any, Dict, List, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+ArrayLike = Union[npt.ArrayLike, Sequence[float], Sequence[Sequence[float]]]
+
+def models() -> List[Dict[str, Any]]:
+    """The model catalogue, as ``bv models --json`` prints it."""
+
+class Model:
+    """A BRDF of bv's catalogue, a user ``.brdf`` file or a MERL table, with its parameters."""
+
+    def __init__(self, model: str, **params: Any) -> None: ...
+    @property
+    def id(self) -> str:
+        """The model id."""
+    @property
+    def params(self) -> Dict[str, Any]:
+        """Every parameter's value, defaults filled in."""
+    @property
+    def transmits(self) -> bool:
+        """Whether the model scatters below the surface."""
+    def eval(
+        self, wi: ArrayLike, wo: ArrayLike, precision: str = "f32"
+    ) -> npt.NDArray[np.floating[Any]]:
+        """f(wi, wo), (N, 3): float32 through the batch kernels, float64 with precision="f64"."""
+    def pdf(self, wi: ArrayLike, wo: ArrayLike) -> npt.NDArray[np.float64]:
+        """The density of `sample` at wo, (N,)."""
+    def sample(
+        self, wi: ArrayLike, u: ArrayLike
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(wo (N, 3), weight (N, 3), pdf (N,)) for uniform points u (N, 2)."""
+    def albedo(
+        self, theta_i: Union[float, ArrayLike], phi_i: float = 0.0
+    ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """(ρhd values (N, 3), errors (N, 3)) at θi in degrees."""
+    def check(self, albedo: str = "auto") -> Dict[str, Any]:
+        """The dict `bv check --json` prints."""
+    def dispatch(self) -> Tuple[bool, str]:
+        """(kernel, isa) of the f32 evaluation."""
+
+class Figure(np.ndarray):
+    """An (H, W, 4) uint8 RGBA image drawn by bv, shown as a PNG in Jupyter."""
+
+    def _repr_png_(self) -> bytes: ...
+    def save(self, path: str) -> None:
+        """Writes the image as a PNG file."""
+
+def render(
+    model: Model,
+    view: str = "lobe3d",
+    width: int = 800,
+    height: int = 600,
+    theta_i: float | None = None,
+    phi_i: float | None = None,
+    theme: str | None = None,
+    log: bool = False,
+    cosine: bool = False,
+    transparent: bool = False,
+    scale: float | None = None,
+) -> Figure:
+    """One view of `model` as `bv render --view VIEW` draws it."""
