@@ -92,18 +92,18 @@ pub fn run(args: &TabulateArgs) -> Result<()> {
 
 /// `bv tabulate --format rgl`.
 fn run_rgl(args: &TabulateArgs) -> Result<()> {
-    let spec = model_spec(&args.model, &args.params)?;
+    let spec = args.model.spec()?;
     let brdf = spec.build()?;
     if !brdf.claims().isotropic {
         warn(&format!(
             "`{}` is anisotropic; the file is isotropic (φi = 0 slice, relative azimuths kept)",
-            args.model
+            spec.id()
         ));
     }
     if !brdf.deltas(glam::DVec3::Z).is_empty() {
         warn(&format!(
             "`{}` has delta lobes, which a table cannot hold (they tabulate as 0)",
-            args.model
+            spec.id()
         ));
     }
     let opts = RglWriteOptions {

@@ -166,6 +166,12 @@ impl Brdf for Rgl {
         }
     }
 
+    /// A measured file promises nothing: the claims above describe the
+    /// lookup, to steer the analysis (`bv check` shows "—").
+    fn claims_declared(&self) -> bool {
+        false
+    }
+
     fn file_data(&self) -> Option<Arc<dyn FileData>> {
         Some(self.material.clone())
     }
