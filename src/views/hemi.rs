@@ -95,8 +95,13 @@ impl View for HemiView {
             return;
         }
         let big = scene.presenting || area.height() > 500.0;
+        // A small cell (the overview, a thumbnail) keeps the discs and
+        // their names: no peak line, no explanatory footer.
+        let tiny = !scene.presenting && (area.height() < 320.0 || area.width() < 360.0);
         let (title_size, small_size) = if big { (17.0, 14.0) } else { (13.0, 11.0) };
-        let footer = if big {
+        let footer = if tiny {
+            4.0
+        } else if big {
             2.6 * small_size + 8.0
         } else {
             2.6 * small_size + 4.0
@@ -105,7 +110,11 @@ impl View for HemiView {
         // Room between discs for the ωi label on the rim.
         let gap = 3.0 * small_size + 16.0;
         let cell_w = (area.width() - gap * (n + 1.0)) / n;
-        let title_h = 2.4 * title_size;
+        let title_h = if tiny {
+            1.3 * title_size
+        } else {
+            2.4 * title_size
+        };
         let side = cell_w
             .min(area.height() - title_h - footer - 16.0)
             .max(20.0);
@@ -141,17 +150,19 @@ impl View for HemiView {
                 FontId::proportional(title_size),
                 b.color(),
             );
-            painter.text(
-                Pos2::new(x0 + side * 0.5, top + 1.2 * title_size),
-                Align2::CENTER_TOP,
-                format!(
-                    "peak {} 1/sr{}",
-                    super::curves::fmt_value(h.map.peak),
-                    if shown.stale { " (updating)" } else { "" }
-                ),
-                FontId::proportional(small_size),
-                text,
-            );
+            if !tiny {
+                painter.text(
+                    Pos2::new(x0 + side * 0.5, top + 1.2 * title_size),
+                    Align2::CENTER_TOP,
+                    format!(
+                        "peak {} 1/sr{}",
+                        super::curves::fmt_value(h.map.peak),
+                        if shown.stale { " (updating)" } else { "" }
+                    ),
+                    FontId::proportional(small_size),
+                    text,
+                );
+            }
             let disc = Rect::from_min_size(Pos2::new(x0, top + title_h), Vec2::splat(side));
             let c = disc.center();
             let r = side * 0.5;
@@ -206,6 +217,9 @@ impl View for HemiView {
                     light,
                 );
             }
+        }
+        if tiny {
+            return;
         }
         let ti = scene.incident.theta_deg;
         let value = if scene.state.display.cosine {
