@@ -179,12 +179,18 @@ impl View for MicrosurfaceView {
 fn summary(sim: &Simulation, specimen: &Specimen) -> Vec<String> {
     let o = sim.surface.options();
     let g = &sim.gonio;
-    let from = specimen
-        .from
-        .as_ref()
-        .map_or(String::new(), |l| format!(" ({l}'s)"));
+    // The BRDF it comes from on a line of its own, its name cut to fit the
+    // 330-point text column (a deck's legend names run long).
+    let from = match &specimen.from {
+        Some(l) if l.chars().count() > 24 => {
+            format!("slopes of {}…", l.chars().take(23).collect::<String>())
+        }
+        Some(l) => format!("slopes of {l}"),
+        None => "the view's own slopes".into(),
+    };
     vec![
-        format!("{} surface{from}, {}²", specimen.describe(), o.size),
+        format!("{} surface, {}²", specimen.describe(), o.size),
+        from,
         format!("light θi = {:.1}°", g.opts.theta_i.to_degrees()),
         String::new(),
         "masking G1(θi)".into(),
