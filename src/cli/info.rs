@@ -186,33 +186,7 @@ fn run_other(args: &InfoArgs) -> Result<()> {
         "ρhd(θi) = ∫ f cosθo dωo (Monte Carlo through the model's sampler ± standard error, {} samples each):",
         int(&report["rho_hd"][0]["samples"])
     );
-    for x in report["rho_hd"].as_array().into_iter().flatten() {
-        let v: Vec<f64> = x["value"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .map(num)
-            .collect();
-        let e: Vec<f64> = x["stderr"]
-            .as_array()
-            .into_iter()
-            .flatten()
-            .map(num)
-            .collect();
-        if v.len() == 3 && e.len() == 3 {
-            let _ = writeln!(
-                out,
-                "  θi = {:>4.0}°  r {} ± {}  g {} ± {}  b {} ± {}",
-                num(&x["theta_i_deg"]),
-                fixed(v[0], 4),
-                fixed(e[0], 4),
-                fixed(v[1], 4),
-                fixed(e[1], 4),
-                fixed(v[2], 4),
-                fixed(e[2], 4)
-            );
-        }
-    }
+    rho_rows(&mut out, &report["rho_hd"]);
     let _ = writeln!(
         out,
         "reciprocity: max |f(wi,wo) − f(wo,wi)| / max f = {:.3e} over {} pairs",
@@ -291,7 +265,24 @@ fn text(r: &Value) -> String {
         r["reciprocity"]["interpolation"].as_str().unwrap_or(""),
         int(&r["rho_hd"][0]["samples"])
     );
-    for x in r["rho_hd"].as_array().into_iter().flatten() {
+    rho_rows(&mut out, &r["rho_hd"]);
+    let _ = writeln!(
+        out,
+        "reciprocity: max |f(wi,wo) − f(wo,wi)| / max f = {:.3e} over {} pairs (the table folds φd by reciprocity, so this checks the lookup path)",
+        num(&r["reciprocity"]["max_rel_error"]),
+        r["reciprocity"]["pairs"]
+    );
+    for w in r["warnings"].as_array().into_iter().flatten() {
+        let _ = writeln!(out, "warning:     {}", w.as_str().unwrap_or(""));
+    }
+    out
+}
+
+/// One line per θi of a report's `rho_hd` rows: r, g, b with their
+/// standard errors (the measured-table and RGL summaries alike).
+fn rho_rows(out: &mut String, rows: &serde_json::Value) {
+    use std::fmt::Write as _;
+    for x in rows.as_array().into_iter().flatten() {
         let v: Vec<f64> = x["value"]
             .as_array()
             .into_iter()
@@ -318,14 +309,4 @@ fn text(r: &Value) -> String {
             );
         }
     }
-    let _ = writeln!(
-        out,
-        "reciprocity: max |f(wi,wo) − f(wo,wi)| / max f = {:.3e} over {} pairs (the table folds φd by reciprocity, so this checks the lookup path)",
-        num(&r["reciprocity"]["max_rel_error"]),
-        r["reciprocity"]["pairs"]
-    );
-    for w in r["warnings"].as_array().into_iter().flatten() {
-        let _ = writeln!(out, "warning:     {}", w.as_str().unwrap_or(""));
-    }
-    out
 }
