@@ -12,7 +12,7 @@
 #import bv::dispatch
 #import bv::frame::PI
 #import bv::sampling::pcg
-#import bv::sphere::{sphere_at, to_local, to_view, turned, SpherePoint}
+#import bv::sphere::{sphere_at, tile_at, to_local, to_view, turned, SpherePoint}
 #import bv::torus
 
 struct Frame {
@@ -40,9 +40,13 @@ struct Frame {
     y1: u32,
     // The surface turned about its normal (radians).
     turn: f32,
-    pad0: f32,
-    pad1: f32,
-    pad2: f32,
+    // Tiles in a full row (src/gpu/sphere.rs, Grid).
+    cols: u32,
+    // The first row of the accumulation buffer bound (its band's; a tile's
+    // rows [y0, y1) may start lower in the band).
+    band: u32,
+    // Object 2, the plane: the eye's elevation above it (radians).
+    elevation: f32,
 }
 
 // Roberts' R_d low-discrepancy sequences ("The unreasonable effectiveness of
@@ -120,16 +124,28 @@ fn glass_path(model: u32, o: u32, n: vec3<f32>) -> vec3<f32> {
     return l;
 }
 
-// Radiance of the delta parts of a (non-mix) model at sphere point s.
-fn delta_leaf(model: u32, o: u32, s: SpherePoint) -> vec3<f32> {
+// Radiance of the delta parts of a (non-mix) model at sphere point s seen
+// from v (towards the eye, view space).
+fn delta_leaf(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
     let kind = dispatch::delta_kind(model);
     if (kind == dispatch::DELTA_REFLECTION) {
-        let v = vec3<f32>(0.0, 0.0, 1.0);
         let c = dot(v, s.n);
         return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
     }
     if (kind == dispatch::DELTA_REFRACTION) {
         return glass_path(model, o, s.n);
+    }
+    return vec3<f32>(0.0);
+}
+
+// The plane's delta parts: a smooth interface over a dark, opaque floor
+// (LECTURE.md N13, "a glass-coated dark floor"): what it reflects, F; what
+// it refracts is absorbed below and never comes back.
+fn delta_leaf_plane(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
+    let kind = dispatch::delta_kind(model);
+    if (kind == dispatch::DELTA_REFLECTION || kind == dispatch::DELTA_REFRACTION) {
+        let c = dot(v, s.n);
+        return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
     }
     return vec3<f32>(0.0);
 }
@@ -195,25 +211,69 @@ fn delta_leaf_torus(model: u32, o: u32, s: SpherePoint, p: vec3<f32>) -> vec3<f3
     return vec3<f32>(0.0);
 }
 
-fn delta_any(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, on_torus: bool) -> vec3<f32> {
-    if (on_torus) {
+fn delta_any(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    if (view.object == 1u) {
         return delta_leaf_torus(model, o, s, p);
     }
-    return delta_leaf(model, o, s);
+    if (view.object == 2u) {
+        return delta_leaf_plane(model, o, s, v);
+    }
+    return delta_leaf(model, o, s, v);
 }
 
-fn delta_radiance(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, on_torus: bool) -> vec3<f32> {
+fn delta_radiance(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
     if (model != L::MODEL_MIX) {
-        return delta_any(model, o, s, p, on_torus);
+        return delta_any(model, o, s, p, v);
     }
     let n = pu(o + L::MIX_COMPONENTS);
     let table = pu(o + L::MIX_COMPONENTS + 1u);
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < n; j++) {
         let e = table + L::COMPONENT_ENTRY_SLOTS * j;
-        sum += pf(e) * delta_any(pu(e + 1u), pu(e + 2u), s, p, on_torus);
+        sum += pf(e) * delta_any(pu(e + 1u), pu(e + 2u), s, p, v);
     }
     return sum;
+}
+
+// A pixel of the plane object (LECTURE.md N13): each tile shows, in the
+// square the sphere would fill, a flat sample of infinite extent under
+// the environment, seen through a pinhole camera (the background's field of
+// view) pitched down by `elevation` towards it. Only directions matter
+// (the environment is distant and the plane casts no shadow on itself),
+// so the camera has no position.
+struct PlaneHit {
+    // The floor's frame (tile −1 where the ray misses it or leaves the tile's square).
+    s: SpherePoint,
+    // Towards the eye (view space).
+    v: vec3<f32>,
+    // Inside the tile's square: above the horizon the ray sees the sky, −v.
+    inside: bool,
+}
+
+fn plane_at(p: vec2<f32>) -> PlaneHit {
+    var out: PlaneHit;
+    out.s.tile = -1;
+    out.inside = false;
+    let cell = tile_at(p, view.size, view.tiles, view.cols);
+    let q = (p - cell.centre) / cell.r;
+    if (abs(q.x) > 1.0 || abs(q.y) > 1.0) {
+        return out;
+    }
+    out.inside = true;
+    let e = view.elevation;
+    // Forward, up and right of the camera (view space: y up, z to the viewer).
+    let f = vec3<f32>(0.0, -sin(e), -cos(e));
+    let up = vec3<f32>(0.0, cos(e), -sin(e));
+    let d = normalize(f + view.fov_tan * (q.x * vec3<f32>(1.0, 0.0, 0.0) - q.y * up));
+    out.v = -d;
+    if (d.y >= 0.0) {
+        return out;
+    }
+    out.s.tile = i32(cell.index);
+    out.s.n = vec3<f32>(0.0, 1.0, 0.0);
+    out.s.t = vec3<f32>(1.0, 0.0, 0.0);
+    out.s.b = cross(out.s.n, out.s.t);
+    return out;
 }
 
 @compute @workgroup_size(8, 8)
@@ -232,23 +292,36 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
     let on_torus = view.object == 1u;
     var s: SpherePoint;
     var x = vec3<f32>(0.0);
+    // Towards the eye: the orthographic view's +z, or the plane's camera ray.
+    var v = vec3<f32>(0.0, 0.0, 1.0);
+    var sky = false;
     if (on_torus) {
-        let hit = torus::torus_at(p, view.size, view.tiles);
+        let hit = torus::torus_at(p, view.size, view.tiles, view.cols);
         s = hit.s;
         x = hit.p;
+    } else if (view.object == 2u) {
+        let hit = plane_at(p);
+        s = hit.s;
+        v = hit.v;
+        sky = hit.inside;
     } else {
-        s = sphere_at(p, view.size, view.tiles);
+        s = sphere_at(p, view.size, view.tiles, view.cols);
     }
     s = turned(s, view.turn);
     var sum = vec3<f32>(0.0);
     if (s.tile < 0) {
-        // Background: the environment through a pinhole of the given field of view.
+        // Background: the environment through a pinhole of the given field
+        // of view; in the plane's square, through its camera.
         let q = (p - 0.5 * view.size) / (0.5 * view.size.y) * view.fov_tan;
-        sum = envmap::radiance(normalize(vec3<f32>(q.x, -q.y, -1.0))) * f32(view.spp);
+        var dir = normalize(vec3<f32>(q.x, -q.y, -1.0));
+        if (sky) {
+            dir = -v;
+        }
+        sum = envmap::radiance(dir) * f32(view.spp);
     } else {
         let m = models[u32(s.tile)];
         let model = select(m.x, FIXED_MODEL, FIXED_MODEL != 0xffffffffu);
-        let wo = to_local(s, vec3<f32>(0.0, 0.0, 1.0));
+        let wo = to_local(s, v);
         // The pixel's shifts: fixed for the whole accumulation (the sequence
         // goes on across passes through view.base).
         let h0 = pcg(pixel * 7919u + 17u);
@@ -294,7 +367,7 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
         }
-        sum += delta_radiance(model, m.y, s, x, on_torus) * f32(view.spp);
+        sum += delta_radiance(model, m.y, s, x, v) * f32(view.spp);
     }
-    accum[(py - view.y0) * w + px] += vec4<f32>(sum, f32(view.spp));
+    accum[(py - view.band) * w + px] += vec4<f32>(sum, f32(view.spp));
 }

@@ -19,6 +19,11 @@ struct View {
     checker: f32,
     // The surface turned about its normal (radians).
     turn: f32,
+    // Tiles in a full row (src/gpu/sphere.rs, Grid).
+    cols: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
     color: vec4<f32>,
     color2: vec4<f32>,
 }
@@ -52,7 +57,7 @@ fn background(p: vec2<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_main(@builtin(position) pos: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = turned(sphere_at(pos.xy, view.size, view.tiles), view.turn);
+    let s = turned(sphere_at(pos.xy, view.size, view.tiles, view.cols), view.turn);
     if (s.tile < 0) {
         return vec4<f32>(background(pos.xy), 1.0);
     }

@@ -213,3 +213,87 @@ fn exr_environments_load() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The plane object (LECTURE.md N13) under a constant environment of
+/// radiance 1: smooth glass over a dark floor shows F(θ) of the angle at
+/// which each pixel's camera ray meets it, Lambert of albedo 1 shows 1, and
+/// the sky in the square and the background show the environment, 1. This
+/// holds only if the shader's camera (elevation, field of view, tiles)
+/// matches `bv::gpu::plane`, which this test reads with bv-core's Fresnel.
+#[test]
+fn the_plane_shows_fresnel_of_each_camera_ray() {
+    use bv::gpu::env::Object;
+    use bv::gpu::plane::{PlaneRay, camera_ray};
+    let Some(mut r) = renderer(&EnvironmentMap::constant([1.0; 3])) else {
+        return;
+    };
+    r.set_object(Object::Plane);
+    let glass = ModelSpec::from_json("glass", &serde_json::json!({"eta": 1.5})).unwrap();
+    let lambert = ModelSpec::from_json("lambert", &serde_json::json!({"albedo": 1.0})).unwrap();
+    let models = [glass, lambert];
+    let (w, h) = (64, 32);
+    let size = DVec2::new(w.into(), h.into());
+    for elevation_deg in [90.0f64, 40.0, 5.0] {
+        let settings = EnvSettings {
+            elevation: elevation_deg.to_radians(),
+            ..EnvSettings::default()
+        };
+        let fov_tan = (0.5 * settings.background_fov_deg.to_radians()).tan();
+        let img = r.render_radiance(&models, &settings, w, h, 256).unwrap();
+        let (mut plane, mut sky) = (0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let got = f64::from(img[(y * w + x) as usize][1]);
+                let (want, tol) = match camera_ray(p, size, 2, fov_tan, settings.elevation) {
+                    PlaneRay::Plane { tile: 0, dir } => {
+                        plane += 1;
+                        (bv_core::fresnel::dielectric(-dir.y, 1.5), 2e-3)
+                    }
+                    // Lambert under the furnace: 1 up to the sampling noise.
+                    PlaneRay::Plane { .. } => (1.0, 0.05),
+                    PlaneRay::Sky { .. } => {
+                        sky += 1;
+                        (1.0, 1e-5)
+                    }
+                    PlaneRay::Outside => (1.0, 1e-5),
+                };
+                // Pixels whose rays graze the horizon or a tile's edge may
+                // fall on either side in f32.
+                let edge = [(-0.5, 0.0), (0.5, 0.0), (0.0, -0.5), (0.0, 0.5)]
+                    .iter()
+                    .any(|&(dx, dy)| {
+                        camera_ray(p + DVec2::new(dx, dy), size, 2, fov_tan, settings.elevation)
+                            != camera_ray(p, size, 2, fov_tan, settings.elevation)
+                            && !matches!(
+                                (
+                                    camera_ray(
+                                        p + DVec2::new(dx, dy),
+                                        size,
+                                        2,
+                                        fov_tan,
+                                        settings.elevation
+                                    ),
+                                    camera_ray(p, size, 2, fov_tan, settings.elevation)
+                                ),
+                                (PlaneRay::Plane { .. }, PlaneRay::Plane { .. })
+                            )
+                    });
+                if !edge {
+                    assert!(
+                        (got - want).abs() <= tol,
+                        "elevation {elevation_deg}°, pixel ({x}, {y}): {got} vs {want}"
+                    );
+                }
+            }
+        }
+        println!("plane at {elevation_deg}°: {plane} plane pixels, {sky} sky pixels");
+        assert!(
+            plane > 50,
+            "elevation {elevation_deg}°: {plane} plane pixels"
+        );
+        if elevation_deg < 10.0 {
+            assert!(sky > 50, "elevation {elevation_deg}°: no sky in the square");
+        }
+    }
+}

@@ -10,7 +10,7 @@
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bv::gpu::sphere::{FILL, sphere_at};
+use bv::gpu::sphere::{Grid, sphere_at};
 use bv::gpu::{
     Background, LitSphereRenderer, LitSphereSettings, ToneMap, gpu_for_test,
     lit_sphere::reference_image, shaders::ShaderLibrary,
@@ -21,10 +21,8 @@ use glam::{DVec2, DVec3};
 fn on_silhouette(x: u32, y: u32, w: u32, h: u32, tiles: usize) -> bool {
     let size = DVec2::new(w.into(), h.into());
     let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-    let tile_w = size.x / tiles as f64;
-    let tile = ((p.x / tile_w).floor() as usize).min(tiles - 1);
-    let c = DVec2::new((tile as f64 + 0.5) * tile_w, 0.5 * size.y);
-    let r = 0.5 * FILL * tile_w.min(size.y);
+    let grid = Grid::new(tiles, size);
+    let (c, r) = grid.circle(grid.tile_at(p, size), size);
     let d2 = ((p - c) / r).length_squared();
     (d2 - 1.0).abs() < 1e-5 || sphere_at(p, size, tiles).is_some() != (d2 < 1.0)
 }
@@ -118,6 +116,14 @@ fn gpu_lit_sphere_matches_cpu_reference() {
         57,
         &mut r,
     );
+    // Small multiples: seven spheres in a grid of two rows (4 + 3, the
+    // last row centred), every tile drawn by its own model's pipeline.
+    let seven: Vec<ModelSpec> = [&lambert, &ct, &aniso, &ct, &lambert, &aniso, &ct]
+        .into_iter()
+        .cloned()
+        .collect();
+    assert_eq!(Grid::new(7, DVec2::new(200.0, 120.0)).cols, 4);
+    compare(&seven, &s2, 200, 120, &mut r);
     // The surface turned about its normal, at several angles.
     for turn_deg in [30.0f64, 90.0, -135.0] {
         let turned = LitSphereSettings {

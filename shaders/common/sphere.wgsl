@@ -1,5 +1,6 @@
-// Image-space geometry of the sphere views: N spheres side by side, each in
-// its tile, orthographic, seen along −z (viewer direction +z), with a tangent
+// Image-space geometry of the sphere views: N spheres in a grid of tiles
+// (`cols` to a row, the last row centred; src/gpu/sphere.rs, Grid, chooses
+// `cols`), each in its tile, orthographic, seen along −z (viewer direction +z), with a tangent
 // frame whose tangent follows the parallels about the vertical axis (the
 // direction of increasing longitude), so that anisotropic models show their
 // stretched highlights. src/gpu/sphere.rs has the same geometry in Rust.
@@ -18,14 +19,38 @@ struct SpherePoint {
     b: vec3<f32>,
 }
 
+// Which tile holds pixel position p, its sphere's centre and radius (pixels).
+struct Tile {
+    index: u32,
+    centre: vec2<f32>,
+    r: f32,
+}
+
+// The tile of p: its row, then its column within the row's centred tiles
+// (a point in a row's margin goes to the row's nearest tile).
+fn tile_at(p: vec2<f32>, size: vec2<f32>, tiles: u32, cols: u32) -> Tile {
+    var out: Tile;
+    let rows = (tiles + cols - 1u) / cols;
+    let tw = size.x / f32(cols);
+    let th = size.y / f32(rows);
+    let row = min(u32(max(floor(p.y / th), 0.0)), rows - 1u);
+    let n = min(cols, tiles - row * cols);
+    let off = 0.5 * f32(cols - n) * tw;
+    let col = min(u32(max(floor((p.x - off) / tw), 0.0)), n - 1u);
+    out.index = row * cols + col;
+    out.centre = vec2<f32>(off + (f32(col) + 0.5) * tw, (f32(row) + 0.5) * th);
+    out.r = 0.5 * FILL * min(tw, th);
+    return out;
+}
+
 // The sphere point under pixel position p (pixel units, y down, centres at +0.5).
-fn sphere_at(p: vec2<f32>, size: vec2<f32>, tiles: u32) -> SpherePoint {
+fn sphere_at(p: vec2<f32>, size: vec2<f32>, tiles: u32, cols: u32) -> SpherePoint {
     var out: SpherePoint;
-    let tile_w = size.x / f32(tiles);
-    let tile = min(u32(floor(p.x / tile_w)), tiles - 1u);
-    let cx = (f32(tile) + 0.5) * tile_w;
-    let cy = 0.5 * size.y;
-    let r = 0.5 * FILL * min(tile_w, size.y);
+    let cell = tile_at(p, size, tiles, cols);
+    let tile = cell.index;
+    let cx = cell.centre.x;
+    let cy = cell.centre.y;
+    let r = cell.r;
     let u = (p.x - cx) / r;
     let v = (cy - p.y) / r;
     let d2 = u * u + v * v;

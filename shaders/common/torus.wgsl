@@ -7,7 +7,7 @@
 // show. src/gpu/torus.rs has the same geometry in Rust.
 #define_import_path bv::torus
 
-#import bv::sphere::{SpherePoint, FILL}
+#import bv::sphere::{SpherePoint, tile_at}
 
 // Radius of the ring's centre line and of its tube (outer radius 0.96 < 1).
 const MAJOR: f32 = 0.64;
@@ -107,14 +107,14 @@ struct TorusHit {
 }
 
 // The torus point under pixel position p (the same tiles as sphere_at).
-fn torus_at(px: vec2<f32>, size: vec2<f32>, tiles: u32) -> TorusHit {
+fn torus_at(px: vec2<f32>, size: vec2<f32>, tiles: u32, cols: u32) -> TorusHit {
     var out: TorusHit;
     out.s.tile = -1;
-    let tile_w = size.x / f32(tiles);
-    let tile = min(u32(floor(px.x / tile_w)), tiles - 1u);
-    let cx = (f32(tile) + 0.5) * tile_w;
-    let cy = 0.5 * size.y;
-    let r = 0.5 * FILL * min(tile_w, size.y);
+    let cell = tile_at(px, size, tiles, cols);
+    let tile = cell.index;
+    let cx = cell.centre.x;
+    let cy = cell.centre.y;
+    let r = cell.r;
     let u = (px.x - cx) / r;
     let v = (cy - px.y) / r;
     let d2 = u * u + v * v;

@@ -27,6 +27,12 @@ pub enum Object {
     /// A torus with its ring tilted towards the viewer, self-shadowing
     /// (`shaders/common/torus.wgsl`).
     Torus,
+    /// A flat sample of infinite extent seen from an eye at
+    /// [`EnvSettings::elevation`] above it (LECTURE.md N13: Fresnel at
+    /// normal, mid and grazing angles; `plane_at` in env.wgsl). A smooth
+    /// dielectric on it is a glass-coated dark floor: what it refracts is
+    /// absorbed.
+    Plane,
 }
 
 impl Object {
@@ -35,6 +41,7 @@ impl Object {
         match self {
             Object::Sphere => 0,
             Object::Torus => 1,
+            Object::Plane => 2,
         }
     }
 }
@@ -53,6 +60,9 @@ pub struct EnvSettings {
     /// The surface turned about its normal (radians, from the tangent
     /// towards the bitangent).
     pub turn: f64,
+    /// The plane object: the eye's elevation above the plane (radians;
+    /// π/2 looks straight down).
+    pub elevation: f64,
 }
 
 impl Default for EnvSettings {
@@ -63,6 +73,7 @@ impl Default for EnvSettings {
             tone_map: ToneMap::Aces,
             background_fov_deg: 60.0,
             turn: 0.0,
+            elevation: 30f64.to_radians(),
         }
     }
 }
@@ -82,7 +93,9 @@ struct FrameUniform {
     y0: u32,
     y1: u32,
     turn: f32,
-    pad: [f32; 3],
+    cols: u32,
+    band: u32,
+    elevation: f32,
 }
 
 #[repr(C)]
@@ -144,6 +157,7 @@ struct Key {
     size: (u32, u32),
     env: u64,
     object: Object,
+    elevation: f64,
 }
 
 /// The progressive environment renderer.
@@ -511,6 +525,12 @@ impl EnvRenderer {
             size: (width, height),
             env: self.env.generation,
             object: self.object,
+            // Only the plane depends on it: a sphere keeps its samples.
+            elevation: if self.object == Object::Plane {
+                settings.elevation
+            } else {
+                0.0
+            },
         }
     }
 
@@ -592,6 +612,10 @@ impl EnvRenderer {
         }
         let tbuf = self.tables.get(&self.gpu, &tables)?;
         let tiles: Vec<[u32; 2]> = refs.iter().map(|r| [r.model, r.offset]).collect();
+        let grid = super::sphere::Grid::new(
+            models.len(),
+            glam::DVec2::new(f64::from(width), f64::from(height)),
+        );
         let frame = FrameUniform {
             size: [width as f32, height as f32],
             tiles: u32::try_from(models.len())?,
@@ -606,7 +630,9 @@ impl EnvRenderer {
             y0: 0,
             y1: height,
             turn: settings.turn as f32,
-            pad: [0.0; 3],
+            cols: u32::try_from(grid.cols)?,
+            band: 0,
+            elevation: settings.elevation as f32,
         };
         let env = EnvUniform {
             width: self.env.size.0,
@@ -646,12 +672,12 @@ impl EnvRenderer {
             // the band's rows, with the tile's model's pipeline.
             for band in &self.accum {
                 for (k, r) in refs.iter().enumerate() {
-                    let x0 = super::lit_sphere::tile_start(k, refs.len(), width);
-                    let x1 = super::lit_sphere::tile_start(k + 1, refs.len(), width);
-                    if x1 <= x0 {
+                    let [x0, x1, ty0, ty1] = grid.pixels(k, width, height);
+                    // The rows of the tile in this band.
+                    let (y0, y1) = (ty0.max(band.y0), ty1.min(band.y0 + band.rows));
+                    if x1 <= x0 || y1 <= y0 {
                         continue;
                     }
-                    let (y0, y1) = (band.y0, band.y0 + band.rows);
                     let fbuf = init(
                         "frame",
                         bytemuck::bytes_of(&FrameUniform {
@@ -659,6 +685,7 @@ impl EnvRenderer {
                             x1,
                             y0,
                             y1,
+                            band: band.y0,
                             ..frame
                         }),
                         wgpu::BufferUsages::UNIFORM,
@@ -681,7 +708,7 @@ impl EnvRenderer {
                     pass.set_bind_group(0, &g0, &[]);
                     pass.dispatch_workgroups(
                         (x1 - x0).div_ceil(WORKGROUP),
-                        band.rows.div_ceil(WORKGROUP),
+                        (y1 - y0).div_ceil(WORKGROUP),
                         1,
                     );
                 }

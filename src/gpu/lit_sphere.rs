@@ -10,6 +10,7 @@ use super::fullscreen;
 use super::pack::{TableBuffer, pack_all};
 use super::shaders::ShaderLibrary;
 use super::specialised::{Followed, ModelPipelines};
+use super::sphere::Grid;
 use anyhow::{Result, bail};
 use bv_core::ModelSpec;
 use glam::DVec3;
@@ -80,6 +81,8 @@ struct ViewUniform {
     background: u32,
     checker: f32,
     turn: f32,
+    cols: u32,
+    pad: [u32; 3],
     color: [f32; 4],
     color2: [f32; 4],
 }
@@ -145,20 +148,6 @@ fn pipeline(
     module: &wgpu::ShaderModule,
 ) -> wgpu::RenderPipeline {
     fullscreen::pipeline(device, "lit sphere", Some(layout), module, TARGET_FORMAT)
-}
-
-/// The first pixel column of tile `k` of `tiles` in an image `width` wide:
-/// pixel x belongs to the tile of its centre, ⌊(x + ½)/tile_w⌋, as in
-/// shaders/common/sphere.wgsl (columns at a boundary are background).
-pub fn tile_start(k: usize, tiles: usize, width: u32) -> u32 {
-    if k == 0 {
-        return 0;
-    }
-    if k >= tiles {
-        return width;
-    }
-    let tile_w = f64::from(width) / tiles as f64;
-    ((k as f64 * tile_w - 0.5).ceil().max(0.0) as u32).min(width)
 }
 
 impl LitSphereRenderer {
@@ -259,6 +248,10 @@ impl LitSphereRenderer {
             Background::Flat(c) => (0, 1.0, c, c),
             Background::Checker { a, b, size } => (1, size.max(1.0), a, b),
         };
+        let grid = Grid::new(
+            models.len(),
+            glam::DVec2::new(f64::from(width), f64::from(height)),
+        );
         let uniform = ViewUniform {
             size: [width as f32, height as f32],
             tiles: u32::try_from(models.len())?,
@@ -273,6 +266,8 @@ impl LitSphereRenderer {
             background,
             checker,
             turn: settings.turn as f32,
+            cols: u32::try_from(grid.cols)?,
+            pad: [0; 3],
             color: [color[0], color[1], color[2], 1.0],
             color2: [color2[0], color2[1], color2[2], 1.0],
         };
@@ -310,9 +305,8 @@ impl LitSphereRenderer {
         // pipeline.
         let mut draws = Vec::with_capacity(refs.len());
         for (k, r) in refs.iter().enumerate() {
-            let x0 = tile_start(k, refs.len(), width);
-            let x1 = tile_start(k + 1, refs.len(), width);
-            if x1 <= x0 {
+            let [x0, x1, y0, y1] = grid.pixels(k, width, height);
+            if x1 <= x0 || y1 <= y0 {
                 continue;
             }
             let Some(p) = self.pipelines.get(r.model) else {
@@ -321,7 +315,7 @@ impl LitSphereRenderer {
             draws.push(fullscreen::Draw {
                 pipeline: p,
                 bind_group: &bind,
-                scissor: Some([x0, 0, x1 - x0, height]),
+                scissor: Some([x0, y0, x1 - x0, y1 - y0]),
             });
         }
         let mut enc = d.create_command_encoder(&Default::default());
@@ -412,30 +406,3 @@ pub fn reference_image(
     Ok(img)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::gpu::sphere::sphere_at;
-    use glam::DVec2;
-
-    #[test]
-    fn tile_columns_partition_the_image_like_the_shader() {
-        for (tiles, width) in [(1usize, 7u32), (2, 300), (3, 301), (5, 97), (4, 1024)] {
-            assert_eq!(tile_start(0, tiles, width), 0);
-            assert_eq!(tile_start(tiles, tiles, width), width);
-            for k in 0..tiles {
-                let (x0, x1) = (tile_start(k, tiles, width), tile_start(k + 1, tiles, width));
-                assert!(x0 <= x1);
-                // Every sphere pixel of a column in [x0, x1) belongs to tile k.
-                let size = DVec2::new(f64::from(width), 100.0);
-                for x in x0..x1 {
-                    for y in [10.0, 50.0, 90.0] {
-                        if let Some(s) = sphere_at(DVec2::new(f64::from(x) + 0.5, y), size, tiles) {
-                            assert_eq!(s.tile, k, "{tiles} tiles, width {width}, x {x}");
-                        }
-                    }
-                }
-            }
-        }
-    }
-}

@@ -37,6 +37,7 @@ pub mod lit_sphere;
 pub mod lobe;
 pub mod pack;
 pub mod pipeline_cache;
+pub mod plane;
 pub mod readback;
 pub mod shaders;
 pub mod specialised;

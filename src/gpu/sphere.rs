@@ -28,17 +28,151 @@ impl SpherePoint {
     }
 }
 
+/// How the spheres of a view are arranged: `cols` tiles to a row, as many
+/// rows as needed, the last row's tiles centred. One row unless a grid makes
+/// the spheres at least [`Grid::GRID_GAIN`] times larger: four BRDFs side
+/// by side stay a row, Cook & Torrance's twelve materials become 6 × 2
+/// (LECTURE.md N5, small multiples). A function of the tile count and the
+/// image's aspect only, so the shaders (given `cols`), the CPU reference and
+/// the overlays drawn in points agree.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Grid {
+    /// Number of spheres.
+    pub tiles: usize,
+    /// Tiles in a full row.
+    pub cols: usize,
+}
+
+impl Grid {
+    /// A grid is used only when its spheres are this much larger than one
+    /// row's: a row reads left to right, and scenes with a few BRDFs keep it.
+    pub const GRID_GAIN: f64 = 1.25;
+
+    /// The arrangement of `tiles` spheres in an image of `size`.
+    pub fn new(tiles: usize, size: DVec2) -> Self {
+        let tiles = tiles.max(1);
+        let radius = |cols: usize| {
+            let rows = tiles.div_ceil(cols);
+            (size.x / cols as f64).min(size.y / rows as f64)
+        };
+        // The largest spheres; on a tie the fewest empty cells (3 + 3
+        // rather than 4 + 2), then the fewest rows.
+        let empty = |cols: usize| cols * tiles.div_ceil(cols) - tiles;
+        let mut best = tiles;
+        for cols in (1..tiles).rev() {
+            let (r, rb) = (radius(cols), radius(best));
+            let tie = (r - rb).abs() <= 1e-9 * rb;
+            if (!tie && r > rb) || (tie && empty(cols) < empty(best)) {
+                best = cols;
+            }
+        }
+        let cols = if radius(best) > Self::GRID_GAIN * radius(tiles) {
+            best
+        } else {
+            tiles
+        };
+        Self { tiles, cols }
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.tiles.div_ceil(self.cols)
+    }
+
+    /// Width and height of one tile.
+    pub fn tile_size(&self, size: DVec2) -> DVec2 {
+        DVec2::new(size.x / self.cols as f64, size.y / self.rows() as f64)
+    }
+
+    /// Tiles in `row` and the row's left margin (its tiles centred).
+    fn row_span(&self, row: usize, size: DVec2) -> (usize, f64) {
+        let n = self.cols.min(self.tiles - row * self.cols);
+        (n, 0.5 * (self.cols - n) as f64 * self.tile_size(size).x)
+    }
+
+    /// The tile whose cell holds `p` (a point in a row's margin or outside
+    /// the image goes to the nearest tile of its row).
+    pub fn tile_at(&self, p: DVec2, size: DVec2) -> usize {
+        // Counted against the same edges as [`Grid::pixels`], so that a
+        // pixel centre on an edge goes to the same tile in both.
+        let row = (1..self.rows())
+            .filter(|&j| p.y >= self.row_edge(j, size))
+            .count();
+        let (n, _) = self.row_span(row, size);
+        let col = (1..n)
+            .filter(|&j| p.x >= self.col_edge(row, j, size))
+            .count();
+        row * self.cols + col
+    }
+
+    /// The top of row `j`.
+    fn row_edge(&self, j: usize, size: DVec2) -> f64 {
+        j as f64 * self.tile_size(size).y
+    }
+
+    /// The left edge of tile `j` of `row`.
+    fn col_edge(&self, row: usize, j: usize, size: DVec2) -> f64 {
+        let (_, off) = self.row_span(row, size);
+        off + j as f64 * self.tile_size(size).x
+    }
+
+    /// Centre and radius of sphere `k`.
+    pub fn circle(&self, k: usize, size: DVec2) -> (DVec2, f64) {
+        let t = self.tile_size(size);
+        let row = k / self.cols;
+        let (_, off) = self.row_span(row.min(self.rows() - 1), size);
+        let col = k % self.cols;
+        (
+            DVec2::new(off + (col as f64 + 0.5) * t.x, (row as f64 + 0.5) * t.y),
+            0.5 * FILL * t.x.min(t.y),
+        )
+    }
+
+    /// The pixels `[x0, x1) × [y0, y1)` of tile `k` in an image `width` ×
+    /// `height`: a pixel belongs to the tile of its centre, as in
+    /// shaders/common/sphere.wgsl. The tiles cover the image (a row's
+    /// margins go to its outer tiles, so that a view that draws a
+    /// background under every pixel draws it there too).
+    pub fn pixels(&self, k: usize, width: u32, height: u32) -> [u32; 4] {
+        let size = DVec2::new(f64::from(width), f64::from(height));
+        let row = (k / self.cols).min(self.rows() - 1);
+        let (n, _) = self.row_span(row, size);
+        let col = (k - row * self.cols).min(n - 1);
+        // The first pixel whose centre is at or past `edge`.
+        let start = |edge: f64, limit: u32| ((edge - 0.5).ceil().max(0.0) as u32).min(limit);
+        let x0 = if col == 0 {
+            0
+        } else {
+            start(self.col_edge(row, col, size), width)
+        };
+        let x1 = if col + 1 == n {
+            width
+        } else {
+            start(self.col_edge(row, col + 1, size), width)
+        };
+        let y0 = if row == 0 {
+            0
+        } else {
+            start(self.row_edge(row, size), height)
+        };
+        let y1 = if row + 1 == self.rows() {
+            height
+        } else {
+            start(self.row_edge(row + 1, size), height)
+        };
+        [x0, x1, y0, y1]
+    }
+}
+
 /// The sphere point under position `p` (pixels, y down, pixel centres at +0.5)
-/// in an image of `size` with `tiles` spheres side by side; `None` on the background.
+/// in an image of `size` with `tiles` spheres arranged by [`Grid::new`];
+/// `None` on the background.
 pub fn sphere_at(p: DVec2, size: DVec2, tiles: usize) -> Option<SpherePoint> {
-    let tiles = tiles.max(1);
-    let tile_w = size.x / tiles as f64;
-    let tile = ((p.x / tile_w).floor().max(0.0) as usize).min(tiles - 1);
-    let cx = (tile as f64 + 0.5) * tile_w;
-    let cy = 0.5 * size.y;
-    let r = 0.5 * FILL * tile_w.min(size.y);
-    let u = (p.x - cx) / r;
-    let v = (cy - p.y) / r;
+    let grid = Grid::new(tiles, size);
+    let tile = grid.tile_at(p, size);
+    let (c, r) = grid.circle(tile, size);
+    let u = (p.x - c.x) / r;
+    let v = (c.y - p.y) / r;
     let d2 = u * u + v * v;
     if d2 >= 1.0 {
         return None;
@@ -65,10 +199,8 @@ pub fn light_from_drag(p: DVec2, size: DVec2, tiles: usize) -> DVec3 {
     if let Some(s) = sphere_at(p, size, tiles) {
         return s.n;
     }
-    let tiles = tiles.max(1);
-    let tile_w = size.x / tiles as f64;
-    let tile = ((p.x / tile_w).floor().max(0.0) as usize).min(tiles - 1);
-    let c = DVec2::new((tile as f64 + 0.5) * tile_w, 0.5 * size.y);
+    let grid = Grid::new(tiles, size);
+    let (c, _) = grid.circle(grid.tile_at(p, size), size);
     let d = DVec2::new(p.x - c.x, c.y - p.y);
     let d = if d.length_squared() > 0.0 {
         d.normalize()
@@ -101,5 +233,59 @@ mod tests {
         assert!((light_from_drag(DVec2::new(150.0, 50.0), size, 2) - DVec3::Z).length() < 1e-12);
         let edge = light_from_drag(DVec2::new(199.0, 50.0), size, 2);
         assert!((edge - DVec3::X).length() < 1e-12);
+    }
+
+    #[test]
+    fn a_few_tiles_stay_a_row_and_many_become_a_grid() {
+        let slide = DVec2::new(1800.0, 900.0);
+        for tiles in 1..=4 {
+            assert_eq!(Grid::new(tiles, slide).cols, tiles);
+        }
+        let g = Grid::new(12, slide);
+        assert_eq!((g.cols, g.rows()), (6, 2));
+        assert_eq!(Grid::new(6, slide).cols, 3);
+        // A tall image stacks them.
+        assert_eq!(Grid::new(3, DVec2::new(300.0, 1200.0)).cols, 1);
+    }
+
+    #[test]
+    fn tiles_partition_the_image_and_hold_their_spheres() {
+        for (tiles, w, h) in [
+            (1usize, 7u32, 5u32),
+            (2, 300, 100),
+            (3, 301, 100),
+            (5, 97, 90),
+            (5, 400, 300),
+            (7, 640, 480),
+            (12, 1800, 900),
+            (12, 1801, 877),
+        ] {
+            let size = DVec2::new(f64::from(w), f64::from(h));
+            let grid = Grid::new(tiles, size);
+            let mut owner = vec![usize::MAX; (w * h) as usize];
+            for k in 0..tiles {
+                let [x0, x1, y0, y1] = grid.pixels(k, w, h);
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let i = (y * w + x) as usize;
+                        assert_eq!(owner[i], usize::MAX, "pixel {x},{y} in two tiles");
+                        owner[i] = k;
+                        let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                        assert_eq!(grid.tile_at(p, size), k, "{tiles} tiles {w}×{h}: {x},{y}");
+                        if let Some(s) = sphere_at(p, size, tiles) {
+                            assert_eq!(s.tile, k);
+                        }
+                    }
+                }
+                // The sphere lies inside its tile's pixels.
+                let (c, r) = grid.circle(k, size);
+                assert!(c.x - r >= f64::from(x0) - 1.0 && c.x + r <= f64::from(x1) + 1.0);
+                assert!(c.y - r >= f64::from(y0) - 1.0 && c.y + r <= f64::from(y1) + 1.0);
+            }
+            assert!(
+                owner.iter().all(|&k| k < tiles),
+                "{tiles} tiles: a pixel in none"
+            );
+        }
     }
 }

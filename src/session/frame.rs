@@ -65,7 +65,30 @@ pub struct Scene<'a> {
     pub presenting: bool,
 }
 
-impl Scene<'_> {
+impl<'a> Scene<'a> {
+    /// The same frame with only the BRDF `id` drawn, as the selected one
+    /// (a panel of small multiples); nothing drawn when it is not here.
+    pub fn only(&self, id: u64) -> Scene<'a> {
+        Scene {
+            state: self.state,
+            brdfs: self
+                .brdfs
+                .iter()
+                .filter(|b| b.id == id)
+                .map(|b| SceneBrdf {
+                    selected: true,
+                    ..b.clone()
+                })
+                .collect(),
+            incident: self.incident,
+            interacting: self.interacting,
+            figure: self.figure,
+            transparent: self.transparent,
+            line_scale: self.line_scale,
+            presenting: self.presenting,
+        }
+    }
+
     /// The BRDF drawn opaque and coloured by value in the lobe view: the
     /// selected one if drawn, else the first drawn.
     pub fn primary(&self) -> Option<&SceneBrdf> {

@@ -82,17 +82,21 @@ pub enum EnvObject {
     /// A torus per BRDF (tangent along the ring, so anisotropy shows; with
     /// self-shadowing).
     Torus,
+    /// A flat sample per BRDF, seen from [`EnvView::elevation_deg`] above
+    /// (LECTURE.md N13).
+    Plane,
 }
 
 impl EnvObject {
     /// Every choice, in menu order.
-    pub const ALL: [EnvObject; 2] = [EnvObject::Sphere, EnvObject::Torus];
+    pub const ALL: [EnvObject; 3] = [EnvObject::Sphere, EnvObject::Torus, EnvObject::Plane];
 
     /// Menu label.
     pub fn label(self) -> &'static str {
         match self {
             EnvObject::Sphere => "sphere",
             EnvObject::Torus => "torus",
+            EnvObject::Plane => "plane",
         }
     }
 }
@@ -142,7 +146,14 @@ pub struct EnvView {
     /// Samples per pixel after which accumulation stops (saves the CPU once
     /// the image is clean).
     pub target_spp: u32,
+    /// The plane object: the eye's elevation above the sample, degrees (90:
+    /// looking straight down, normal incidence; 5: grazing).
+    pub elevation_deg: f64,
 }
+
+/// The range of [`EnvView::elevation_deg`]: from grazing (the sample is a
+/// sliver at the horizon below 2°) to straight down.
+pub const ELEVATION_RANGE: (f64, f64) = (2.0, 90.0);
 
 /// Largest accepted target sample count.
 pub const MAX_TARGET_SPP: u32 = 1 << 16;
@@ -157,6 +168,7 @@ impl Default for EnvView {
             rotation_deg: 0.0,
             map: None,
             target_spp: 1024,
+            elevation_deg: 30.0,
         }
     }
 }
@@ -189,6 +201,13 @@ impl Lighting {
             0.0
         };
         self.env.target_spp = self.env.target_spp.clamp(1, MAX_TARGET_SPP);
+        self.env.elevation_deg = if self.env.elevation_deg.is_finite() {
+            self.env
+                .elevation_deg
+                .clamp(ELEVATION_RANGE.0, ELEVATION_RANGE.1)
+        } else {
+            EnvView::default().elevation_deg
+        };
         if self.env.map.as_deref().is_some_and(|m| m.trim().is_empty()) {
             self.env.map = None;
         }

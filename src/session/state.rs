@@ -320,6 +320,10 @@ pub struct PlotSettings {
     /// primary BRDF's slopes (F = 1; single and all bounces) instead of
     /// the BRDF itself (issue 29).
     pub gonio_surface: bool,
+    /// The polar view as small multiples (LECTURE.md N5): each drawn BRDF
+    /// in its own panel, on its own scale, instead of all of them overlaid
+    /// on the largest one's.
+    pub small_multiples: bool,
 }
 
 /// The albedo view's options: saved with the scene, so that a deck's slide
@@ -349,6 +353,7 @@ impl Default for PlotSettings {
             microsurface: MicrosurfaceSettings::default(),
             gonio: false,
             gonio_surface: false,
+            small_multiples: false,
         }
     }
 }

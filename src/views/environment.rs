@@ -19,7 +19,7 @@ use super::lit_sphere::{arrangement_control, exposure_control, tone_control};
 use super::{Scene, View};
 use crate::gpu::{EnvRenderer, EnvSettings, EnvironmentMap};
 use crate::session::command::Command;
-use crate::session::lighting::{EnvObject, EnvView, MAX_TARGET_SPP};
+use crate::session::lighting::{ELEVATION_RANGE, EnvObject, EnvView, MAX_TARGET_SPP};
 use crate::session::platform::Instant;
 use crate::widgets::files::{Files, Filter};
 use bv_core::ModelSpec;
@@ -261,6 +261,7 @@ impl EnvironmentView {
             exposure_ev: env.exposure_ev,
             tone_map: gpu_image::tone_map(env.tone_map),
             background_fov_deg: BACKGROUND_FOV_DEG,
+            elevation: env.elevation_deg.to_radians(),
         }
     }
 
@@ -596,6 +597,25 @@ impl View for EnvironmentView {
             .widget_info(|| {
                 egui::WidgetInfo::labeled(egui::Role::ComboBox, true, "environment object")
             });
+        if env.object == EnvObject::Plane {
+            let label = ui.label("eye");
+            ui.add(
+                egui::DragValue::new(&mut next.elevation_deg)
+                    .speed(0.5)
+                    .range(ELEVATION_RANGE.0..=ELEVATION_RANGE.1)
+                    .suffix("°")
+                    .fixed_decimals(0)
+                    .update_while_editing(false),
+            )
+            .labelled_by(label.id)
+            .on_hover_text(
+                "The eye's elevation above the plane: 90° looks straight down \
+                 (normal incidence), a few degrees is grazing",
+            )
+            .widget_info(|| {
+                egui::WidgetInfo::labeled(egui::Role::SpinButton, true, "eye elevation")
+            });
+        }
         let label = ui.label("rot");
         let r = ui
             .add(
@@ -834,7 +854,14 @@ impl View for EnvironmentView {
                 &painter,
                 rect.right_top() + Vec2::new(-6.0, 6.0),
                 Align2::RIGHT_TOP,
-                &format!("{map_name} · rot {:.0}°", env.rotation_deg),
+                &if env.object == EnvObject::Plane {
+                    format!(
+                        "{map_name} · rot {:.0}° · eye {:.0}° above the plane",
+                        env.rotation_deg, env.elevation_deg
+                    )
+                } else {
+                    format!("{map_name} · rot {:.0}°", env.rotation_deg)
+                },
                 text,
             );
         }
@@ -842,13 +869,23 @@ impl View for EnvironmentView {
         for (k, d) in drawables.iter().enumerate() {
             let (c, r) = circle(k);
             let [cr, cg, cb] = d.brdf.rgb;
+            // The plane's square, framed in the BRDF's colour: at a grazing
+            // eye its sky merges with the background.
+            if env.object == EnvObject::Plane {
+                painter.rect_stroke(
+                    egui::Rect::from_center_size(c, egui::vec2(2.0 * r, 2.0 * r)),
+                    0.0,
+                    egui::Stroke::new(2.0, Color32::from_rgb(cr, cg, cb)),
+                    egui::StrokeKind::Outside,
+                );
+            }
             gpu_image::plate_text_within(
                 &painter,
                 egui::pos2(c.x, (c.y + r + 3.0).min(rect.max.y - 18.0)),
                 Align2::CENTER_TOP,
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),
-                Some(rect.width() / drawables.len().max(1) as f32),
+                Some(gpu_image::sphere_tile_width(rect, drawables.len())),
             );
         }
         gpu_image::errors_and_empty(

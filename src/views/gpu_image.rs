@@ -473,17 +473,26 @@ pub fn pixel_size(rect: egui::Rect, pixels_per_point: f32) -> (u32, u32) {
 }
 
 /// Centre and radius (points) of sphere `tile` of `tiles` in `rect` (the
-/// geometry of `gpu::sphere`, for overlays and hit tests).
+/// geometry of `gpu::sphere`, its [`Grid`](crate::gpu::sphere::Grid), for
+/// overlays and hit tests).
 pub fn sphere_circle(rect: egui::Rect, tiles: usize) -> impl Fn(usize) -> (egui::Pos2, f32) {
-    let tiles = tiles.max(1);
-    let tile_w = rect.width() / tiles as f32;
-    let r = 0.5 * crate::gpu::sphere::FILL as f32 * tile_w.min(rect.height());
+    let size = glam::DVec2::new(rect.width().into(), rect.height().into());
+    let grid = crate::gpu::sphere::Grid::new(tiles, size);
     move |tile| {
+        let (c, r) = grid.circle(tile, size);
         (
-            egui::pos2(rect.min.x + (tile as f32 + 0.5) * tile_w, rect.center().y),
-            r,
+            egui::pos2(rect.min.x + c.x as f32, rect.min.y + c.y as f32),
+            r as f32,
         )
     }
+}
+
+/// The width (points) of one sphere's tile in `rect`: the room its label
+/// may take.
+pub fn sphere_tile_width(rect: egui::Rect, tiles: usize) -> f32 {
+    let size = glam::DVec2::new(rect.width().into(), rect.height().into());
+    let grid = crate::gpu::sphere::Grid::new(tiles, size);
+    grid.tile_size(size).x as f32
 }
 
 /// What a view of the drawn BRDFs says when none is drawn.
@@ -669,5 +678,6 @@ pub fn env_object(o: EnvObject) -> Object {
     match o {
         EnvObject::Sphere => Object::Sphere,
         EnvObject::Torus => Object::Torus,
+        EnvObject::Plane => Object::Plane,
     }
 }

@@ -478,7 +478,7 @@ impl LitSphereView {
                 Align2::CENTER_TOP,
                 &d.brdf.label,
                 Color32::from_rgb(cr, cg, cb),
-                Some(rect.width() / drawables.len().max(1) as f32),
+                Some(gpu_image::sphere_tile_width(rect, drawables.len())),
             );
             // A mirror or smooth glass under a point light is black but for
             // one point: say why rather than show a black disc.
@@ -517,7 +517,8 @@ impl LitSphereView {
             );
         }
         // The hint only where it clears the spheres' labels.
-        let below = rect.max.y - (circle(0).0.y + circle(0).1);
+        let last = circle(drawables.len().saturating_sub(1));
+        let below = rect.max.y - (last.0.y + last.1);
         if below > 44.0 && !scene.figure {
             painter.text(
                 rect.left_bottom() + Vec2::new(6.0, -5.0),

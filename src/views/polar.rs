@@ -202,6 +202,20 @@ impl View for PolarView {
                 ..plots
             }));
         }
+        if scene.brdfs.len() > 1
+            && super::toolbar_toggle(
+                ui,
+                plots.small_multiples,
+                "multiples",
+                "Small multiples: each BRDF in its own panel, on its own scale, \
+                 instead of all overlaid on the largest one's",
+            )
+        {
+            out.push(Command::SetPlots(crate::session::state::PlotSettings {
+                small_multiples: !plots.small_multiples,
+                ..plots
+            }));
+        }
         if plots.gonio
             && super::toolbar_toggle(
                 ui,
@@ -236,6 +250,59 @@ impl View for PolarView {
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        if scene.state.plots.small_multiples && scene.brdfs.len() > 1 {
+            self.small_multiples(ui, scene, out);
+        } else {
+            self.panel(ui, scene, out, None);
+        }
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+
+    fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
+        Some(polar_svg(scene, size, dark))
+    }
+}
+
+impl PolarView {
+    /// Every drawn BRDF in its own panel on its own scale (LECTURE.md N5),
+    /// its name above it in its colour.
+    fn small_multiples(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
+        let area = ui.available_rect_before_wrap();
+        let title_h = if scene.presenting { 34.0 } else { 22.0 };
+        let [cols, rows] = multiples_grid(
+            scene.brdfs.len(),
+            [area.width(), area.height()],
+            title_h,
+            transmits,
+        );
+        let cell = egui::vec2(area.width() / cols as f32, area.height() / rows as f32);
+        let size = if scene.presenting { 18.0 } else { 14.0 };
+        for (k, b) in scene.brdfs.iter().enumerate() {
+            let min = area.min + egui::vec2((k % cols) as f32 * cell.x, (k / cols) as f32 * cell.y);
+            let rect = egui::Rect::from_min_size(min, cell).shrink(4.0);
+            let sub = scene.only(b.id);
+            ui.scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+                ui.set_clip_rect(rect.intersect(ui.clip_rect()));
+                ui.label(RichText::new(&b.label).color(b.color()).size(size).strong());
+                self.panel(ui, &sub, out, Some(k));
+            });
+        }
+        ui.allocate_rect(area, egui::Sense::hover());
+    }
+
+    /// One polar plot of `scene`'s BRDFs; `cell`: the panel's index among
+    /// small multiples (no legend, no readout: the panel's title names it).
+    fn panel(
+        &mut self,
+        ui: &mut Ui,
+        scene: &Scene<'_>,
+        out: &mut Vec<Command>,
+        cell: Option<usize>,
+    ) {
         let dark = ui.visuals().dark_mode;
         let d = scene.state.display;
         let (theta_i, phi_i) = (
@@ -294,13 +361,14 @@ impl View for PolarView {
         // Room for the readout line, and for the swap line once a direction
         // has been hovered (before that it would be an empty band).
         // Presenting, no hover readout (nor its hint) below the plot.
-        let readout_h = if scene.figure || (scene.presenting && self.pinned.is_none()) {
-            0.0
-        } else if self.pinned.is_some() {
-            46.0
-        } else {
-            22.0
-        };
+        let readout_h =
+            if cell.is_some() || scene.figure || (scene.presenting && self.pinned.is_none()) {
+                0.0
+            } else if self.pinned.is_some() {
+                46.0
+            } else {
+                22.0
+            };
         let size = ui.available_size() - egui::vec2(0.0, readout_h);
         let value_name = super::value_label(d.cosine);
         let log = d.log;
@@ -308,7 +376,7 @@ impl View for PolarView {
         // Presenting, the legend is a column beside the plot: in the corner
         // it covered the ωr label and a δ spike's weight once the circle
         // filled the slide's height.
-        let legend: Vec<super::chart::Series> = if scene.presenting {
+        let legend: Vec<super::chart::Series> = if scene.presenting && cell.is_none() {
             let entry =
                 |label: &str, color: Color32, width: f32, dash: Option<f32>| super::chart::Series {
                     label: label.to_string(),
@@ -348,8 +416,14 @@ impl View for PolarView {
             Vec::new()
         };
         let legend_w = super::side_legend_room(ui, &legend, size.x);
-        let plot = Plot::new(super::view_id(crate::session::views::POLAR.id));
-        let plot = if scene.presenting {
+        let plot = Plot::new(super::view_id(crate::session::views::POLAR.id).with(cell));
+        // A small panel keeps room for the ring values under the surface.
+        let plot = if cell.is_some() {
+            plot.include_y(-0.14 * outer)
+        } else {
+            plot
+        };
+        let plot = if scene.presenting || cell.is_some() {
             plot
         } else {
             super::with_legend(plot, size, scene.brdfs.len(), Corner::RightTop)
@@ -383,7 +457,7 @@ impl View for PolarView {
         let draw = |pui: &mut egui_plot::PlotUi<'_>| {
             // Rings with the value they stand for, and spokes every 15°.
             // On the log scale the rings stand at round values of f.
-            for (r, _) in rings(outer, log) {
+            for (j, (r, _)) in rings(outer, log).into_iter().enumerate() {
                 let n = 4 * span as usize;
                 let pts: Vec<[f64; 2]> = (0..=n)
                     .map(|j| {
@@ -398,7 +472,12 @@ impl View for PolarView {
                         .width(scene.stroke(1.0))
                         .allow_hover(false),
                 );
-                // Ring values read along the surface line, like a radial axis.
+                // Ring values read along the surface line, like a radial axis;
+                // a small panel labels every other ring, which keeps its
+                // scale and leaves the labels room.
+                if cell.is_some() && j % 2 == 0 {
+                    continue;
+                }
                 let label = curves::fmt_tick(value_at(r, log));
                 pui.text(
                     Text::new(
@@ -566,7 +645,7 @@ impl View for PolarView {
                         .radius(scene.stroke(3.5)),
                     );
                 }
-                if !scene.presenting {
+                if !scene.presenting || cell.is_some() {
                     pui.text(
                         Text::new(
                             "",
@@ -592,7 +671,7 @@ impl View for PolarView {
                 pui.text(
                     Text::new(
                         "",
-                        PlotPoint::new(s.tip[0] * 1.08, s.tip[1] * 1.08),
+                        PlotPoint::new(s.label_at(outer)[0], s.label_at(outer)[1]),
                         RichText::new(s.text()).size(11.0),
                     )
                     .color(s.color)
@@ -609,6 +688,7 @@ impl View for PolarView {
         // No readout where a presenter's pointer happens to rest.
         if response.response.hovered()
             && !scene.presenting
+            && cell.is_none()
             && let Some(p) = response.inner
         {
             let a = p.x.atan2(p.y);
@@ -636,7 +716,7 @@ impl View for PolarView {
                 });
             }
         }
-        if !scene.figure {
+        if !scene.figure && cell.is_none() {
             if !scene.presenting {
                 readout_ui(ui, self.readout.as_ref(), d.cosine);
             }
@@ -655,13 +735,47 @@ impl View for PolarView {
             }
         }
     }
+}
 
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
+/// Columns and rows of small multiples in an area of `size` (points) with a
+/// title of `title_h` above each panel: the layout whose plots are largest
+/// (a polar plot is 2.6 outer radii wide and 1.45 high, 2.6 high when it
+/// shows transmission); on a tie, the fewest empty panels.
+fn multiples_grid(n: usize, size: [f32; 2], title_h: f32, transmits: bool) -> [usize; 2] {
+    let n = n.max(1);
+    let aspect = if transmits { 1.0 } else { 1.45 / 2.6 };
+    let scale = |cols: usize| {
+        let rows = n.div_ceil(cols);
+        let (w, h) = (size[0] / cols as f32, size[1] / rows as f32 - title_h);
+        w.min(h / aspect)
+    };
+    let mut best = n;
+    for cols in (1..n).rev() {
+        let (r, rb) = (scale(cols), scale(best));
+        let empty = |c: usize| c * n.div_ceil(c) - n;
+        if r > rb * 1.0001 || ((r - rb).abs() <= rb * 1e-4 && empty(cols) < empty(best)) {
+            best = cols;
+        }
     }
+    [best, n.div_ceil(best)]
+}
 
-    fn svg(&mut self, scene: &Scene<'_>, size: [f32; 2], dark: bool) -> Option<String> {
-        Some(polar_svg(scene, size, dark))
+/// The panels the polar view draws and the value of each one's outer ring
+/// (1/sr, of the quantity drawn): one panel of every BRDF on one scale, or,
+/// as small multiples, one panel per BRDF (its id) on its own.
+pub fn panel_scales(scene: &Scene<'_>) -> Vec<(Vec<u64>, f64)> {
+    let log = scene.state.display.log;
+    if scene.state.plots.small_multiples && scene.brdfs.len() > 1 {
+        scene
+            .brdfs
+            .iter()
+            .map(|b| (vec![b.id], value_at(polar_curves(&scene.only(b.id)).1, log)))
+            .collect()
+    } else {
+        vec![(
+            scene.brdfs.iter().map(|b| b.id).collect(),
+            value_at(polar_curves(scene).1, log),
+        )]
     }
 }
 
@@ -931,6 +1045,27 @@ pub struct Spike {
 }
 
 impl Spike {
+    /// Where its label goes (plot units), `outer` the outer ring's radius:
+    /// past the tip of a short spike; beside a long one, two thirds of the
+    /// way out and to its horizon side, since past its tip it would sit on
+    /// the ωr or ωt label at the end of the same direction.
+    pub fn label_at(&self, outer: f64) -> [f64; 2] {
+        let [x, y] = self.tip;
+        let len = x.hypot(y);
+        if len < 0.6 * outer || len == 0.0 {
+            return [x * 1.08, y * 1.08];
+        }
+        // The unit normal to the spike pointing away from the surface
+        // normal (+y), towards the horizon.
+        let (ux, uy) = (x / len, y / len);
+        let (mut px, mut py) = (uy, -ux);
+        if px * x < 0.0 {
+            (px, py) = (-px, -py);
+        }
+        let off = 0.1 * outer;
+        [0.62 * x + off * px, 0.62 * y + off * py]
+    }
+
     /// The legend entry: `glass δ reflected` or `glass δ transmitted`.
     pub fn legend(&self) -> String {
         let kind = if self.radiance.is_some() {
@@ -1105,15 +1240,66 @@ fn rings(outer: f64, log: bool) -> Vec<(f64, f64)> {
 
 /// The polar plot as SVG: the same rings, spokes, markers and curves.
 pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
-    use super::chart::{Palette, Series, legend};
     use super::svg::{Anchor, Baseline, Svg};
+    let [w, h] = [size[0].max(120.0), size[1].max(90.0)];
+    let mut svg = Svg::new(w, h);
+    if !(scene.state.plots.small_multiples && scene.brdfs.len() > 1) {
+        polar_svg_panel(&mut svg, scene, [w, h], dark, false);
+        return svg.finish();
+    }
+    // Small multiples: a panel per BRDF, its name above it.
+    let pal = super::chart::Palette::new(dark, scene.transparent);
+    if let Some(bg) = pal.background {
+        svg.rect([0.0, 0.0], [w, h], Some(bg), None);
+    }
+    let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
+    let title_h = 20.0;
+    let [cols, rows] = multiples_grid(scene.brdfs.len(), [w, h], title_h, transmits);
+    let cell = [w / cols as f32, h / rows as f32];
+    for (k, b) in scene.brdfs.iter().enumerate() {
+        let at = [(k % cols) as f32 * cell[0], (k / cols) as f32 * cell[1]];
+        svg.begin_translate(at);
+        svg.text(
+            [8.0, 4.0],
+            &b.label,
+            14.0,
+            b.color(),
+            Anchor::Start,
+            Baseline::Top,
+            None,
+        );
+        svg.begin_translate([0.0, title_h]);
+        polar_svg_panel(
+            &mut svg,
+            &scene.only(b.id),
+            [cell[0], cell[1] - title_h],
+            dark,
+            true,
+        );
+        svg.end_group();
+        svg.end_group();
+    }
+    svg.finish()
+}
+
+/// One polar plot of `scene`'s BRDFs drawn into `svg` over `[0, size]`;
+/// `titled`: a panel of small multiples, whose title names its BRDF (its
+/// curve then has no legend entry).
+fn polar_svg_panel(
+    svg: &mut super::svg::Svg,
+    scene: &Scene<'_>,
+    size: [f32; 2],
+    dark: bool,
+    titled: bool,
+) {
+    use super::chart::{Palette, Series, legend};
+    use super::svg::{Anchor, Baseline};
     let d = scene.state.display;
     let pal = Palette::new(dark, scene.transparent);
     let (curves, outer) = polar_curves(scene);
     let transmits = scene.brdfs.iter().any(|b| b.brdf.transmits());
     let theta_i = scene.incident.theta_deg.to_radians();
     let [w, h] = [size[0].max(120.0), size[1].max(90.0)];
-    let mut svg = Svg::new(w, h);
     if let Some(bg) = pal.background {
         svg.rect([0.0, 0.0], [w, h], Some(bg), None);
     }
@@ -1307,7 +1493,7 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
     for s in delta_spikes(scene, outer) {
         svg.line(at([0.0, 0.0]), at(s.tip), s.color, 2.0, None);
         svg.text(
-            at([s.tip[0] * 1.08, s.tip[1] * 1.08]),
+            at(s.label_at(outer)),
             &s.text(),
             10.5,
             s.color,
@@ -1329,13 +1515,27 @@ pub fn polar_svg(scene: &Scene<'_>, size: [f32; 2], dark: bool) -> String {
         Baseline::Bottom,
         None,
     );
-    legend(&mut svg, &series, [w - 4.0, 4.0], pal);
-    svg.finish()
+    if titled {
+        series.retain(|e| !scene.brdfs.iter().any(|b| b.label == e.label));
+    }
+    legend(svg, &series, [w - 4.0, 4.0], pal);
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_multiples_fill_the_area() {
+        // Four reflection plots on a slide: 2 × 2; on a wide strip: a row.
+        assert_eq!(multiples_grid(4, [1800.0, 800.0], 30.0, false), [2, 2]);
+        assert_eq!(multiples_grid(4, [3000.0, 300.0], 20.0, false), [4, 1]);
+        // Transmission doubles a plot's height: three side by side.
+        assert_eq!(multiples_grid(3, [1800.0, 600.0], 30.0, true), [3, 1]);
+        // Five: 3 + 2 rather than 4 + 1 or 5.
+        assert_eq!(multiples_grid(5, [1800.0, 900.0], 30.0, false), [3, 2]);
+        assert_eq!(multiples_grid(1, [100.0, 100.0], 10.0, false), [1, 1]);
+    }
 
     #[test]
     fn radius_and_value_are_inverse() {
