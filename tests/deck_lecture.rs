@@ -114,7 +114,7 @@ fn every_scene_names_real_seed_slides_and_the_deck_covers_the_lecture() {
         100.0 * share
     );
     // What the deck covers today; it only grows (the goal is 90 %).
-    assert!(slides.len() >= 75, "{} scenes", slides.len());
+    assert!(slides.len() >= 77, "{} scenes", slides.len());
     assert!(covered.len() >= 53, "{} headings covered", covered.len());
     // In the seed's order: a scene's first heading never comes before the
     // previous scene's first one, by more than a part of the lecture
@@ -354,6 +354,109 @@ fn fresnel_dielectric(cos_i: f64, eta_i: f64, eta_t: f64) -> f64 {
     let rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
     let rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
     0.5 * (rs * rs + rp * rp)
+}
+
+/// LECTURE.md scene 47 (N9): the facet normals' histogram of the
+/// simulated surface lies within 5 % of the model's D wherever D is at
+/// least a tenth of its peak, and the model's D is normalised.
+#[test]
+fn the_facet_normals_follow_d() {
+    use bv::derive::jobs::Waker;
+    use bv::derive::microsurface;
+    let slides = slides();
+    let s = slide(&slides, "D is the distribution of the facets' normals");
+    assert!(s.state.plots.microsurface.ndf);
+    let mut rt = Runtime::default();
+    rt.sync(&s.state);
+    let mut scene = build_scene(&s.state, &rt, false);
+    // As a figure: the simulation is computed before it is drawn.
+    scene.figure = true;
+    let specimen = microsurface::specimen(&scene);
+    assert_eq!(specimen.describe(), "Beckmann α 0.30");
+    let shown = microsurface::request(&Waker::none(), &scene, &specimen);
+    let done = shown.done.expect("a figure computes its simulation");
+    let sim = &done.value;
+    let h = &sim.ndf;
+    // Σ expected (θ bins and the steeper rest) is ∫ D cos θm dω = 1.
+    let total: f64 = h.expected.iter().sum();
+    assert!((total - 1.0).abs() < 1e-9, "{total}");
+    let peak = (0..h.n_theta).map(|t| h.d_values(t).1).fold(0.0, f64::max);
+    let mut checked = 0;
+    for t in 0..h.n_theta {
+        let (measured, model) = h.d_values(t);
+        if model >= 0.1 * peak {
+            checked += 1;
+            assert!(
+                (measured - model).abs() <= 0.05 * model,
+                "bin {t}: measured D {measured}, model {model}"
+            );
+        }
+    }
+    assert!(checked >= 8, "{checked} bins checked");
+}
+
+/// Issue 29: the lobe view's gonio overlay draws the surface's readings at
+/// the detector's directions in the plane of incidence, the one-bounce
+/// readings near the F = 1 model's section, all bounces above them. "Near":
+/// within 4σ + 15 % up to 45° from the normal and 4σ + 30 % beyond, since
+/// Smith's masking assumes heights and normals uncorrelated, which a
+/// generated surface's are not (Heitz 2014, §5): this GGX α 0.6 surface
+/// reads 5–10 % above the model near the normal and up to 28 % at 75°.
+#[test]
+fn the_lobe_overlay_sets_the_surface_against_the_f1_lobe() {
+    use bv::derive::jobs::Waker;
+    use bv::views::gonio_overlay::readings_3d;
+    let slides = slides();
+    let s = slide(&slides, "The lost energy, around the whole lobe");
+    let mut rt = Runtime::default();
+    rt.sync(&s.state);
+    let mut scene = build_scene(&s.state, &rt, false);
+    scene.figure = true;
+    let overlay = readings_3d(&scene, &Waker::none()).expect("a figure measures now");
+    assert_eq!(overlay.sets.len(), 2);
+    let (all, one) = (&overlay.sets[0], &overlay.sets[1]);
+    assert!(all.filled && !one.filled);
+    let reference = overlay.reference.as_ref().expect("the F = 1 lobe");
+    let b = scene.primary().unwrap();
+    let furnace = b.brdf.furnace().unwrap();
+    let wi = scene.wi();
+    let mut checked = 0;
+    for (a, o) in all.stops.iter().zip(&one.stops) {
+        for &(dir, v, lo, hi) in [a, o] {
+            // In the plane of incidence (φi = 0: the x–z plane).
+            assert!(
+                dir.y.abs() < 1e-9 && (dir.length() - 1.0).abs() < 1e-9,
+                "{dir}"
+            );
+            assert!(lo <= v && v <= hi, "{lo} {v} {hi}");
+        }
+        let (dir, v, lo, hi) = *o;
+        assert_eq!(dir, a.0);
+        let sigma = (hi - lo) / 4.0;
+        let sigma_all = (a.3 - a.2) / 4.0;
+        // All the light is at least the light of one bounce.
+        assert!(a.1 >= v - 3.0 * (sigma + sigma_all), "{} < {v}", a.1);
+        if dir.z > 0.25 {
+            checked += 1;
+            let model = mean_rgb(furnace.eval(wi, dir));
+            let share = if dir.z >= 45f64.to_radians().cos() {
+                0.15
+            } else {
+                0.30
+            };
+            assert!(
+                (model - v).abs() <= 4.0 * sigma + share * model,
+                "at {dir}: one bounce {v} ± {sigma}, the model {model}"
+            );
+        }
+    }
+    assert!(checked >= 25, "{checked} stops checked");
+    // The dashed section is the F = 1 model's own values.
+    for &(dir, v) in reference.iter().step_by(17) {
+        if dir.z > 0.0 {
+            assert!((mean_rgb(furnace.eval(wi, dir)) - v).abs() < 1e-9);
+        }
+    }
 }
 
 /// LECTURE.md scene 03 with N5: the four classes as small multiples, each

@@ -7,7 +7,7 @@
 use super::jobs::{self, Shown, Slots, Steps, Waker};
 use crate::session::frame::Scene;
 use crate::session::state::MicrosurfaceSettings;
-use bv_core::microsurface::measure::{self, G1Point, Gonio, GonioJob, GonioOptions};
+use bv_core::microsurface::measure::{self, G1Point, Gonio, GonioJob, GonioOptions, NdfHistogram};
 use bv_core::microsurface::trace::{Walk, walk};
 use bv_core::microsurface::{SimFresnel, SlopeDistribution, Surface, SurfaceOptions};
 use glam::DVec3;
@@ -109,7 +109,19 @@ pub struct Simulation {
     /// ρhd of the single-scattering Cook–Torrance model with the same D,
     /// height-correlated Smith G and F = 1 (bin quadrature).
     pub analytic_rho: f64,
+    /// The facet normals' histogram against D: [`NDF_BINS`] bins in θm,
+    /// all azimuths together, of a [`NDF_SIZE`]² surface with the same
+    /// statistics.
+    pub ndf: NdfHistogram,
 }
+
+/// θm bins of [`Simulation::ndf`].
+pub const NDF_BINS: usize = 16;
+
+/// Grid side of the surface whose normals [`Simulation::ndf`] counts: the
+/// drawn 128² patch holds about (128/4)² independent slopes, and its
+/// histogram strays 5–8 % from D at the peak; 512² holds 16 times more.
+pub const NDF_SIZE: usize = 512;
 
 /// The simulations of the process (one slot).
 pub fn slots() -> Arc<Slots<Key, Arc<Simulation>>> {
@@ -118,7 +130,12 @@ pub fn slots() -> Arc<Slots<Key, Arc<Simulation>>> {
 
 enum Phase {
     Start,
-    Rays(Arc<Surface>, Vec<(Vec<DVec3>, DVec3)>, Box<GonioJob>),
+    Rays(
+        Arc<Surface>,
+        Vec<(Vec<DVec3>, DVec3)>,
+        Box<GonioJob>,
+        Box<NdfHistogram>,
+    ),
     Done,
 }
 
@@ -142,12 +159,18 @@ impl Steps<Arc<Simulation>> for Job {
                 let mut g = GonioOptions::new(theta, RAYS, 1);
                 g.phi_i = self.wi.y.atan2(self.wi.x);
                 let job = GonioJob::new(Arc::clone(&surface), g).ok()?;
-                self.phase = Phase::Rays(surface, paths, Box::new(job));
+                let big = Surface::generate(&SurfaceOptions {
+                    size: NDF_SIZE,
+                    ..self.opts
+                })
+                .ok()?;
+                let ndf = measure::ndf_histogram(&big, NDF_BINS, 1);
+                self.phase = Phase::Rays(surface, paths, Box::new(job), Box::new(ndf));
                 None
             }
-            Phase::Rays(surface, paths, mut job) => {
+            Phase::Rays(surface, paths, mut job, ndf) => {
                 let Some(gonio) = job.step(4) else {
-                    self.phase = Phase::Rays(surface, paths, job);
+                    self.phase = Phase::Rays(surface, paths, job, ndf);
                     return None;
                 };
                 let o = gonio.opts;
@@ -164,6 +187,7 @@ impl Steps<Arc<Simulation>> for Job {
                     gonio,
                     g1,
                     analytic_rho,
+                    ndf: *ndf,
                 }))
             }
             Phase::Done => None,
@@ -172,7 +196,7 @@ impl Steps<Arc<Simulation>> for Job {
 
     fn progress(&self) -> Option<(usize, usize)> {
         match &self.phase {
-            Phase::Rays(_, _, job) => Some(job.progress()),
+            Phase::Rays(_, _, job, _) => Some(job.progress()),
             _ => None,
         }
     }

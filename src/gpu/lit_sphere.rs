@@ -405,4 +405,3 @@ pub fn reference_image(
     }
     Ok(img)
 }
-

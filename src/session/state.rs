@@ -371,6 +371,9 @@ pub struct MicrosurfaceSettings {
     pub distribution: SlopeDistribution,
     /// Its roughness α when not taken from the model.
     pub alpha: f64,
+    /// Under the surface, the facet normals' histogram against the model's
+    /// D(θm) (LECTURE.md N9: a rough surface and its NDF).
+    pub ndf: bool,
 }
 
 impl Default for MicrosurfaceSettings {
@@ -379,6 +382,7 @@ impl Default for MicrosurfaceSettings {
             from_model: true,
             distribution: SlopeDistribution::Beckmann,
             alpha: 0.5,
+            ndf: false,
         }
     }
 }

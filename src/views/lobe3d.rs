@@ -662,6 +662,7 @@ impl View for Lobe3dView {
             scene,
             crate::derive::factor::request(&super::waker(ui.ctx()), scene).as_ref(),
         );
+        super::gonio_overlay::control(ui, scene, out);
         if super::toolbar_toggle(
             ui,
             d.auto_scale,
@@ -846,6 +847,7 @@ impl Lobe3dView {
 
         let d = scene.state.display;
         let small = FontId::proportional(12.5);
+        self.gonio_overlay(ui, &painter, &at, scene, dark);
         // Colour bar of the primary lobe.
         if let Some(p) = scene.primary()
             && d.color_by_value
@@ -952,6 +954,90 @@ impl Lobe3dView {
 }
 
 /// Text with a thin outline in the background colour, readable over the lobe.
+impl Lobe3dView {
+    /// The gonioreflectometer's readings (`plots.gonio`) as dots with 2σ
+    /// bars at their detector directions, on the lobes' radius scale: the
+    /// same measurement the polar view draws, here against the whole lobe.
+    fn gonio_overlay(
+        &self,
+        ui: &Ui,
+        painter: &egui::Painter,
+        at: &dyn Fn(Vec3) -> Option<Pos2>,
+        scene: &Scene<'_>,
+        dark: bool,
+    ) {
+        if !scene.state.plots.gonio {
+            return;
+        }
+        let Some(overlay) = super::gonio_overlay::readings_3d(scene, &super::waker(ui.ctx()))
+        else {
+            return;
+        };
+        let sets = &overlay.sets;
+        let scale = f64::from(self.last_scale);
+        let radius = if scene.state.display.log {
+            RadiusScale::Log
+        } else {
+            RadiusScale::Linear
+        };
+        let ink = super::strong_text_color(dark);
+        let halo = if dark {
+            Color32::from_black_alpha(200)
+        } else {
+            Color32::from_white_alpha(220)
+        };
+        let point = |dir: glam::DVec3, v: f64| at((dir * radius.apply(v) * scale).as_vec3());
+        // The one-bounce model (F = 1) the surface's hollow dots follow,
+        // dashed in the primary BRDF's colour.
+        if let Some(curve) = &overlay.reference {
+            let color = scene.primary().map_or(ink, |b| b.color());
+            let pts: Vec<Pos2> = curve.iter().filter_map(|&(dir, v)| point(dir, v)).collect();
+            for w in [4.0, 2.0] {
+                let c = if w > 3.0 { halo } else { color };
+                painter.extend(egui::Shape::dashed_line(&pts, Stroke::new(w, c), 8.0, 5.0));
+            }
+        }
+        for set in sets {
+            for &(dir, v, lo, hi) in &set.stops {
+                if let (Some(a), Some(b)) = (point(dir, lo), point(dir, hi)) {
+                    painter.line_segment([a, b], Stroke::new(3.5, halo));
+                    painter.line_segment([a, b], Stroke::new(1.5, ink));
+                }
+                if let Some(c) = point(dir, v) {
+                    if set.filled {
+                        painter.circle(c, 3.5, ink, Stroke::new(1.5, halo));
+                    } else {
+                        painter.circle(c, 3.5, halo, Stroke::new(1.5, ink));
+                    }
+                }
+            }
+        }
+        // One line per entry: in one line it ran wider than the view.
+        let lines: Vec<String> = sets
+            .iter()
+            .map(|s| format!("{} {}, 2σ bars", if s.filled { "●" } else { "○" }, s.label))
+            .chain(
+                overlay
+                    .reference
+                    .as_ref()
+                    .map(|_| "- - the model with F = 1".to_string()),
+            )
+            .collect();
+        let rect = painter.clip_rect();
+        // Top right: the light's label may be top left, the grid radius
+        // is bottom left and the colour bar right of the middle.
+        outlined_text(
+            painter,
+            rect.right_top() + Vec2::new(-8.0, 8.0),
+            Align2::RIGHT_TOP,
+            &lines.join("\n"),
+            FontId::proportional(13.0),
+            ink,
+            dark,
+        );
+    }
+}
+
 /// The text is moved inside the painter's clip rectangle if it would stick out,
 /// so a label is never cut in a narrow view.
 fn outlined_text(

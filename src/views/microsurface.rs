@@ -14,6 +14,10 @@
 //! drawing
 //! sorts triangles back to front; the rays are drawn over the surface
 //! (a ray behind a ridge is still shown).
+//!
+//! With *NDF* on, a chart under it compares the facet normals' histogram
+//! (the measured D averaged over each θm bin, dashed) with the model's
+//! D(θm) (LECTURE.md N9: a rough surface and its NDF).
 
 use super::{Scene, View};
 use crate::derive::microsurface::{self, Simulation, Specimen};
@@ -88,6 +92,15 @@ impl View for MicrosurfaceView {
             let range = microsurface::ALPHA_RANGE;
             ui.add(egui::Slider::new(&mut set.alpha, range).text("α"));
         }
+        if super::toolbar_toggle(
+            ui,
+            set.ndf,
+            "NDF",
+            "Under the surface, the histogram of its facet normals (measured D \
+             averaged over each θm bin) against the model's D(θm)",
+        ) {
+            set.ndf = !set.ndf;
+        }
         if set != before {
             out.push(Command::SetPlots(PlotSettings {
                 microsurface: set,
@@ -97,8 +110,16 @@ impl View for MicrosurfaceView {
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
-        let rect = ui.available_rect_before_wrap();
-        ui.allocate_rect(rect, Sense::hover());
+        let full = ui.available_rect_before_wrap();
+        ui.allocate_rect(full, Sense::hover());
+        // With the NDF chart, the surface takes the left half and the chart
+        // the right.
+        let show_ndf = scene.state.plots.microsurface.ndf;
+        let rect = if show_ndf {
+            Rect::from_min_max(full.min, Pos2::new(full.center().x, full.max.y))
+        } else {
+            full
+        };
         let painter = ui.painter_at(rect);
         let specimen = microsurface::specimen(scene);
         let shown = microsurface::request(&super::waker(ui.ctx()), scene, &specimen);
@@ -116,6 +137,21 @@ impl View for MicrosurfaceView {
             return;
         };
         let sim = &done.value;
+        if show_ndf {
+            let chart_rect = Rect::from_min_max(Pos2::new(rect.max.x + 8.0, full.min.y), full.max);
+            let dark = ui.visuals().dark_mode;
+            let chart = ndf_chart(sim, &specimen, dark);
+            let id = super::view_id(crate::session::views::MICROSURFACE.id).with("ndf");
+            ui.scope_builder(egui::UiBuilder::new().max_rect(chart_rect), |ui| {
+                // Presenting, the legend is a column beside the chart.
+                let legend_w = if scene.presenting {
+                    super::side_legend_width(ui, &chart.series).min(0.4 * chart_rect.width())
+                } else {
+                    0.0
+                };
+                super::terms::plot_chart(ui, id, &chart, chart_rect.size(), false, scene, legend_w);
+            });
+        }
         let mut lines = summary(sim, &specimen);
         if let Some((a, b)) = shown.progress.filter(|_| shown.busy) {
             lines.push(format!("simulating: {a}/{b} batches"));
@@ -218,6 +254,78 @@ fn summary(sim: &Simulation, specimen: &Specimen) -> Vec<String> {
             100.0 * g.rho_multiple
         ),
     ]
+}
+
+/// The facet normals against the model: the measured D averaged over each
+/// θm bin (`Simulation::ndf`, joined at the bins' centres) and the model's
+/// D(θm) averaged over azimuth, in 1/sr.
+pub fn ndf_chart(sim: &Simulation, specimen: &Specimen, dark: bool) -> super::chart::Chart {
+    use super::chart::{self, Chart, Series};
+    let h = &sim.ndf;
+    let dt = h.theta_max / h.n_theta as f64;
+    // Each bin's mean D at its centre.
+    let stairs: Vec<[f64; 2]> = (0..h.n_theta)
+        .map(|t| {
+            let (d, _) = h.d_values(t * h.n_phi);
+            [((t as f64 + 0.5) * dt).to_degrees(), d]
+        })
+        .collect();
+    let mf = sim.surface.microfacet();
+    let model: Vec<[f64; 2]> = (0..=200)
+        .map(|k| {
+            let th = h.theta_max * k as f64 / 200.0;
+            let d = (0..32)
+                .map(|j| {
+                    let ph = std::f64::consts::TAU * (j as f64 + 0.5) / 32.0;
+                    mf.d(bv_core::microsurface::measure::direction(th, ph))
+                })
+                .sum::<f64>()
+                / 32.0;
+            [th.to_degrees(), d]
+        })
+        .collect();
+    let top = stairs
+        .iter()
+        .chain(&model)
+        .map(|p| p[1])
+        .fold(0.0, f64::max)
+        * 1.08;
+    let x_max = h.theta_max.to_degrees();
+    let measured = super::strong_text_color(dark);
+    let blue = Color32::from_rgb(78, 151, 234);
+    Chart {
+        title: String::new(),
+        x_label: "θm (facet normal from the surface normal)".into(),
+        y_label: "D (1/sr)".into(),
+        x_range: (0.0, x_max),
+        y_range: (0.0, top),
+        x_ticks: chart::angle_ticks(0.0, x_max),
+        y_ticks: chart::labelled(chart::nice_ticks(0.0, top, 5)),
+        bands: Vec::new(),
+        series: vec![
+            Series {
+                label: format!("{} D(θm)", specimen.distribution.label()),
+                color: blue,
+                points: model,
+                width: 2.5,
+                dash: None,
+            },
+            Series {
+                label: format!(
+                    "facet normals of a {}² surface like it (bins of {:.1}°)",
+                    microsurface::NDF_SIZE,
+                    dt.to_degrees()
+                ),
+                color: measured,
+                points: stairs,
+                width: 2.0,
+                dash: Some(6.0),
+            },
+        ],
+        vlines: Vec::new(),
+        hlines: Vec::new(),
+        note: String::new(),
+    }
 }
 
 /// The patch, shaded by the light, and the ray paths.

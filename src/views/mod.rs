@@ -20,6 +20,7 @@ pub mod factor;
 pub mod factor_overlay;
 pub mod fonts;
 pub mod fresnel;
+pub mod gonio_overlay;
 pub mod gpu_image;
 pub mod hemi;
 pub mod image_slice;

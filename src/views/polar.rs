@@ -189,19 +189,6 @@ impl View for PolarView {
             crate::derive::factor::request(&super::waker(ui.ctx()), scene).as_ref(),
         );
         let plots = scene.state.plots;
-        if super::toolbar_toggle(
-            ui,
-            plots.gonio,
-            "gonio",
-            "Virtual gonioreflectometer: photons from the selected BRDF's own sampler, \
-             counted by a detector (1.5° aperture) stopping every 5° in the plane of \
-             incidence; dots with 2σ error bars over the curve",
-        ) {
-            out.push(Command::SetPlots(crate::session::state::PlotSettings {
-                gonio: !plots.gonio,
-                ..plots
-            }));
-        }
         if scene.brdfs.len() > 1
             && super::toolbar_toggle(
                 ui,
@@ -216,37 +203,7 @@ impl View for PolarView {
                 ..plots
             }));
         }
-        if plots.gonio
-            && super::toolbar_toggle(
-                ui,
-                plots.gonio_surface,
-                "surface",
-                "Measure a simulated microsurface with the selected BRDF's slopes \
-                 (Beckmann or GGX, F = 1) instead of the BRDF: filled dots all bounces, \
-                 hollow dots one bounce, dashed the model's lobe with F = 1",
-            )
-        {
-            out.push(Command::SetPlots(crate::session::state::PlotSettings {
-                gonio_surface: !plots.gonio_surface,
-                ..plots
-            }));
-        }
-        if plots.gonio
-            && plots.gonio_surface
-            && let Some(b) = scene.primary()
-            && crate::derive::gonio::specimen(scene, b.brdf.as_ref()).is_none()
-        {
-            ui.label(format!(
-                "{} names no Beckmann or GGX slopes to simulate",
-                b.label
-            ));
-        }
-        if let Some(shown) = crate::derive::gonio::request(&super::waker(ui.ctx()), scene)
-            && shown.busy
-            && let Some((a, b)) = shown.progress
-        {
-            ui.label(format!("measuring {a}/{b}"));
-        }
+        super::gonio_overlay::control(ui, scene, out);
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {

@@ -288,7 +288,10 @@ fn legend_corner(c: &Chart) -> Corner {
 /// Draws a chart with egui_plot into `size` points; presenting, its legend
 /// is a column `legend_w` wide (of the width) beside it (over a plot that
 /// short it covered the curves).
-fn plot_chart(
+/// Draws chart `c` with egui_plot in `size` (`log_y`: the values are
+/// log10, labelled as decades; `legend_w`: a side legend's width when
+/// presenting). The term charts and the microsurface view's NDF use it.
+pub fn plot_chart(
     ui: &mut Ui,
     id: egui::Id,
     c: &Chart,

@@ -66,6 +66,32 @@ fn the_rough_dielectrics_furnace_is_the_untinted_interface() {
     }
 }
 
+/// The coated model's furnace lobe is its coat's interface alone: the rough
+/// dielectric of the same roughness, distribution and η, untinted.
+#[test]
+fn the_coated_furnace_is_its_coats_interface() {
+    let f = model(
+        "coated",
+        json!({"alpha": 0.4, "distribution": "ggx", "eta": 1.6, "base": "lambert",
+               "base_albedo": [0.8, 0.2, 0.1], "thickness": 1.0, "absorption": 0.5}),
+    )
+    .furnace()
+    .unwrap();
+    let interface = model(
+        "rough-dielectric",
+        json!({"alpha": 0.4, "distribution": "ggx", "eta": 1.6, "geometry": "smith"}),
+    );
+    for k in 0..200 {
+        let wi = frame::from_spherical(3.0 * (k as f64 * 0.618).fract(), k as f64 * 2.4);
+        let wo = frame::from_spherical(3.0 * (k as f64 * 0.377).fract(), k as f64 * 1.3);
+        let (a, b) = (f.eval(wi, wo), interface.eval(wi, wo));
+        assert!(
+            (a - b).abs().max_element() <= 1e-12 * (1.0 + b.max_element()),
+            "{a:?} {b:?}"
+        );
+    }
+}
+
 /// Every model of the catalogue whose lobe the furnace switch shows keeps
 /// at most all of the light, and loses more at high roughness than at low
 /// (single scattering drops the light that would bounce again).
@@ -76,6 +102,7 @@ fn furnace_lobes_keep_at_most_everything_and_lose_more_when_rough() {
         ("cook-torrance", "alpha", 0.1, 0.9),
         ("disney", "roughness", 0.3, 0.95),
         ("rough-dielectric", "alpha", 0.1, 0.9),
+        ("coated", "alpha", 0.1, 0.9),
     ];
     for (id, param, smooth, rough) in cases {
         let e = |a: f64| {

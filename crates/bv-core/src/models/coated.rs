@@ -568,6 +568,15 @@ impl Brdf for Coated {
         Some(self.coat.microfacet())
     }
 
+    /// The coat's interface alone, untinted (the rough dielectric's
+    /// furnace): with no base to return light, what it reflects and
+    /// transmits in one scattering, `ρR + ρT`, is what a single-scattering
+    /// interface keeps; the rest is the energy the coat's microfacet model
+    /// loses before the base is even reached.
+    fn furnace(&self) -> Option<Box<dyn Brdf>> {
+        self.coat.furnace()
+    }
+
     fn fresnel_term(&self) -> Option<FresnelTerm> {
         Some(FresnelTerm {
             fresnel: fresnel::Fresnel::Dielectric {
