@@ -11,8 +11,8 @@
 #import bv::layout as L
 #import bv::dispatch
 #import bv::frame::PI
-#import bv::sampling::pcg
-#import bv::sphere::{sphere_at, tile_at, to_local, to_view, turned, SpherePoint}
+#import bv::sampling::{pcg, rand}
+#import bv::sphere::{sphere_at, tile_at, frame_at, to_local, to_view, turned, SpherePoint}
 #import bv::torus
 
 struct Frame {
@@ -235,6 +235,62 @@ fn delta_radiance(model: u32, o: u32, s: SpherePoint, p: vec3<f32>, v: vec3<f32>
     return sum;
 }
 
+// Most interfaces a path through a transmitting object crosses or reflects
+// off inside it (src/gpu/env.rs, MAX_BOUNCES, which the view shows).
+const MAX_BOUNCES: u32 = 16u;
+
+// Radiance of the light that reaches the object's surface point s (position
+// x: the unit normal on the sphere, the hit on the torus) from inside, along
+// the local direction wi (below the surface), with the weight `thr` of the
+// draw so far: the path is followed from interface to interface (reflected
+// inside, total internal reflection included, or out to the environment),
+// each step drawn by the model's own sampler on the whole sphere, up to
+// MAX_BOUNCES (the rest counts as dark). Issue 33: frosted glass.
+fn through_object(model: u32, o: u32, s: SpherePoint, x: vec3<f32>, wi: vec3<f32>, thr_in: vec3<f32>, seed: u32) -> vec3<f32> {
+    var thr = thr_in;
+    var p = x;
+    var n_in = s.n;
+    var dir = to_view(s, wi);
+    var state = seed;
+    for (var k = 0u; k < MAX_BOUNCES; k++) {
+        var q: vec3<f32>;
+        var fr: SpherePoint;
+        if (view.object == 1u) {
+            let t = torus::trace_inside(p, n_in, dir);
+            if (t < 0.0) {
+                return vec3<f32>(0.0);
+            }
+            q = p + t * dir;
+            fr = torus::frame(q, 0);
+        } else {
+            // The unit sphere from inside: p + t dir with t = −2 p·dir.
+            q = p + (-2.0 * dot(p, dir)) * dir;
+            fr = frame_at(normalize(q), 0);
+        }
+        fr = turned(fr, view.turn);
+        // Towards where the path came from: inside, below this interface.
+        let wo = to_local(fr, -dir);
+        let u = vec3<f32>(rand(&state), rand(&state), rand(&state));
+        let smp = dispatch::sample_sphere(model, o, wo, u);
+        if (smp.wi.z == 0.0) {
+            return vec3<f32>(0.0);
+        }
+        thr *= smp.weight;
+        let d = to_view(fr, smp.wi);
+        if (smp.wi.z > 0.0) {
+            // The light comes from outside: the path leaves the object.
+            if (view.object == 1u) {
+                return thr * torus_radiance(q, fr.n, d);
+            }
+            return thr * envmap::radiance(d);
+        }
+        p = q;
+        n_in = fr.n;
+        dir = d;
+    }
+    return vec3<f32>(0.0);
+}
+
 // A pixel of the plane object (LECTURE.md N13): each tile shows, in the
 // square the sphere would fill, a flat sample of infinite extent under
 // the environment, seen through a pinhole camera (the background's field of
@@ -333,7 +389,24 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
         let h6 = pcg(h5 ^ 0xd3a2646cu);
         let shift_b = vec3<u32>(h0, h1, h2);
         let shift_e = vec4<u32>(h3, h4, h5, h6);
-        for (var k = 0u; k < view.spp; k++) {
+        // A transmitting model: its own draws on the whole sphere, the
+        // light that enters followed through the object (on the plane, into
+        // a dark floor, where it is lost).
+        let through = dispatch::transmits(model);
+        for (var k = 0u; through && k < view.spp; k++) {
+            let n = view.base + k;
+            let smp = dispatch::sample_sphere(model, m.y, wo, r3(shift_b, n));
+            let d = to_view(s, smp.wi);
+            if (smp.wi.z > 0.0) {
+                if (!on_torus || torus::unoccluded(x, s.n, d)) {
+                    sum += smp.weight * envmap::radiance(d);
+                }
+            } else if (smp.wi.z < 0.0 && view.object != 2u) {
+                let at = select(s.n, x, on_torus);
+                sum += through_object(model, m.y, s, at, smp.wi, smp.weight, pcg(pixel * 9781u + n * 6271u + 1u));
+            }
+        }
+        for (var k = 0u; !through && k < view.spp; k++) {
             let n = view.base + k;
             // BRDF strategy.
             let u = r3(shift_b, n);

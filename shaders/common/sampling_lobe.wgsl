@@ -54,3 +54,20 @@ fn power_lobe(p: f32, axis: vec3<f32>, e: f32) -> Lobe {
 fn ggx_lobe(p: f32, ax: f32, ay: f32) -> Lobe {
     return Lobe(LOBE_GGX, p, vec3<f32>(0.0, 0.0, 1.0), 0.0, clamp(ax, 0.001, 1.0), clamp(ay, 0.001, 1.0));
 }
+
+// A direction drawn on the whole sphere by a transmitting model's own
+// sampler (`fn sample_sphere(o, wo, u) -> SphereSample` in its module): the
+// environment renderer follows such a model's light through the object.
+struct SphereSample {
+    // Towards the light, either side of the surface (0 when nothing was drawn).
+    wi: vec3<f32>,
+    // f(wi, wo) |cos θi| / pdf(wi).
+    weight: vec3<f32>,
+}
+
+fn no_sphere_sample() -> SphereSample {
+    var s: SphereSample;
+    s.wi = vec3<f32>(0.0);
+    s.weight = vec3<f32>(0.0);
+    return s;
+}

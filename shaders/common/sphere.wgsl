@@ -58,13 +58,20 @@ fn sphere_at(p: vec2<f32>, size: vec2<f32>, tiles: u32, cols: u32) -> SpherePoin
         out.tile = -1;
         return out;
     }
-    out.tile = i32(tile);
-    out.n = vec3<f32>(u, v, sqrt(1.0 - d2));
-    // t = normalize(ŷ × n) = (n.z, 0, −n.x)/√(n.x² + n.z²); at the poles
-    // (only reachable at the silhouette's top and bottom) fall back to +x.
-    let l = sqrt(out.n.x * out.n.x + out.n.z * out.n.z);
+    return frame_at(vec3<f32>(u, v, sqrt(1.0 - d2)), i32(tile));
+}
+
+// The sphere's frame at unit normal n (view space): the tangent along the
+// parallel about the vertical axis, t = normalize(ŷ × n) = (n.z, 0, −n.x)/
+// √(n.x² + n.z²); at the poles (only reachable at the silhouette's top and
+// bottom, or from inside the sphere) +x.
+fn frame_at(n: vec3<f32>, tile: i32) -> SpherePoint {
+    var out: SpherePoint;
+    out.tile = tile;
+    out.n = n;
+    let l = sqrt(n.x * n.x + n.z * n.z);
     if (l > 0.0) {
-        out.t = vec3<f32>(out.n.z, 0.0, -out.n.x) / l;
+        out.t = vec3<f32>(n.z, 0.0, -n.x) / l;
     } else {
         out.t = vec3<f32>(1.0, 0.0, 0.0);
     }

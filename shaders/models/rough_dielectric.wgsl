@@ -7,7 +7,8 @@
 #define_import_path bv::models::rough_dielectric
 
 #import bv::params::{pf, prgb, pu}
-#import bv::sampling_lobe::{Lobe, ggx_lobe}
+#import bv::sampling_lobe::{Lobe, ggx_lobe, SphereSample, no_sphere_sample}
+#import bv::sampling::sample_ggx_vndf
 #import bv::frame::log1p
 #import bv::fresnel::dielectric
 #import bv::microfacet::{ggx_d, beckmann_d, ggx_lambda, beckmann_lambda}
@@ -112,4 +113,89 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
 // gathered by that renderer), with the least cosine share.
 fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
     return ggx_lobe(0.1, pf(o + ROUGH_DIELECTRIC_ALPHA_X), pf(o + ROUGH_DIELECTRIC_ALPHA_Y));
+}
+
+// Draws wi on the whole sphere for the environment renderer's paths through
+// the object (Walter et al. 2007, §5.3, with Heitz 2018's visible normals):
+// a normal m visible from wo (GGX at the model's roughness, also for a
+// Beckmann model), then reflection with probability F(wo·m) and refraction
+// otherwise. A draw that lands on the wrong side (reflected through the
+// surface, or refracted back out) is no sample: eval would read that pair
+// as the other lobe, which the other branch's draws count (as pbrt-v4's
+// DielectricBxDF does). The weight f |cos θi| / pdf is taken in closed form,
+// the terms of eq. 20/21 over those of the density (eq. 14/17 with the
+// visible-normal pdf G1(wo) ⟨wo·m⟩ D_GGX(m) / cos θo):
+//   reflection  (D(m) / D_GGX(m)) G(wi, wo) / G1_GGX(wo),
+//   refraction  (ηo/ηi)² (D(m) / D_GGX(m)) G(wi, wo) / G1_GGX(wo),
+// which is what eval / pdf equals at the same m, without recomputing the
+// half vector from wi and wo in f32 (near the critical angle it cancels
+// badly, and a 0.05-rough D turns that into fireflies).
+fn sample_sphere(o: u32, wo: vec3<f32>, u: vec3<f32>) -> SphereSample {
+    let eta = pf(o + ROUGH_DIELECTRIC_ETA);
+    let ax = pf(o + ROUGH_DIELECTRIC_ALPHA_X);
+    let ay = pf(o + ROUGH_DIELECTRIC_ALPHA_Y);
+    let beckmann = pu(o + ROUGH_DIELECTRIC_DISTRIBUTION) == ROUGH_DIELECTRIC_DISTRIBUTION_BECKMANN;
+    let correlated = pu(o + ROUGH_DIELECTRIC_GEOMETRY) == ROUGH_DIELECTRIC_GEOMETRY_SMITH_CORRELATED;
+    if (wo.z == 0.0) {
+        return no_sphere_sample();
+    }
+    // Work with the viewer above: flip both sides when wo is below.
+    let above = wo.z > 0.0;
+    let sgn = select(-1.0, 1.0, above);
+    let w = wo * sgn;
+    let m = sample_ggx_vndf(w, ax, ay, u.xy);
+    let wm = dot(w, m);
+    if (wm <= 0.0 || m.z <= 0.0) {
+        return no_sphere_sample();
+    }
+    // Index on wo's side over the other's; F from wo's side.
+    let eo = select(eta, 1.0, above);
+    let et = select(1.0, eta, above);
+    let rel = eo / et;
+    let sin2_t = rel * rel * max(1.0 - wm * wm, 0.0);
+    var f = 1.0;
+    if (sin2_t < 1.0) {
+        let cos_t = sqrt(1.0 - sin2_t);
+        let r_par = (et * wm - eo * cos_t) / (et * wm + eo * cos_t);
+        let r_perp = (eo * wm - et * cos_t) / (eo * wm + et * cos_t);
+        f = 0.5 * (r_par * r_par + r_perp * r_perp);
+    }
+    var wi_up: vec3<f32>;
+    var scale = 1.0;
+    let reflects = u.z < f;
+    if (reflects) {
+        wi_up = 2.0 * wm * m - w;
+        if (wi_up.z <= 0.0) {
+            return no_sphere_sample();
+        }
+    } else {
+        let cos_t = sqrt(max(1.0 - sin2_t, 0.0));
+        wi_up = normalize(-rel * w + (rel * wm - cos_t) * m);
+        if (wi_up.z >= 0.0) {
+            return no_sphere_sample();
+        }
+        scale = rel * rel;
+    }
+    var dr = 1.0;
+    if (beckmann) {
+        dr = beckmann_d(m, ax, ay) / ggx_d(m, ax, ay);
+    }
+    let li = lambda(beckmann, wi_up, ax, ay);
+    let lo = lambda(beckmann, w, ax, ay);
+    var g = 1.0 / ((1.0 + li) * (1.0 + lo));
+    if (correlated) {
+        if (reflects) {
+            g = 1.0 / (1.0 + li + lo);
+        } else {
+            g = beta(1.0 + li, 1.0 + lo);
+        }
+    }
+    let g1 = 1.0 / (1.0 + ggx_lambda(w, ax, ay));
+    var s: SphereSample;
+    s.wi = wi_up * sgn;
+    s.weight = scale * dr * g / g1 * prgb(o + ROUGH_DIELECTRIC_TINT);
+    if (!all(s.weight >= vec3<f32>(0.0)) || !all(s.weight < vec3<f32>(3.0e38))) {
+        return no_sphere_sample();
+    }
+    return s;
 }

@@ -46,6 +46,11 @@ impl Object {
     }
 }
 
+/// Most interfaces a path through a transmitting object crosses or reflects
+/// off inside it (`MAX_BOUNCES` in shaders/env.wgsl); the rest of a path
+/// counts as dark. The view says so.
+pub const MAX_BOUNCES: u32 = 16;
+
 /// Settings of an environment-lit frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EnvSettings {

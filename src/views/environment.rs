@@ -854,13 +854,26 @@ impl View for EnvironmentView {
                 &painter,
                 rect.right_top() + Vec2::new(-6.0, 6.0),
                 Align2::RIGHT_TOP,
-                &if env.object == EnvObject::Plane {
-                    format!(
-                        "{map_name} · rot {:.0}° · eye {:.0}° above the plane",
-                        env.rotation_deg, env.elevation_deg
-                    )
-                } else {
-                    format!("{map_name} · rot {:.0}°", env.rotation_deg)
+                &{
+                    let mut t = if env.object == EnvObject::Plane {
+                        format!(
+                            "{map_name} · rot {:.0}° · eye {:.0}° above the plane",
+                            env.rotation_deg, env.elevation_deg
+                        )
+                    } else {
+                        format!("{map_name} · rot {:.0}°", env.rotation_deg)
+                    };
+                    // A transmitting model's light is followed through
+                    // the object: say how far.
+                    if env.object != EnvObject::Plane
+                        && drawables.iter().any(|d| d.brdf.brdf.transmits())
+                    {
+                        t.push_str(&format!(
+                            "\nlight followed through the object, ≤ {} interfaces",
+                            crate::gpu::env::MAX_BOUNCES
+                        ));
+                    }
+                    t
                 },
                 text,
             );

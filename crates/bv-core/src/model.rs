@@ -121,6 +121,12 @@ pub struct GpuPort {
     /// Lobe` (`bv::sampling_lobe`), the proxy lobe the environment renderer
     /// importance-samples; without one it samples the cosine.
     pub sampling_lobe: bool,
+    /// Whether the module defines `fn sample_sphere(o: u32, wo: vec3<f32>,
+    /// u: vec3<f32>) -> SphereSample` (`bv::sampling_lobe`): its own
+    /// sampler on the whole sphere, with the weight f |cos θi| / pdf, so
+    /// that the environment renderer follows its transmitted light through
+    /// the object (issue 33: frosted glass).
+    pub sphere_sampling: bool,
     /// The model's delta lobes, if it has any.
     pub delta: Option<DeltaPort>,
 }
@@ -135,8 +141,15 @@ impl GpuPort {
             derived: &[],
             derive: None,
             sampling_lobe: false,
+            sphere_sampling: false,
             delta: None,
         }
+    }
+
+    /// The same port with a sampler on the whole sphere.
+    pub const fn with_sphere_sampling(mut self) -> Self {
+        self.sphere_sampling = true;
+        self
     }
 
     /// The same port with a sampling proxy.

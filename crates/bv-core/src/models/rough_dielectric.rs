@@ -126,7 +126,8 @@ pub static INFO: ModelInfo = ModelInfo {
             "shaders/models/rough_dielectric.wgsl",
             include_str!("../../../../shaders/models/rough_dielectric.wgsl"),
         )
-        .with_sampling_lobe(),
+        .with_sampling_lobe()
+        .with_sphere_sampling(),
     ),
 };
 
