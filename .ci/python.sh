@@ -21,9 +21,21 @@ fi
 # Pinned below the next major versions; pip skips what is already there.
 "$venv/bin/python" -m pip install -q --disable-pip-version-check \
     'numpy>=1.21,<3' 'maturin>=1.5,<2' 'pytest>=7,<10'
-# The `bv` binary the tests compare with (built by `cargo test` already).
-cargo build -q --bin bv
-# VIRTUAL_ENV tells maturin where to install.
+# The `bv` binary the tests compare with, resolved over the whole workspace
+# (`--workspace`) as `cargo test --workspace` resolves it, so that after
+# .ci/run's `cargo test` it is fresh. A plain `cargo build --bin bv` resolves
+# features for the `bv` package alone: pyo3's macros enable syn's
+# `extra-traits`/`visit-mut` only in the workspace-wide resolution, so every
+# crate behind serde_derive, thiserror, clap_derive or bytemuck_derive (61
+# units, wgpu, naga, egui and bv itself among them) got a second build with
+# different features: most of this script's 359 s on a clean clone.
+cargo build -q --workspace --bin bv
+# VIRTUAL_ENV tells maturin where to install. `maturin develop` builds
+# `-p bv-python`, whose feature resolution is the workspace's (bv-python
+# depends on bv), so bv, bv-core and their dependencies are reused; only
+# pyo3, numpy and the module compile (maturin sets PYO3_CONFIG_FILE, which
+# pyo3-ffi's build script watches, so they are rebuilt after a plain cargo
+# build or clippy has built them without it).
 VIRTUAL_ENV=$venv PATH="$venv/bin:$PATH" \
     "$venv/bin/maturin" develop -q --manifest-path python/Cargo.toml
 BV_BIN="$target/debug/bv" "$venv/bin/python" -m pytest -q python/tests
