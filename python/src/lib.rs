@@ -12,6 +12,7 @@
 //! come back as `ValueError` with the command line's message; nothing a
 //! caller passes panics.
 
+use bv::session::state::{AppState, Theme};
 use bv_core::batch::{Dirs, Out};
 use bv_core::{Brdf, ModelSpec, Rgb};
 use glam::{DVec2, DVec3};
@@ -461,15 +462,9 @@ fn eval_f32(
     Ok(out)
 }
 
-/// One view of `model` as an `(H, W, 4)` uint8 RGBA array, drawn as `bv
-/// render --view …` draws it: `args` are `bv render`'s options (`--view`,
-/// `--width`, `--theta-i`, …; parsed and checked by its own parser).
-#[pyfunction]
-fn render<'py>(
-    py: Python<'py>,
-    model: &Model,
-    args: Vec<String>,
-) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+/// `bv render`'s options `args` (`--view`, `--width`, `--theta-i`, …)
+/// parsed and checked by its own parser.
+fn render_args(args: Vec<String>) -> PyResult<bv::cli::render::RenderArgs> {
     use clap::Parser as _;
     let argv = ["bv", "render"]
         .into_iter()
@@ -479,17 +474,196 @@ fn render<'py>(
         .chain(["--out".to_string(), "figure.png".to_string()]);
     let cli = bv::cli::Cli::try_parse_from(argv)
         .map_err(|e| PyValueError::new_err(e.render().to_string().trim().to_string()))?;
-    let Some(bv::cli::Command::Render(a)) = cli.command else {
-        return Err(PyValueError::new_err("internal: not a render command"));
-    };
-    let spec = model.spec.clone();
-    let img = py
-        .detach(|| bv::cli::render::view_image(&a, Some(spec)))
-        .map_err(|e| value_error(&e))?;
+    match cli.command {
+        Some(bv::cli::Command::Render(a)) => Ok(a),
+        _ => Err(PyValueError::new_err("internal: not a render command")),
+    }
+}
+
+/// An RGBA image as an `(H, W, 4)` uint8 array.
+fn image_array(py: Python<'_>, img: image::RgbaImage) -> PyResult<Bound<'_, numpy::PyArray3<u8>>> {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let arr = numpy::ndarray::Array3::from_shape_vec((h, w, 4), img.into_raw())
         .map_err(|e| PyValueError::new_err(format!("internal: image of {w}×{h}: {e}")))?;
     Ok(arr.into_pyarray(py))
+}
+
+/// One view of `model` as an `(H, W, 4)` uint8 RGBA array, drawn as `bv
+/// render --view …` draws it: `args` are `bv render`'s options (`--view`,
+/// `--width`, `--theta-i`, …; parsed and checked by its own parser).
+#[pyfunction]
+fn render<'py>(
+    py: Python<'py>,
+    model: &Model,
+    args: Vec<String>,
+) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+    let a = render_args(args)?;
+    let spec = model.spec.clone();
+    let img = py
+        .detach(|| bv::cli::render::view_image(&a, Some(spec)))
+        .map_err(|e| value_error(&e))?;
+    image_array(py, img)
+}
+
+/// One view of a whole scene (all its BRDFs, its light and display options,
+/// `args` on top) as an `(H, W, 4)` uint8 RGBA array, drawn as `bv render
+/// --scene FILE --view …` draws the scene's file.
+#[pyfunction]
+fn render_scene<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    args: Vec<String>,
+) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+    let a = render_args(args)?;
+    let state = scene.state.clone();
+    let img = py
+        .detach(|| bv::cli::render::scene_image(&a, state))
+        .map_err(|e| value_error(&e))?;
+    image_array(py, img)
+}
+
+/// A scene: BRDFs (model, parameters, colour, visibility), light, camera,
+/// display options; read and written as scene files (`bv --scene FILE`,
+/// `bv render --scene FILE`, `bv scene check FILE`).
+#[pyclass(module = "bv._native", name = "Scene", frozen)]
+struct Scene {
+    state: AppState,
+    warnings: Vec<String>,
+}
+
+#[pymethods]
+impl Scene {
+    /// The scene of `models` (none: the first-run scene's) with the light
+    /// at (`theta_i`, `phi_i`) degrees and the display options, checked as
+    /// `bv scene new` checks them.
+    #[new]
+    #[pyo3(signature = (models, theta_i=None, phi_i=None, log=false, cosine=false, light=false))]
+    fn new(
+        models: Vec<PyRef<'_, Model>>,
+        theta_i: Option<f64>,
+        phi_i: Option<f64>,
+        log: bool,
+        cosine: bool,
+        light: bool,
+    ) -> PyResult<Self> {
+        let specs = models.iter().map(|m| m.spec.clone()).collect();
+        let opts = bv::cli::scene::NewScene {
+            model: Vec::new(),
+            params: Vec::new(),
+            theta_i,
+            phi_i,
+            light,
+            log,
+            cosine,
+        };
+        let state = bv::cli::scene::state_with(specs, &opts).map_err(|e| value_error(&e))?;
+        Ok(Self {
+            state,
+            warnings: Vec::new(),
+        })
+    }
+
+    /// Reads a scene file as `bv scene check` reads it (the same message
+    /// on failure).
+    #[staticmethod]
+    fn load(path: std::path::PathBuf) -> PyResult<Self> {
+        bv::session::user_models::install();
+        let loaded = bv::cli::scene::load(&path).map_err(|e| value_error(&e))?;
+        Ok(Self {
+            state: loaded.state,
+            warnings: loaded.warnings,
+        })
+    }
+
+    /// Writes the scene file atomically, as the viewer's Save does (paths
+    /// relative to its folder where they lie inside it).
+    fn save(&self, path: std::path::PathBuf) -> PyResult<()> {
+        bv::session::scene_file::save(&path, &self.state)
+            .map_err(|e| value_error(&anyhow::Error::new(e)))
+    }
+
+    /// The scene file's text (paths as given).
+    fn to_toml(&self) -> PyResult<String> {
+        bv::session::scene_file::to_toml(&self.state).map_err(bv_error)
+    }
+
+    /// The remarks loading made (unknown keys, a missing `format` line).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    /// The BRDFs as a JSON list of `{id, params, name, visible, color}`.
+    fn brdfs_json(&self) -> PyResult<String> {
+        let list: Vec<serde_json::Value> = self
+            .state
+            .brdfs
+            .iter()
+            .map(|b| {
+                serde_json::json!({
+                    "id": b.spec.id(),
+                    "params": b.spec.params().to_json(),
+                    "name": b.name,
+                    "visible": b.visible,
+                    "color": b.color,
+                })
+            })
+            .collect();
+        serde_json::to_string(&list).map_err(bv_error)
+    }
+
+    /// The BRDFs as models, in order.
+    fn models(&self) -> PyResult<Vec<Model>> {
+        self.state
+            .brdfs
+            .iter()
+            .map(|b| {
+                let brdf = b.spec.build().map_err(bv_error)?;
+                Ok(Model {
+                    spec: b.spec.clone(),
+                    brdf,
+                })
+            })
+            .collect()
+    }
+
+    /// The light's polar angle, degrees.
+    #[getter]
+    fn theta_i(&self) -> f64 {
+        self.state.incident.theta_deg
+    }
+
+    /// The light's azimuth, degrees.
+    #[getter]
+    fn phi_i(&self) -> f64 {
+        self.state.incident.phi_deg
+    }
+
+    /// Whether plots use a logarithmic scale.
+    #[getter]
+    fn log(&self) -> bool {
+        self.state.display.log
+    }
+
+    /// Whether plots show f · cos θo.
+    #[getter]
+    fn cosine(&self) -> bool {
+        self.state.display.cosine
+    }
+
+    /// `"light"` or `"dark"`.
+    #[getter]
+    fn theme(&self) -> &'static str {
+        match self.state.theme {
+            Theme::Light => "light",
+            Theme::Dark => "dark",
+        }
+    }
+
+    /// Whether two scenes hold the same state (what a scene file records).
+    fn same_as(&self, other: &Scene) -> bool {
+        self.state == other.state
+    }
 }
 
 /// The compiled half of the `bv` package (see `bv/__init__.py`).
@@ -498,6 +672,8 @@ fn render<'py>(
 fn bv_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models_json, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
+    m.add_function(wrap_pyfunction!(render_scene, m)?)?;
     m.add_class::<Model>()?;
+    m.add_class::<Scene>()?;
     Ok(())
 }

@@ -52,3 +52,19 @@ def bv_eval(bv_cli):
 def data(name: str) -> str:
     """A user `.brdf` file of the Rust tests."""
     return str(ROOT / "tests" / "data" / "brdf" / name)
+
+
+def need(module: str):
+    """Imports an optional test dependency (nbclient, dask.distributed).
+    Missing is a failure under CI (BV_CI=1, set by .ci/python.sh, which
+    installs them), a skip elsewhere."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:
+        if os.environ.get("BV_CI") == "1":
+            raise RuntimeError(
+                f"{module} is not installed in the CI virtual environment: {e}"
+            ) from e
+        pytest.skip(f"{module} is not installed ({e}); .ci/python.sh installs it")

@@ -171,7 +171,7 @@ pub fn views_for(name: &str) -> Result<Vec<&'static ViewEntry>> {
 /// The state to draw: the scene (or defaults), with the command line's
 /// changes on top.
 pub fn state_for(a: &RenderArgs) -> Result<AppState> {
-    let mut state = match &a.scene {
+    let state = match &a.scene {
         Some(p) => {
             let loaded = scene::load(p).map_err(|e| match e {
                 // It names the file already.
@@ -186,6 +186,14 @@ pub fn state_for(a: &RenderArgs) -> Result<AppState> {
         None if a.model.is_none() && a.preset.is_none() => AppState::first_run(),
         None => AppState::default(),
     };
+    apply_args(a, state)
+}
+
+/// `state` with the command line's changes on top (model or preset, light,
+/// theme, samples, display options), sanitised: what `bv render --scene
+/// FILE …` draws once the file is read. The Python module's
+/// `bv.render(scene, …)` gives it a scene held in memory.
+pub fn apply_args(a: &RenderArgs, mut state: AppState) -> Result<AppState> {
     if let Some(p) = &a.preset {
         let spec = super::params::preset_spec_from_cli(p, &a.params)?;
         let name = super::params::find_preset(p)?.name.clone();
@@ -313,13 +321,7 @@ fn scale_of(a: &RenderArgs, width: u32) -> Result<f32> {
 /// render --view V --out F.png` writes, for the Python module's
 /// `bv.render`.
 pub fn view_image(a: &RenderArgs, spec: Option<bv_core::ModelSpec>) -> Result<image::RgbaImage> {
-    let [width, height] = size_of(a)?;
-    let view = a.view.as_deref().unwrap_or_default();
-    if view.trim().eq_ignore_ascii_case("all") || view.trim().eq_ignore_ascii_case("window") {
-        bail!("view {view:?}: one view of this build (lobe3d, polar, cartesian, albedo, …)");
-    }
-    let e = views_for(view)?[0];
-    let scale = scale_of(a, width)?;
+    let e = one_view(a)?;
     let mut state = state_for(a)?;
     if let Some(spec) = spec {
         state.brdfs.clear();
@@ -327,14 +329,44 @@ pub fn view_image(a: &RenderArgs, spec: Option<bv_core::ModelSpec>) -> Result<im
         state.add(spec);
         state = state.sanitised();
     }
+    draw_view(a, e, &state)
+}
+
+/// One view (`--view`) of the scene `scene` (all its BRDFs, its light and
+/// display options) with `a`'s changes on top ([`apply_args`]) as an RGBA
+/// image: what `bv render --scene FILE --view V --out F.png` writes for
+/// that scene's file, for the Python module's `bv.render(scene, …)`.
+pub fn scene_image(a: &RenderArgs, scene: AppState) -> Result<image::RgbaImage> {
+    let e = one_view(a)?;
+    let state = apply_args(a, scene)?;
+    draw_view(a, e, &state)
+}
+
+/// The single view `a.view` names (not `all` or `window`), with the size
+/// and scale checked.
+fn one_view(a: &RenderArgs) -> Result<&'static ViewEntry> {
+    let [width, _] = size_of(a)?;
+    let view = a.view.as_deref().unwrap_or_default();
+    if view.trim().eq_ignore_ascii_case("all") || view.trim().eq_ignore_ascii_case("window") {
+        bail!("view {view:?}: one view of this build (lobe3d, polar, cartesian, albedo, …)");
+    }
+    let e = views_for(view)?[0];
+    scale_of(a, width)?;
+    Ok(e)
+}
+
+/// Draws the view `e` of `state` offscreen at `a`'s size and scale.
+fn draw_view(a: &RenderArgs, e: &ViewEntry, state: &AppState) -> Result<image::RgbaImage> {
+    let [width, height] = size_of(a)?;
+    let scale = scale_of(a, width)?;
     let frame = Frame {
         size: Vec2::new(width as f32 / scale, height as f32 / scale),
         pixels_per_point: scale,
-        dark: export::is_dark(&state),
+        dark: export::is_dark(state),
         transparent: a.transparent,
     };
     let mut off = open_device(frame)?;
-    export::render_view(&mut off, &state, e, frame)
+    export::render_view(&mut off, state, e, frame)
         .with_context(|| format!("drawing the {} view", e.id))
 }
 

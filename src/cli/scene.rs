@@ -97,8 +97,9 @@ fn summary(s: &AppState) -> String {
     )
 }
 
-/// Reads a scene file; the message names the file once.
-fn load(file: &std::path::Path) -> Result<scene::Loaded> {
+/// Reads a scene file; the message names the file once (what `bv scene
+/// check` says, and the Python module's `bv.Scene.load` raises).
+pub fn load(file: &std::path::Path) -> Result<scene::Loaded> {
     scene::load(file).map_err(|e| match e {
         scene::SceneError::File(e) => anyhow::Error::new(e),
         e => anyhow::Error::new(e).context(file.display().to_string()),
@@ -145,7 +146,6 @@ pub fn run(a: &SceneArgs, argv: &[String]) -> Result<()> {
 /// Builds the state of `bv scene new`, pairing each --param with the
 /// --model before it on the command line.
 pub fn new_state(o: &NewScene, argv: &[String]) -> Result<AppState> {
-    let mut state = AppState::default();
     let groups = group_params(argv)?;
     let grouped: usize = groups.iter().map(Vec::len).sum();
     if groups.len() != o.model.len() || grouped != o.params.len() {
@@ -156,12 +156,25 @@ pub fn new_state(o: &NewScene, argv: &[String]) -> Result<AppState> {
              `--param NAME=VALUE` after its `--model ID`"
         );
     }
-    if o.model.is_empty() {
-        state = AppState::first_run();
-    }
+    let mut specs = Vec::with_capacity(o.model.len());
     for (k, m) in o.model.iter().enumerate() {
         let params = groups.get(k).cloned().unwrap_or_default();
-        let spec = super::params::spec_from_cli(m, &params)?;
+        specs.push(super::params::spec_from_cli(m, &params)?);
+    }
+    state_with(specs, o)
+}
+
+/// The scene of `specs` (in order; none: the first-run scene's BRDFs) with
+/// `o`'s light and display options (its `model`/`params` are not read),
+/// checked as a scene file is: what `bv scene new` writes, and the Python
+/// module's `bv.Scene(models, …)` holds.
+pub fn state_with(specs: Vec<bv_core::ModelSpec>, o: &NewScene) -> Result<AppState> {
+    let mut state = if specs.is_empty() {
+        AppState::first_run()
+    } else {
+        AppState::default()
+    };
+    for spec in specs {
         state.add(spec);
     }
     if let Some(first) = state.brdfs.first() {

@@ -13,6 +13,9 @@ code as the ``bv`` command line::
     f = m.eval(wi, wo)                                  # (2, 3) float32, 1/sr per RGB channel
     rho, err = m.albedo([0, 30, 60])                    # ρhd with its error estimate
     report = m.check()                                  # the dict of `bv check --json`
+    scene = bv.Scene([m, bv.Model("lambert")], theta_i=30)
+    scene.save("two.toml")                              # a scene file (bv --scene two.toml)
+    fig = bv.render(bv.Scene.load("two.toml"), view="polar")  # (H, W, 4) uint8, shown by Jupyter
 
 Conventions (as everywhere in bv): the normal is +z, the tangent +x; ``wi``
 (towards the light) and ``wo`` (towards the viewer) point away from the
@@ -28,6 +31,7 @@ from __future__ import annotations
 import json
 import os
 import struct
+import warnings
 import zlib
 from typing import Any, Dict, List, Sequence, Tuple, Union
 
@@ -35,7 +39,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["Figure", "Model", "models", "render"]
+__all__ = ["Figure", "Model", "Scene", "models", "render"]
 
 ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
 
@@ -190,6 +194,126 @@ class Model:
         return self._m.dispatch()
 
 
+def _model_of(native: Any) -> "Model":
+    """A :class:`Model` around an already built ``_native.Model``."""
+    m = Model.__new__(Model)
+    m._m = native
+    return m
+
+
+class Scene:
+    """A bv scene: BRDFs (model, parameters, colour, visibility), the
+    light's direction, camera and display options; what the viewer's
+    File ▸ Save writes and ``bv --scene FILE`` / ``bv render --scene FILE``
+    read.
+
+    ``Scene([m1, m2], theta_i=30, log=True)`` makes one from
+    :class:`Model` objects (checked as ``bv scene new`` checks its options);
+    :meth:`load` reads a scene file and :meth:`save` writes one. ``s1 == s2``
+    compares everything a scene file records. :func:`render` draws a
+    scene with all its BRDFs.
+    """
+
+    def __init__(
+        self,
+        models: Sequence["Model"] = (),
+        theta_i: Union[float, None] = None,
+        phi_i: Union[float, None] = None,
+        log: bool = False,
+        cosine: bool = False,
+        theme: Union[str, None] = None,
+    ) -> None:
+        ms = list(models)
+        for m in ms:
+            if not isinstance(m, Model):
+                raise ValueError(f"models must be bv.Model objects, found {type(m).__name__}")
+        if theme not in (None, "light", "dark"):
+            raise ValueError(f'theme={theme!r}: expected "light" or "dark"')
+        self._s = _native.Scene(
+            [m._m for m in ms],
+            None if theta_i is None else float(theta_i),
+            None if phi_i is None else float(phi_i),
+            bool(log),
+            bool(cosine),
+            theme == "light",
+        )
+
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike]) -> "Scene":
+        """Reads a scene file (relative paths in it are taken from its
+        folder). A file bv refuses (missing, not TOML, a bad value, a model
+        that cannot be built) raises ``ValueError`` with the message of ``bv
+        scene check``; remarks that do not refuse it (unknown keys) are
+        issued as ``UserWarning`` and kept in :attr:`warnings`."""
+        s = cls.__new__(cls)
+        s._s = _native.Scene.load(os.fspath(path))
+        for w in s._s.warnings:
+            warnings.warn(f"{os.fspath(path)}: {w}", UserWarning, stacklevel=2)
+        return s
+
+    def save(self, path: Union[str, os.PathLike]) -> None:
+        """Writes the scene file atomically (file paths relative to its
+        folder where they lie inside it), as the viewer saves; an error
+        (a missing folder, a read-only file) raises ``ValueError``."""
+        self._s.save(os.fspath(path))
+
+    def to_toml(self) -> str:
+        """The scene file's text."""
+        return self._s.to_toml()
+
+    @property
+    def brdfs(self) -> List[Dict[str, Any]]:
+        """The BRDFs in order: dicts of ``id``, ``params`` (every value),
+        ``name`` (a preset's, or None), ``visible`` and ``color`` (sRGB)."""
+        return json.loads(self._s.brdfs_json())
+
+    @property
+    def models(self) -> List["Model"]:
+        """The BRDFs as :class:`Model` objects, in order."""
+        return [_model_of(m) for m in self._s.models()]
+
+    @property
+    def theta_i(self) -> float:
+        """The light's polar angle, degrees."""
+        return self._s.theta_i
+
+    @property
+    def phi_i(self) -> float:
+        """The light's azimuth, degrees."""
+        return self._s.phi_i
+
+    @property
+    def log(self) -> bool:
+        """Whether plots use a logarithmic scale."""
+        return self._s.log
+
+    @property
+    def cosine(self) -> bool:
+        """Whether plots show f · cos θo."""
+        return self._s.cosine
+
+    @property
+    def theme(self) -> str:
+        """``"light"`` or ``"dark"``."""
+        return self._s.theme
+
+    @property
+    def warnings(self) -> List[str]:
+        """What loading remarked on without refusing the file."""
+        return self._s.warnings
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Scene):
+            return NotImplemented
+        return self._s.same_as(other._s)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        ids = ", ".join(b["id"] for b in self.brdfs)
+        return f"<bv.Scene [{ids}] θi={self.theta_i}° φi={self.phi_i}°>"
+
+
 def _png(rgba: np.ndarray) -> bytes:
     """An (H, W, 4) uint8 array as PNG bytes (8-bit RGBA, no filter)."""
     h, w, _ = rgba.shape
@@ -221,7 +345,7 @@ class Figure(np.ndarray):
 
 
 def render(
-    model: Model,
+    model: Union[Model, Scene],
     view: str = "lobe3d",
     width: int = 800,
     height: int = 600,
@@ -238,6 +362,11 @@ def render(
     machine without a GPU) and returns it as a :class:`Figure`, an
     ``(height, width, 4)`` uint8 RGBA array.
 
+    ``model`` is a :class:`Model` (drawn alone, with bv's default light and
+    display) or a :class:`Scene` (all its BRDFs, its light, theme and display
+    options, as ``bv render --scene FILE`` draws its file; the options
+    given here override the scene's).
+
     ``view``: ``lobe3d``, ``polar``, ``cartesian``, ``albedo``, ``fresnel``
     or any view ``bv render --help`` lists. ``theta_i``/``phi_i``: the
     light's direction in degrees. ``theme``: ``"light"`` (dark on white, for
@@ -246,8 +375,8 @@ def render(
     800 within 1..4). Options are checked by ``bv render``'s parser: a bad
     one raises ``ValueError`` with its message.
     """
-    if not isinstance(model, Model):
-        raise ValueError(f"model must be a bv.Model, found {type(model).__name__}")
+    if not isinstance(model, (Model, Scene)):
+        raise ValueError(f"model must be a bv.Model or a bv.Scene, found {type(model).__name__}")
     args = ["--view", str(view), "--width", str(int(width)), "--height", str(int(height))]
     if theta_i is not None:
         args += ["--theta-i", repr(float(theta_i))]
@@ -260,4 +389,6 @@ def render(
     if scale is not None:
         args += ["--scale", repr(float(scale))]
     args += [flag for flag, on in (("--log", log), ("--cosine", cosine), ("--transparent", transparent)) if on]
+    if isinstance(model, Scene):
+        return _native.render_scene(model._s, args).view(Figure)
     return _native.render(model._m, args).view(Figure)

@@ -1,5 +1,6 @@
 """Type stub of the `bv` package (bv, the BRDF viewer, from Python)."""
 
+import os
 from typing import Any, Dict, List, Sequence, Tuple, Union
 
 import numpy as np
@@ -42,15 +43,60 @@ class Model:
     def dispatch(self) -> Tuple[bool, str]:
         """(kernel, isa) of the f32 evaluation."""
 
+class Scene:
+    """A bv scene: BRDFs, light, camera and display options; scene files."""
+
+    def __init__(
+        self,
+        models: Sequence[Model] = (),
+        theta_i: float | None = None,
+        phi_i: float | None = None,
+        log: bool = False,
+        cosine: bool = False,
+        theme: str | None = None,
+    ) -> None: ...
+    @classmethod
+    def load(cls, path: Union[str, os.PathLike[str]]) -> Scene:
+        """Reads a scene file (ValueError with `bv scene check`'s message)."""
+    def save(self, path: Union[str, os.PathLike[str]]) -> None:
+        """Writes the scene file atomically."""
+    def to_toml(self) -> str:
+        """The scene file's text."""
+    @property
+    def brdfs(self) -> List[Dict[str, Any]]:
+        """The BRDFs: id, params, name, visible, color."""
+    @property
+    def models(self) -> List[Model]:
+        """The BRDFs as models."""
+    @property
+    def theta_i(self) -> float:
+        """The light's polar angle, degrees."""
+    @property
+    def phi_i(self) -> float:
+        """The light's azimuth, degrees."""
+    @property
+    def log(self) -> bool:
+        """Logarithmic scale."""
+    @property
+    def cosine(self) -> bool:
+        """Plots show f · cos θo."""
+    @property
+    def theme(self) -> str:
+        """"light" or "dark"."""
+    @property
+    def warnings(self) -> List[str]:
+        """Remarks made while loading."""
+    def __eq__(self, other: object) -> bool: ...
+
 class Figure(np.ndarray):
     """An (H, W, 4) uint8 RGBA image drawn by bv, shown as a PNG in Jupyter."""
 
     def _repr_png_(self) -> bytes: ...
-    def save(self, path: str) -> None:
+    def save(self, path: Union[str, os.PathLike[str]]) -> None:
         """Writes the image as a PNG file."""
 
 def render(
-    model: Model,
+    model: Union[Model, Scene],
     view: str = "lobe3d",
     width: int = 800,
     height: int = 600,
@@ -62,4 +108,4 @@ def render(
     transparent: bool = False,
     scale: float | None = None,
 ) -> Figure:
-    """One view of `model` as `bv render --view VIEW` draws it."""
+    """One view of a model, or of a whole scene, as `bv render --view VIEW` draws it."""
