@@ -701,3 +701,193 @@ fn the_g_slide_shows_g2_alone_v_groove_against_smith() {
     assert!((at_x(s, 80.0) - at_x(s, -80.0)).abs() < 1e-9);
     assert!((at_x(s, 80.0) - 0.56).abs() < 0.01, "{}", at_x(s, 80.0));
 }
+
+/// `|got − want| ≤ tol · want`, with the scene and quantity in the message.
+fn near(got: f64, want: f64, tol: f64, what: &str) {
+    assert!(
+        (got - want).abs() <= tol * want.abs(),
+        "{what}: {got} where the plan reads {want}"
+    );
+}
+
+/// LECTURE.md scene 11 [bv]: four GGX lobes at θi = 30° peak at the mirror
+/// direction, about ten times taller per decade of α².
+#[test]
+fn property_0_peaks_grow_tenfold_per_decade_of_alpha_squared() {
+    let slides = slides();
+    let c = polar_curves(slide(&slides, "Property 0: 0 ≤ f ≤ ∞"));
+    let want = [1.16, 10.6, 118.0, 1061.0];
+    assert_eq!(c.len(), 4);
+    for (k, (curve, w)) in c.iter().zip(want).enumerate() {
+        let (at, v) = peak(curve);
+        // α 0.3's lobe leans off-specular (its 1/cos θo), the sharp ones not.
+        let lean = if k == 0 { 4.0 } else { 1.0 };
+        assert!((at - 30.0).abs() <= lean, "peak at {at}°");
+        // On the 0.05° grid the sharpest lobe's top may fall between samples.
+        near(v, w, 0.03, "Property 0 peak");
+    }
+}
+
+/// LECTURE.md scene 46 [bv, cf]: single-scattering Cook–Torrance with
+/// F = 1 keeps ρhd(0°) = 0.988 / 0.688 / 0.307 at α 0.1 / 0.5 / 1.0.
+#[test]
+fn cook_torrance_loses_energy_with_roughness() {
+    let slides = slides();
+    let d = albedo_curves(slide(
+        &slides,
+        "Cook-Torrance: single scattering loses energy",
+    ));
+    for (data, want) in d.iter().zip([0.988, 0.688, 0.307]) {
+        let r = rho_at(data, 0.0);
+        assert!((r - want).abs() <= 0.005, "ρhd(0°) {r}, the plan {want}");
+        assert!(data.rho.iter().all(|e| mean_rgb(e.value) < 1.0));
+    }
+}
+
+/// Torrance–Sparrow in the plane of incidence (Cook & Torrance 1982):
+/// `F D G / (4 cos θi cos θo)` with Beckmann D of roughness `m`, the v-groove
+/// G and glass's exact F, light at θi on the negative side, θo signed.
+fn torrance_sparrow(ti: f64, to: f64, m: f64) -> f64 {
+    use std::f64::consts::PI;
+    let wi = glam::DVec3::new(-ti.sin(), 0.0, ti.cos());
+    let wo = glam::DVec3::new(to.sin(), 0.0, to.cos());
+    let h = (wi + wo).normalize();
+    let t2 = (1.0 - h.z * h.z) / (h.z * h.z);
+    let d = (-t2 / (m * m)).exp() / (PI * m * m * h.z.powi(4));
+    let oh = wo.dot(h);
+    let g = (2.0 * h.z * wo.z / oh).min(2.0 * h.z * wi.z / oh).min(1.0);
+    fresnel_dielectric(oh, 1.0, 1.5) * d * g / (4.0 * wi.z * wo.z)
+}
+
+/// LECTURE.md scene 53 [bv]: at θi = 75° Blinn-Phong peaks at the mirror
+/// direction (1.16) and Torrance–Sparrow at the horizon (21.4, the closed
+/// form at 89.95°); from θi = 15° its peak has grown about 560×.
+#[test]
+fn cook_torrance_moves_off_specular_at_grazing_light() {
+    let slides = slides();
+    let c = polar_curves(slide(
+        &slides,
+        "Cook-Torrance against Phong at grazing light",
+    ));
+    let (at, v) = peak(&c[0]);
+    assert!((at - 75.0).abs() <= 1.0, "Blinn-Phong peaks at {at}°");
+    near(v, 1.16, 0.02, "Blinn-Phong peak");
+    let (at, v) = peak(&c[1]);
+    assert!(at >= 85.0, "Cook-Torrance peaks at {at}°");
+    let ti = 75f64.to_radians();
+    near(
+        v,
+        torrance_sparrow(ti, at.to_radians(), 0.3),
+        1e-6,
+        "Cook-Torrance at its peak",
+    );
+    near(v, 21.4, 0.02, "Cook-Torrance peak");
+    let at_15 = (0..900)
+        .map(|k| torrance_sparrow(15f64.to_radians(), (f64::from(k) / 10.0).to_radians(), 0.3))
+        .fold(0.0, f64::max);
+    near(at_15, 0.038, 0.02, "its peak at θi = 15°");
+    let growth = v / at_15;
+    assert!((500.0..620.0).contains(&growth), "grows {growth}×");
+}
+
+/// LECTURE.md scene 56 [cf]: the mix of 0.5 Lambert 0.8, 0.4 GGX α 0.2 and
+/// 0.1 mirror: a floor at 0.5 · 0.8/π = 0.127, a lobe to 1.69 at +45° and a
+/// spike labelled "δ 0.100".
+#[test]
+fn a_complex_brdf_is_floor_lobe_and_spike() {
+    use bv::views::polar::delta_spikes;
+    let slides = slides();
+    let s = slide(&slides, "A complex BRDF: diffuse + glossy + specular");
+    let c = polar_curves(s);
+    // The floor: the curve never dips below the Lambert part, and where the
+    // lobe's tail is least it is within 7 % of it.
+    let floor = 0.5 * 0.8 / std::f64::consts::PI;
+    let least = c[0].iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    assert!(
+        least >= floor - 1e-9 && least <= 1.07 * floor,
+        "floor {least} vs {floor}"
+    );
+    // GGX's lobe leans a little past the mirror direction.
+    let (at, _) = peak(&c[0]);
+    assert!((at - 45.0).abs() <= 3.0, "the lobe peaks at {at}°");
+    near(value_at(&c[0], 45.0), 1.69, 0.02, "the lobe at +45°");
+    let mut rt = Runtime::default();
+    rt.sync(&s.state);
+    let scene = build_scene(&s.state, &rt, false);
+    let sp = delta_spikes(&scene, 1.0);
+    assert_eq!(sp.len(), 1);
+    assert_eq!(sp[0].text(), "δ 0.100");
+}
+
+/// LECTURE.md scene 58 [bv]: Hapke's opposition surge is a cusp at the
+/// light's direction, θo = −30°: 0.166 there, 0.148 at −28°, 0.115 at −20°.
+#[test]
+fn hapke_surges_at_the_lights_direction() {
+    let slides = slides();
+    let c = polar_curves(slide(
+        &slides,
+        "BRDF illustrations: Hapke's opposition surge",
+    ));
+    near(value_at(&c[0], -30.0), 0.166, 0.02, "Hapke at −30°");
+    near(value_at(&c[0], -28.0), 0.148, 0.02, "Hapke at −28°");
+    near(value_at(&c[0], -20.0), 0.115, 0.02, "Hapke at −20°");
+}
+
+/// LECTURE.md scene 43 [bv]: Lafortune's lobes put the mirror side's
+/// maximum off-specular, at +63° (0.0623 over 0.0454 at +50°), a retro
+/// maximum at −50° (0.0633), over a floor of kd/π = 0.032.
+#[test]
+fn lafortune_peaks_off_specular_and_backwards() {
+    let slides = slides();
+    let c = polar_curves(slide(&slides, "Lafortune"));
+    let mirror_side: Vec<(f64, f64)> = c[0].iter().copied().filter(|p| p.0 > 0.0).collect();
+    let (at, v) = peak(&mirror_side);
+    assert!((at - 63.0).abs() <= 2.0, "mirror-side maximum at {at}°");
+    near(v, 0.0623, 0.02, "mirror-side maximum");
+    near(
+        value_at(&c[0], 50.0),
+        0.0454,
+        0.02,
+        "at the mirror direction",
+    );
+    let retro: Vec<(f64, f64)> = c[0].iter().copied().filter(|p| p.0 < 0.0).collect();
+    let (at, v) = peak(&retro);
+    assert!((at + 50.0).abs() <= 2.0, "retro maximum at {at}°");
+    near(v, 0.0633, 0.02, "retro maximum");
+    let floor = c[0].iter().map(|p| p.1).fold(f64::INFINITY, f64::min);
+    assert!(floor >= 0.1 / std::f64::consts::PI - 1e-9, "floor {floor}");
+}
+
+/// LECTURE.md scene 45 [cf]: GGX α 0.3 with glass's Fresnel at θi = 60°:
+/// D(0) = 1/(πα²) = 3.54, F(0) = 0.040 and F(60°) = 0.089 (computed here),
+/// and G2 at the mirror direction ≈ 0.89.
+#[test]
+fn the_ingredients_read_their_closed_forms() {
+    let slides = slides();
+    let ch = term_charts_of(slide(&slides, "The ingredients: D, G, F"));
+    let d = ch.d.expect("D is shown");
+    let d0 = d.series[0].points[0];
+    assert!(d0[0].abs() < 1e-9);
+    near(d0[1], 1.0 / (std::f64::consts::PI * 0.09), 1e-4, "D(0)");
+    let f = ch.f.expect("F is shown");
+    let fpts = &f.series[0].points;
+    near(
+        at_x(fpts, 0.0),
+        fresnel_dielectric(1.0, 1.0, 1.5),
+        1e-3,
+        "F(0°)",
+    );
+    near(
+        at_x(fpts, 60.0),
+        fresnel_dielectric(60f64.to_radians().cos(), 1.0, 1.5),
+        2e-3,
+        "F(60°)",
+    );
+    let g = ch.g.expect("G is shown");
+    let g2 = g
+        .series
+        .iter()
+        .find(|s| s.label.contains("G2"))
+        .expect("a G2 curve");
+    near(at_x(&g2.points, 60.0), 0.89, 0.02, "G2 at ωr (+60°)");
+}

@@ -7,6 +7,7 @@
 #define_import_path bv::models::coated
 
 #import bv::params::{pf, prgb, pu}
+#import bv::sampling_lobe::{Lobe, ggx_lobe}
 #import bv::frame::INV_PI
 #import bv::fresnel::{dielectric, conductor}
 #import bv::microfacet::{ggx_d, beckmann_d, ggx_lambda, beckmann_lambda}
@@ -91,4 +92,21 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         v += t;
     }
     return v;
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe): GGX
+// visible normals at the coat's roughness. Over a Lambert base half the
+// draws are cosine-weighted (the body), half go to the coat's highlight,
+// which is faint in energy (F0 ≈ 4 %) but holds the studio's lamps; over a
+// conductor base the light that matters left through the coat from the
+// base's lobe, which refraction widens by about η, so the lobe is the wider
+// of the two and the cosine keeps its least share.
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    let ax = pf(o + COATED_ALPHA_X);
+    let ay = pf(o + COATED_ALPHA_Y);
+    if (pu(o + COATED_BASE) == COATED_BASE_CONDUCTOR) {
+        let b = min(pf(o + COATED_BASE_ALPHA) * pf(o + COATED_ETA), 1.0);
+        return ggx_lobe(0.1, max(ax, b), max(ay, b));
+    }
+    return ggx_lobe(0.5, ax, ay);
 }

@@ -173,7 +173,8 @@ pub static INFO: ModelInfo = ModelInfo {
             "shaders/models/coated.wgsl",
             include_str!("../../../../shaders/models/coated.wgsl"),
         )
-        .with_derived(DERIVED_SLOTS, derive_slots),
+        .with_derived(DERIVED_SLOTS, derive_slots)
+        .with_sampling_lobe(),
     ),
 };
 
