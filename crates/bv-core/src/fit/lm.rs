@@ -2,14 +2,17 @@
 //! parameters `t` (the fit maps them into the declared ranges), with a
 //! central-difference Jacobian.
 //!
-//! Why our own rather than a crate: the `levenberg-marquardt` crate (0.14)
-//! brings `nalgebra` (and its `simba`/`num` tree) into a core that has no
-//! linear-algebra dependency, for a problem of at most a dozen unknowns
-//! whose normal equations a 20-line Cholesky solves; `argmin` (0.10) has no
-//! Levenberg–Marquardt of its own (its Gauss–Newton line search needs an
-//! `argmin-math` back end, again nalgebra or ndarray). What the fit needs
-//! besides — a cancel flag checked every step, progress, a Jacobian by
-//! differences of f32 batch evaluations — neither crate gives.
+//! Why our own rather than a crate: `levenberg-marquardt` (0.14, a port of
+//! MINPACK's `lmder`) is well kept but built on `nalgebra` (with its
+//! `simba`/`num` tree), which this core does not otherwise use, for a
+//! problem of at most a dozen unknowns whose normal equations a 20-line
+//! Cholesky solves; it wants an analytic Jacobian (its numeric one is for
+//! testing) and has no hook to stop early but a failing residual call.
+//! `argmin` (0.10) lists Gauss–Newton (with a line search) but no
+//! Levenberg–Marquardt, and needs an `argmin-math` back end (nalgebra or
+//! ndarray again). What the fit needs besides — a cancel flag read every
+//! step, progress, a Jacobian by differences of f32 batch evaluations — is
+//! a few lines here.
 //!
 //! The method is Marquardt's (1963, "An Algorithm for Least-Squares
 //! Estimation of Nonlinear Parameters", SIAM J. Appl. Math. 11(2), eq. 8 and

@@ -103,7 +103,7 @@ pub struct FitResult {
     pub error: f64,
     /// Its error at the first start (the given values), for comparison.
     pub initial_error: f64,
-    /// The error per 10° band of θi.
+    /// The error per 10° band of θi, up to the sample set's grazing cut.
     pub residuals: Vec<ThetaResidual>,
     /// The unknowns, as `name` or `name[channel]`.
     pub unknowns: Vec<String>,
@@ -301,6 +301,7 @@ struct Problem {
     metric: Metric,
     sqrt_w: Vec<f64>,
     target_g: [Vec<f64>; 3],
+    max_theta_deg: f64,
 }
 
 impl Problem {
@@ -333,6 +334,7 @@ impl Problem {
             metric,
             sqrt_w,
             target_g,
+            max_theta_deg: samples.max_theta_deg,
         })
     }
 
@@ -352,10 +354,11 @@ impl Problem {
         );
     }
 
-    /// The error per 10° band of θi, from a residual vector.
+    /// The error per 10° band of θi, from a residual vector (bands up to
+    /// the grazing cut).
     fn bands(&self, r: &[f64]) -> Vec<ThetaResidual> {
         let n = self.set.len();
-        let bands = 9;
+        let bands = ((self.max_theta_deg / 10.0).ceil() as usize).clamp(1, 9);
         let mut sum = vec![0.0; bands];
         let mut w = vec![0.0; bands];
         let mut count = vec![0usize; bands];
