@@ -150,7 +150,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let started = Instant::now();
     let mut last_start = usize::MAX;
     let mut progress = |p: &FitProgress| {
-        if p.start != last_start || p.iteration % 10 == 0 {
+        if p.start != last_start || p.iteration.is_multiple_of(10) {
             last_start = p.start;
             eprint(&format!(
                 "bv fit: start {}/{}, iteration {}: error {:.6}\n",
