@@ -204,7 +204,10 @@ fn bad_input_is_refused_with_a_message() {
             vec!["fit", "-m", "nope", "--to", "lambert"],
             "unknown model `nope`",
         ),
-        (vec!["fit", "-m", "lambert", "--to", "nope"], "--to nope: unknown model `nope`"),
+        (
+            vec!["fit", "-m", "lambert", "--to", "nope"],
+            "--to nope: unknown model `nope`",
+        ),
         (
             vec!["fit", "-m", "lambert", "--to", missing.to_str().unwrap()],
             "nothing.binary",
