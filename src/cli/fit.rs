@@ -186,7 +186,8 @@ pub fn run(args: &FitArgs) -> Result<()> {
             )),
         );
         state.selected = Some(fitted);
-        scene::save(out, &state).with_context(|| format!("writing {}", out.display()))?;
+        // The error names the file (as `bv scene new`'s does).
+        scene::save(out, &state)?;
         eprint(&format!("bv fit: wrote {}\n", out.display()));
     }
 
