@@ -196,6 +196,46 @@ fn cook_torrance_fitted_to_an_rgl_file() {
 }
 
 #[test]
+fn cook_torrance_recovered_from_a_user_brdf_file() {
+    // tests/data/brdf/cooktorrance.brdf is bv's Cook-Torrance with Beckmann
+    // D, v-groove G and Schlick F, in GLSL run by the interpreter (f64):
+    // its `m` is α.
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/brdf/cooktorrance.brdf"
+    );
+    let v = json_of(&bv(&[
+        "fit",
+        "-m",
+        "cook-torrance",
+        "-p",
+        "fresnel=schlick",
+        "--free",
+        "kd,ks,alpha",
+        "--to",
+        file,
+        "--to-param",
+        "m=0.12",
+        "--to-param",
+        "ks=0.4",
+        "--to-param",
+        "kd=0.1,0.2,0.3",
+        "--json",
+    ]));
+    let p = &v["params"];
+    assert!(rel(p["alpha_x"].as_f64().unwrap(), 0.12) < 0.01, "{p}");
+    assert!(rel(p["ks"].as_f64().unwrap(), 0.4) < 0.01, "{p}");
+    for (c, want) in [0.1, 0.2, 0.3].into_iter().enumerate() {
+        assert!(rel(p["kd"][c].as_f64().unwrap(), want) < 0.01, "{p}");
+    }
+    let (e, e0) = (
+        v["error"].as_f64().unwrap(),
+        v["initial_error"].as_f64().unwrap(),
+    );
+    assert!(e < 1e-4 * e0, "error {e} from {e0}");
+}
+
+#[test]
 fn bad_input_is_refused_with_a_message() {
     let dir = temp_dir("bad");
     let missing = dir.join("nothing.binary");

@@ -122,6 +122,16 @@ pub fn run(args: &FitArgs) -> Result<()> {
             model.id()
         );
     }
+    // A file target is shown by its file name, a model by its id.
+    let target_name = match target.model().file_param() {
+        Some(_) => std::path::Path::new(args.to.trim())
+            .file_name()
+            .map_or_else(
+                || target.id().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            ),
+        None => target.id().to_string(),
+    };
     let free_refs: Vec<&str> = free.iter().map(String::as_str).collect();
     let target_brdf = target
         .build()
@@ -175,7 +185,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
 
     if let Some(out) = &args.out {
         let mut state = AppState::default();
-        state.add_named(target.clone(), Some(format!("target: {}", target.id())));
+        state.add_named(target.clone(), Some(format!("target: {target_name}")));
         let fitted = state.add_named(
             result.spec.clone(),
             Some(format!(
@@ -212,7 +222,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
         "fit of {} to {} ({} metric, {} pairs, {} starts, {} iterations, {:.2} s)\n\
          error {:.6} (from {:.6} at the given values)\nparams {}\n\nθi band      error     pairs\n",
         model.id(),
-        target.id(),
+        target_name,
         result.metric.name(),
         result.pairs,
         opts.starts,
