@@ -15,8 +15,10 @@
 //! a few lines here.
 //!
 //! The method is Marquardt's (1963, "An Algorithm for Least-Squares
-//! Estimation of Nonlinear Parameters", SIAM J. Appl. Math. 11(2), eq. 8 and
-//! the λ strategy of §4) with Moré's (1978) scaling: solve
+//! Estimation of Nonlinear Parameters", SIAM J. Appl. Math. 11(2): the
+//! damped normal equations and the λ up/down strategy) with Moré's (1978,
+//! "The Levenberg-Marquardt algorithm: implementation and theory") diagonal
+//! scaling: solve
 //! `(JᵀJ + λ diag(JᵀJ)) δ = −Jᵀr`, accept the step when the cost falls
 //! (λ /= 3), otherwise λ ×= 2 and solve again.
 

@@ -12,13 +12,13 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "lowercase")]
 pub enum Metric {
     /// Ngan et al. 2005 ("Experimental Analysis of BRDF Models", EGSR,
-    /// §4): the cube root of the cosine-weighted BRDF,
+    /// their fitting objective): the cube root of the cosine-weighted BRDF,
     /// `E = sqrt(Σ w (∛(f_t cos θi) − ∛(f_m cos θi))² / Σ w)`, `w` the solid
     /// angle weight of each sample. The cube root compresses the specular
     /// peak so that the diffuse part and the lobe's tails still count.
     Ngan,
     /// Löw et al. 2012 ("BRDF Models for Accurate and Efficient Rendering of
-    /// Glossy Surfaces", ACM TOG 31(1), §5.1, the metric E2):
+    /// Glossy Surfaces", ACM TOG 31(1), the metric they call E2):
     /// `E2 = sqrt(Σ w (ln(1 + f_t cos θi) − ln(1 + f_m cos θi))² / Σ w)`,
     /// relative for large values, absolute for small ones.
     E2,

@@ -24,6 +24,14 @@
 //! - **Starts.** Start 0 is the given spec's values; the others are points
 //!   of an additive recurrence (Roberts' R_d sequence) in the middle 80 % of
 //!   each unknown's σ range. The best result wins.
+//! - **Conditioning.** Parameters that only scale the same thing together
+//!   cannot all be recovered: Cook-Torrance's `ks` with a dielectric
+//!   Fresnel's `eta` (the data fixes `ks F0(η)`, the angular shape of F
+//!   barely), `alpha2` while `weight2` is 0 (no effect at all). The fit
+//!   still returns a point of lowest error (a zero column of the Jacobian
+//!   leaves its unknown where it is); fix such parameters with `-p` for
+//!   meaningful values. Roughness, exponents, `ks` and `kd` of one lobe
+//!   over a diffuse base are well conditioned (`tests/fit.rs`).
 //! - **Cancel and progress.** An `AtomicBool` is read before every Jacobian
 //!   and every trial step; the progress callback hears every iteration.
 

@@ -11,11 +11,12 @@
 //! no random numbers, the same pairs on every run and machine.
 //!
 //! Each pair carries its share of the measure dωi dωo = 4 cos θd dωh dωd
-//! (Rusinkiewicz 1998, §3.1: wo is wi reflected about h, and
-//! |∂ωo/∂ωh| = 4 (wi·h)), so that a sum over the set approximates an integral
-//! over pairs of directions. Pairs with θi or θo beyond [`SampleOptions::max_theta_deg`]
-//! (80° by default: Ngan et al. 2005, §4, leave out grazing data, the least
-//! reliable part of a measurement) are dropped.
+//! (wo is wi reflected about h, and |∂ωo/∂ωh| = 4 (wi·h): Walter et al.
+//! 2007, eq. 14; dωd = dωi at fixed h, a rotation), so that a sum over the
+//! set approximates an integral over pairs of directions. Pairs with θi or
+//! θo beyond [`SampleOptions::max_theta_deg`] (80° by default: Ngan et al. 2005 ignore data beyond 80°, as the later
+//! "Addressing grazing angle reflections in Phong models" recalls:
+//! grazing data is the least reliable part of a measurement) are dropped.
 
 use crate::batch::PairBuf;
 use glam::DVec3;
@@ -134,7 +135,7 @@ impl SampleSet {
     }
 }
 
-/// (wi, wo) from half/difference angles (Rusinkiewicz 1998, §3): the
+/// (wi, wo) from half/difference angles (Rusinkiewicz 1998): the
 /// difference vector rotated from the half vector's frame to the surface's.
 pub fn from_half_diff(theta_h: f64, phi_h: f64, theta_d: f64, phi_d: f64) -> (DVec3, DVec3) {
     let d = DVec3::new(
