@@ -534,9 +534,16 @@ mod tests {
                 let x = map.value(t);
                 assert!((map.min..=map.max).contains(&x), "{t} → {x}");
             }
-            for x in [0.01, 0.3, 0.9] {
+            for x in [0.05, 0.3, 0.9] {
                 let back = map.value(map.param(x));
                 assert!((back - x).abs() < 1e-9 * x.max(1.0), "{x} → {back}");
+            }
+            // A value on a bound (or below a log map's floor, max · 1e-6)
+            // starts just inside it: σ is kept within [1e-6, 1 − 1e-6].
+            for x in [map.min, map.max] {
+                let back = map.value(map.param(x));
+                let span = if map.log { map.max } else { map.max - map.min };
+                assert!((back - x).abs() <= 2e-5 * span, "{x} → {back}");
             }
         }
     }
