@@ -291,6 +291,17 @@ fn tabulate_never_replaces_what_it_must_not() {
 }
 
 #[test]
+fn fit_scene_never_replaces_what_it_must_not() {
+    check_writer(
+        "fit",
+        &[
+            "fit", "-m", "lambert", "--to", "lambert", "--starts", "1", "--out", "{}",
+        ],
+        ".toml",
+    );
+}
+
+#[test]
 fn render_svg_never_replaces_what_it_must_not() {
     // A 2D plot as SVG needs no GPU; it goes through the same writer as
     // every figure.

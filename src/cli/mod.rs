@@ -11,7 +11,8 @@
 //! - [`render`]: figures without a window (PNG, SVG, OBJ/PLY);
 //! - [`slice`]: the plotted curves as numbers (CSV);
 //! - [`scene`]: check, print and create scene files;
-//! - [`simulate`]: the virtual gonioreflectometer on a random microsurface.
+//! - [`simulate`]: the virtual gonioreflectometer on a random microsurface;
+//! - [`fit`]: a model's parameters fitted to measured data or another model.
 //!
 //! Errors are reported as `bv: <message>` on stderr with a non-zero exit
 //! status; nothing a user types makes the program panic.
@@ -20,6 +21,7 @@ pub mod bench;
 pub mod budget;
 pub mod check;
 pub mod eval;
+pub mod fit;
 pub mod info;
 pub mod models;
 pub mod output;
@@ -81,6 +83,8 @@ pub enum Command {
     Scene(scene::SceneArgs),
     /// Ray-trace a random microsurface: G1, NDF, BRDF and ρhd against the analytic model.
     Simulate(simulate::SimulateArgs),
+    /// Fit a model's parameters to a measured file, a user file or another model.
+    Fit(fit::FitArgs),
 }
 
 /// What the command line needs from the window above it: the binary wires
@@ -124,6 +128,7 @@ pub fn main(shell: &Shell) -> ExitCode {
         Some(Command::Render(a)) => render::run(a, shell).map(|()| ExitCode::SUCCESS),
         Some(Command::Slice(a)) => slice::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Simulate(a)) => simulate::run(a),
+        Some(Command::Fit(a)) => fit::run(a).map(|()| ExitCode::SUCCESS),
         Some(Command::Scene(a)) => {
             let argv: Vec<String> = std::env::args().collect();
             scene::run(a, &argv).map(|()| ExitCode::SUCCESS)

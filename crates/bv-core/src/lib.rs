@@ -15,6 +15,7 @@ pub mod analysis;
 pub mod batch;
 pub mod brdf;
 pub mod error;
+pub mod fit;
 pub mod frame;
 pub mod fresnel;
 pub mod fsio;
