@@ -14,10 +14,11 @@ skipped. For each file, one task computes its directional albedo ρhd at the
 (energy, reciprocity). For each (file, model) pair, one task computes the
 model's albedo at the same angles and how far the model is from the file:
 the RMS difference of log(1 + f·cos θo) over a fixed set of direction
-pairs (the quantity a fit would minimise). bv has no fitting yet (issue 30
-names `bv.fit` for when it lands): the models keep the parameters given
-here, so the distance ranks models at those parameters, and a fitting task
-would replace the pair task once it exists.
+pairs. With --fit, each pair task first fits the model's parameters to the
+file (`bv.fit`, Löw et al. 2012's E2 metric, the parameters given here as
+the start) and reports the fitted parameters, the fit's error and the
+fitted model's albedo and distance; without it the models keep the
+parameters given here, and the distance ranks them at those.
 
 On a real cluster every worker needs the `bv` module (`pip install
 ./python` from bv's repository) and must see the folder at the same path (a
@@ -56,6 +57,7 @@ COLUMNS = [
     "file",
     "model",
     "params",
+    "fit_error",
     "theta_i",
     "rho_file",
     "rho_file_err",
@@ -121,13 +123,21 @@ def file_task(path: str, thetas: Sequence[float]) -> Dict[str, Any]:
     }
 
 
-def pair_task(path: str, model: str, thetas: Sequence[float]) -> Dict[str, Any]:
-    """Per (file, model): the model's ρhd and error at each θi, and the RMS
-    difference of log(1 + f·cos θo) between model and file over every θi
-    and the fixed direction set."""
+def pair_task(
+    path: str, model: str, thetas: Sequence[float], fit: bool = False
+) -> Dict[str, Any]:
+    """Per (file, model): with ``fit``, the model fitted to the file first
+    (``bv.fit``, metric E2, one start at the given parameters); then the
+    model's ρhd and error at each θi, and the RMS difference of
+    log(1 + f·cos θo) between model and file over every θi and the fixed
+    direction set."""
     mid, params = parse_model(model)
     m = bv.Model(mid, **params)
     f = bv.Model(path)
+    fit_error = None
+    if fit:
+        r = bv.fit(m, to=f, metric="e2", starts=1)
+        m, fit_error = r.model, r.error
     rho, err = m.albedo(list(thetas))
     wo = directions()
     sq = [
@@ -137,6 +147,7 @@ def pair_task(path: str, model: str, thetas: Sequence[float]) -> Dict[str, Any]:
         "file": path,
         "model": mid,
         "params": m.params,
+        "fit_error": fit_error,
         "rho": rho.mean(axis=1).tolist(),
         "err": err.mean(axis=1).tolist(),
         "rms_log_diff": float(math.sqrt(np.mean(sq))),
@@ -156,10 +167,12 @@ def run_study(
     folder: str,
     models: Sequence[str] = DEFAULT_MODELS,
     thetas: Sequence[float] = DEFAULT_THETAS,
+    fit: bool = False,
 ) -> List[Dict[str, Any]]:
     """Submits one task per file and one per (file, model) pair to the
-    Dask ``client``, gathers them, and returns the table's rows (one per
-    pair and θi, in file, model, θi order)."""
+    Dask ``client`` (``fit``: each pair's model fitted to its file first),
+    gathers them, and returns the table's rows (one per pair and θi, in
+    file, model, θi order)."""
     if __name__ != "__main__":
         # Imported as a module (a test, a notebook): the tasks name its
         # functions by module, so the workers get this file (run as a
@@ -172,7 +185,8 @@ def run_study(
     per_file = client.map(file_task, files, thetas=thetas, pure=False)
     pairs = [(f, m) for f in files for m in models]
     per_pair = client.map(
-        pair_task, [f for f, _ in pairs], [m for _, m in pairs], thetas=thetas, pure=False
+        pair_task, [f for f, _ in pairs], [m for _, m in pairs], thetas=thetas, fit=fit,
+        pure=False,
     )
     file_rows = {r["file"]: r for r in client.gather(per_file)}
     rows = []
@@ -184,6 +198,7 @@ def run_study(
                     "file": os.path.basename(r["file"]),
                     "model": r["model"],
                     "params": " ".join(f"{k2}={v}" for k2, v in sorted(r["params"].items())),
+                    "fit_error": "" if r["fit_error"] is None else r["fit_error"],
                     "theta_i": t,
                     "rho_file": fr["rho"][k],
                     "rho_file_err": fr["err"][k],
@@ -217,6 +232,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                     f"default: {', '.join(DEFAULT_MODELS)})")
     ap.add_argument("--theta", type=float, action="append", dest="thetas",
                     help="light polar angle in degrees (repeatable; default 0, 30, 60)")
+    ap.add_argument("--fit", action="store_true",
+                    help="fit each model to each file first (bv.fit, metric E2)")
     ap.add_argument("--out", help="write the CSV table here (default: stdout)")
     a = ap.parse_args(argv)
 
@@ -244,7 +261,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         cluster = LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True)
         client = Client(cluster)
     try:
-        rows = run_study(client, a.folder, models, a.thetas or DEFAULT_THETAS)
+        rows = run_study(client, a.folder, models, a.thetas or DEFAULT_THETAS, fit=a.fit)
     finally:
         client.close()
         if cluster is not None:

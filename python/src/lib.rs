@@ -666,10 +666,98 @@ impl Scene {
     }
 }
 
+/// Fits the parameters `free` of `model` (its values are the first start
+/// and the fixed ones; `None`: `bv_core::fit::default_free`) to `target`
+/// with `bv_core::fit::fit`, as `bv fit` does, the GIL released. Returns
+/// the fitted model and the result as JSON (what `bv fit --json` prints,
+/// less the timing).
+#[pyfunction]
+#[pyo3(signature = (model, target, free, metric, starts))]
+fn fit(
+    py: Python<'_>,
+    model: &Model,
+    target: &Model,
+    free: Option<Vec<String>>,
+    metric: &str,
+    starts: usize,
+) -> PyResult<(Model, String)> {
+    use bv_core::fit::{FitOptions, Metric};
+    let metric = match metric {
+        "ngan" => Metric::Ngan,
+        "e2" => Metric::E2,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "metric={other:?}: expected \"ngan\" (Ngan et al. 2005) or \"e2\" (Löw et al. 2012)"
+            )));
+        }
+    };
+    if !(1..=64).contains(&starts) {
+        return Err(PyValueError::new_err(format!(
+            "starts={starts}: expected 1 to 64"
+        )));
+    }
+    let free: Vec<String> = match free {
+        Some(list) => list,
+        None => bv_core::fit::default_free(&model.spec)
+            .into_iter()
+            .map(str::to_string)
+            .collect(),
+    };
+    if free.is_empty() {
+        return Err(PyValueError::new_err(format!(
+            "model `{}` has no float or colour parameter to fit",
+            model.spec.id()
+        )));
+    }
+    let opts = FitOptions {
+        metric,
+        starts,
+        ..FitOptions::default()
+    };
+    let spec = &model.spec;
+    let target_brdf = target.brdf.as_ref();
+    let result = py
+        .detach(|| {
+            let refs: Vec<&str> = free.iter().map(String::as_str).collect();
+            bv_core::fit::fit(
+                spec,
+                &refs,
+                target_brdf,
+                &opts,
+                &std::sync::atomic::AtomicBool::new(false),
+                &mut |_| {},
+            )
+        })
+        .map_err(bv_error)?;
+    let brdf = result.spec.build().map_err(bv_error)?;
+    let v = serde_json::json!({
+        "model": result.spec.id(),
+        "params": result.spec.params().to_json(),
+        "metric": result.metric.name(),
+        "error": result.error,
+        "initial_error": result.initial_error,
+        "residuals": result.residuals,
+        "free": result.unknowns,
+        "target": target.spec.to_json(),
+        "pairs": result.pairs,
+        "iterations": result.iterations,
+        "evaluations": result.evaluations,
+    });
+    let json = serde_json::to_string(&v).map_err(bv_error)?;
+    Ok((
+        Model {
+            spec: result.spec,
+            brdf,
+        },
+        json,
+    ))
+}
+
 /// The compiled half of the `bv` package (see `bv/__init__.py`).
 #[pymodule]
 #[pyo3(name = "_native")]
 fn bv_native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(fit, m)?)?;
     m.add_function(wrap_pyfunction!(models_json, m)?)?;
     m.add_function(wrap_pyfunction!(render, m)?)?;
     m.add_function(wrap_pyfunction!(render_scene, m)?)?;

@@ -142,3 +142,25 @@ def test_study_as_a_command(folder, tmp_path):
         capture_output=True, text=True, timeout=600,
     )
     assert p.returncode != 0 and "NAME=VALUE" in p.stderr
+
+
+def test_study_fits_each_model_to_each_file(tmp_path):
+    """With fit=True each pair's model is fitted to its file on a worker:
+    Lambert fitted to the Lambert file lands on the file's own albedo (the
+    fit error and the distance drop to ~0), as a direct bv.fit does."""
+    distributed = need("dask.distributed")
+    study = load_study()
+    shutil.copy(data("lambert.brdf"), tmp_path / "lambert.brdf")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        plain = study.run_study(client, str(tmp_path), ["lambert albedo=0.9"], [30.0])
+        fitted = study.run_study(client, str(tmp_path), ["lambert albedo=0.9"], [30.0], fit=True)
+    assert plain[0]["fit_error"] == "" and fitted[0]["fit_error"] != ""
+    direct = bv.fit(
+        bv.Model("lambert", albedo=0.9), to=bv.Model(str(data("lambert.brdf"))),
+        metric="e2", starts=1,
+    )
+    assert fitted[0]["fit_error"] == pytest.approx(direct.error, rel=1e-9)
+    assert fitted[0]["rms_log_diff"] < 1e-4 < plain[0]["rms_log_diff"]
+    assert fitted[0]["rho_model"] == pytest.approx(fitted[0]["rho_file"], abs=2e-3)

@@ -13,6 +13,7 @@ code as the ``bv`` command line::
     f = m.eval(wi, wo)                                  # (2, 3) float32, 1/sr per RGB channel
     rho, err = m.albedo([0, 30, 60])                    # ρhd with its error estimate
     report = m.check()                                  # the dict of `bv check --json`
+    r = bv.fit(bv.Model("ward"), to=m)                  # Ward's best fit to m (as `bv fit`)
     scene = bv.Scene([m, bv.Model("lambert")], theta_i=30)
     scene.save("two.toml")                              # a scene file (bv --scene two.toml)
     fig = bv.render(bv.Scene.load("two.toml"), view="polar")  # (H, W, 4) uint8, shown by Jupyter
@@ -39,7 +40,7 @@ import numpy as np
 
 from . import _native
 
-__all__ = ["Figure", "Model", "Scene", "models", "render"]
+__all__ = ["Figure", "FitResult", "Model", "Scene", "fit", "models", "render"]
 
 ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
 
@@ -192,6 +193,65 @@ class Model:
         kernel for this model, and on which instruction set (``"scalar"``
         when it falls back to the f64 code lane by lane)."""
         return self._m.dispatch()
+
+
+class FitResult:
+    """What :func:`fit` found: the fitted ``model`` (a :class:`Model`), its
+    ``error`` under ``metric`` (and ``initial_error`` at the given values),
+    the error per 10° band of θi (``residuals``: dicts with ``theta_i_min``,
+    ``theta_i_max``, ``error``, ``samples``), the fitted unknowns (``free``;
+    a colour counts three), and the effort (``iterations``, ``evaluations``
+    over ``pairs`` direction pairs). ``report`` is the whole dict, as
+    ``bv fit --json`` prints it."""
+
+    def __init__(self, model: "Model", report: Dict[str, Any]) -> None:
+        self.model = model
+        self.report = report
+        self.metric: str = report["metric"]
+        self.error: float = report["error"]
+        self.initial_error: float = report["initial_error"]
+        self.residuals: List[Dict[str, Any]] = report["residuals"]
+        self.free: List[str] = report["free"]
+        self.iterations: int = report["iterations"]
+        self.evaluations: int = report["evaluations"]
+        self.pairs: int = report["pairs"]
+
+    def __repr__(self) -> str:
+        return f"FitResult({self.model!r}, {self.metric} error {self.error:.6g})"
+
+
+def fit(
+    model: "Model",
+    to: "Model",
+    free: Union[None, str, Sequence[str]] = None,
+    metric: str = "ngan",
+    starts: int = 4,
+) -> FitResult:
+    """Fits the parameters ``free`` of ``model`` to the BRDF ``to`` (any
+    :class:`Model`: a catalogue model with parameters, a ``.brdf`` file, a
+    MERL or RGL file) by Levenberg–Marquardt over bv's fixed set of
+    direction pairs, exactly as ``bv fit`` does (bv-core's ``fit`` module).
+
+    ``model``'s own values are the first starting point and the values of
+    the parameters that are not free. ``free``: parameter ids (or an alias
+    such as ``"alpha"``), as a list or a comma-separated string; default,
+    every float and colour parameter that applies. ``metric``: ``"ngan"``
+    (Ngan et al. 2005, the cube root of f cos θi) or ``"e2"`` (Löw et al.
+    2012, ln(1 + f cos θi)). ``starts``: 1 to 64 deterministic starting
+    points. A fit never leaves the parameters' declared ranges.
+    """
+    if not isinstance(model, Model) or not isinstance(to, Model):
+        raise ValueError("fit(model, to): both must be bv.Model objects")
+    if isinstance(free, str):
+        free = [f.strip() for f in free.split(",") if f.strip()]
+    elif free is not None:
+        free = [str(f) for f in free]
+    try:
+        n = int(starts)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"starts must be an integer: {e}") from None
+    native, report = _native.fit(model._m, to._m, free, str(metric), n)
+    return FitResult(_model_of(native), json.loads(report))
 
 
 def _model_of(native: Any) -> "Model":

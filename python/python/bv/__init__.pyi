@@ -109,3 +109,29 @@ def render(
     scale: float | None = None,
 ) -> Figure:
     """One view of a model, or of a whole scene, as `bv render --view VIEW` draws it."""
+
+
+class FitResult:
+    """What :func:`fit` found (see ``bv.fit``)."""
+
+    model: Model
+    report: Dict[str, Any]
+    metric: str
+    error: float
+    initial_error: float
+    residuals: List[Dict[str, Any]]
+    free: List[str]
+    iterations: int
+    evaluations: int
+    pairs: int
+    def __init__(self, model: Model, report: Dict[str, Any]) -> None: ...
+
+def fit(
+    model: Model,
+    to: Model,
+    free: Union[None, str, Sequence[str]] = ...,
+    metric: str = ...,
+    starts: int = ...,
+) -> FitResult:
+    """Fits the parameters ``free`` of ``model`` to ``to`` as ``bv fit`` does."""
+    ...
