@@ -1170,9 +1170,16 @@ pub fn interface_marks(scene: &Scene<'_>, outer: f64, dark: bool) -> Vec<Mark> {
         }
         _ => {}
     }
+    // Which BRDF the interface is, when there is more than one to tell
+    // apart (a panel of small multiples names its BRDF in its title).
+    let text = if scene.brdfs.len() > 1 {
+        format!("η {eta:.3} ({label})")
+    } else {
+        format!("η {eta:.3}")
+    };
     out.push(Mark::Text {
         at: [-outer * 1.25, -outer * 0.06],
-        text: format!("η {eta:.3} ({label})"),
+        text,
         color: window_line,
     });
     out
