@@ -154,6 +154,34 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
                 width,
                 dash: None,
             });
+            // A transmitting interface: what it passes, 1 − F, and its
+            // reflectance for light arriving from inside, which reaches 1
+            // (total internal reflection) at the critical angle (issue 33).
+            if b.brdf.transmits()
+                && matches!(fr.fresnel, bv_core::fresnel::Fresnel::Dielectric { .. })
+            {
+                let f_of = |c: f64| bv_core::mean_rgb(fr.fresnel.eval(c));
+                f_series.push(Series {
+                    label: format!("{}: 1 − F, transmitted", b.label),
+                    color,
+                    points: xs
+                        .iter()
+                        .map(|&x| [x, 1.0 - f_of(x.to_radians().cos())])
+                        .collect(),
+                    width: width - 0.6,
+                    dash: Some(3.0),
+                });
+                f_series.push(Series {
+                    label: format!("{}: F from inside", b.label),
+                    color,
+                    points: xs
+                        .iter()
+                        .map(|&x| [x, f_of(-x.to_radians().cos())])
+                        .collect(),
+                    width: width - 0.6,
+                    dash: Some(9.0),
+                });
+            }
         }
     }
     if scene.brdfs.is_empty() {
@@ -285,12 +313,10 @@ fn legend_corner(c: &Chart) -> Corner {
     }
 }
 
-/// Draws a chart with egui_plot into `size` points; presenting, its legend
-/// is a column `legend_w` wide (of the width) beside it (over a plot that
-/// short it covered the curves).
-/// Draws chart `c` with egui_plot in `size` (`log_y`: the values are
-/// log10, labelled as decades; `legend_w`: a side legend's width when
-/// presenting). The term charts and the microsurface view's NDF use it.
+/// Draws chart `c` with egui_plot into `size` points (`log_y`: the values
+/// are log10, labelled as decades); presenting, its legend is a column
+/// `legend_w` wide beside it (over a plot that short it covered the
+/// curves). The term charts and the microsurface view's NDF use it.
 pub fn plot_chart(
     ui: &mut Ui,
     id: egui::Id,
@@ -493,6 +519,47 @@ mod tests {
                 selected: k == 0,
             })
             .collect()
+    }
+
+    #[test]
+    fn a_transmitting_interface_shows_what_it_passes_and_its_tir() {
+        let state = AppState::default();
+        let rd = ModelSpec::from_json(
+            "rough-dielectric",
+            &serde_json::json!({"alpha": 0.3, "eta": 1.5}),
+        )
+        .unwrap();
+        let scene = Scene {
+            state: &state,
+            brdfs: scene_of(&state, &[rd]),
+            incident: crate::session::state::Incident {
+                theta_deg: 30.0,
+                phi_deg: 0.0,
+            },
+            interacting: false,
+            figure: true,
+            transparent: false,
+            line_scale: 1.0,
+            presenting: false,
+        };
+        let c = term_charts(&scene, TermToggles::default(), true);
+        let f = c.f.unwrap();
+        assert_eq!(f.series.len(), 3);
+        let at = |s: &Series, x: f64| {
+            s.points
+                .iter()
+                .min_by(|a, b| (a[0] - x).abs().total_cmp(&(b[0] - x).abs()))
+                .unwrap()[1]
+        };
+        // F + (1 − F) = 1; from inside, F(0) is the same 4 % and TIR sets
+        // in past θc = asin(1/1.5) = 41.8°.
+        for x in [0.0, 20.0, 60.0] {
+            assert!((at(&f.series[0], x) + at(&f.series[1], x) - 1.0).abs() < 1e-12);
+        }
+        assert!((at(&f.series[2], 0.0) - 0.04).abs() < 1e-12);
+        let theta_c = (1.0f64 / 1.5).asin().to_degrees();
+        assert!(at(&f.series[2], theta_c + 1.0) == 1.0);
+        assert!(at(&f.series[2], theta_c - 2.0) < 1.0);
     }
 
     #[test]
