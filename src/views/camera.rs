@@ -12,6 +12,15 @@ pub const FOV_Y_DEG: f32 = 30.0;
 /// unit height sits in the middle of the view.
 pub const TARGET: Vec3 = Vec3::new(0.0, 0.0, 0.35);
 
+/// The point the camera orbits when the view shows the whole sphere (light
+/// from below, or a model that transmits): the origin, so that what lies
+/// below the surface is framed as well as what lies above.
+pub const WHOLE_TARGET: Vec3 = Vec3::ZERO;
+
+/// How much farther the eye stands when framing the whole sphere: the scene
+/// then reaches about 1.2 units below the target as well as above.
+pub const WHOLE_ZOOM_OUT: f32 = 1.3;
+
 /// Matrices of one frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraMatrices {
@@ -24,10 +33,25 @@ pub struct CameraMatrices {
 }
 
 impl CameraMatrices {
-    /// Matrices of `cam` for a viewport of `width × height`.
+    /// Matrices of `cam` for a viewport of `width × height`, framing the
+    /// upper hemisphere.
     pub fn new(cam: &Camera, width: f32, height: f32) -> Self {
-        let eye = eye_position(cam);
-        let view = glam::camera::rh::view::look_at_mat4(eye, TARGET, Vec3::Z);
+        Self::framed(cam, width, height, false)
+    }
+
+    /// Matrices of `cam` for a viewport of `width × height`; `whole`: frame
+    /// the whole sphere (about [`WHOLE_TARGET`], [`WHOLE_ZOOM_OUT`] farther
+    /// away) rather than the upper hemisphere.
+    pub fn framed(cam: &Camera, width: f32, height: f32, whole: bool) -> Self {
+        let (target, eye) = if whole {
+            (
+                WHOLE_TARGET,
+                WHOLE_TARGET + (eye_position(cam) - TARGET) * WHOLE_ZOOM_OUT,
+            )
+        } else {
+            (TARGET, eye_position(cam))
+        };
+        let view = glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Z);
         let aspect = (width / height.max(1.0)).max(1e-3);
         // In a portrait viewport widen the vertical field so that the
         // horizontal one is a quarter wider than FOV_Y_DEG: the scene (axes and
@@ -118,6 +142,31 @@ pub fn pick_hemisphere(origin: Vec3, dir: Vec3) -> Option<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_whole_sphere_fits_the_view_when_framed_for_it() {
+        // The tail of the light's arrow (1.6 units) at θi = 140° and the
+        // lobes' unit sphere: outside the upper framing, inside the whole one.
+        let (w, h) = (1200.0, 800.0);
+        let t = 140f32.to_radians();
+        let below = Vec3::new(t.sin(), 0.0, t.cos()) * 1.6;
+        let inside = |m: &CameraMatrices, p: Vec3| {
+            m.project(p)
+                .is_some_and(|s| s[0] >= 0.0 && s[0] <= w && s[1] >= 0.0 && s[1] <= h)
+        };
+        let upper = CameraMatrices::new(&Camera::default(), w, h);
+        let whole = CameraMatrices::framed(&Camera::default(), w, h, true);
+        assert!(!inside(&upper, below));
+        for p in [
+            below,
+            Vec3::Z * 1.2,
+            Vec3::NEG_Z * 1.2,
+            Vec3::X * 1.4,
+            Vec3::NEG_X * 1.4,
+        ] {
+            assert!(inside(&whole, p), "{p}");
+        }
+    }
 
     #[test]
     fn target_projects_to_the_centre() {

@@ -238,7 +238,7 @@ impl Lobe3dView {
         let scale = self.scale_for(scene);
         self.last_scale = scale;
         let d = scene.state.display;
-        let cam = CameraMatrices::new(&scene.state.camera, size.x, size.y);
+        let cam = CameraMatrices::framed(&scene.state.camera, size.x, size.y, whole_sphere(scene));
         let primary = scene.primary().map(|b| b.id);
         let sh = self
             .sh
@@ -729,7 +729,12 @@ impl View for Lobe3dView {
 
         // The frame's camera, with the viewport in points that projecting
         // labels and pointer rays needs.
-        let cam = CameraMatrices::new(&scene.state.camera, rect.width(), rect.height());
+        let cam = CameraMatrices::framed(
+            &scene.state.camera,
+            rect.width(),
+            rect.height(),
+            whole_sphere(scene),
+        );
         handle_input(ui, &response, rect, scene, &cam, out);
         self.overlays(ui, rect, scene, &cam, dark);
     }
@@ -954,6 +959,13 @@ impl Lobe3dView {
 }
 
 /// Text with a thin outline in the background colour, readable over the lobe.
+/// Whether the view frames the whole sphere: the light is below the
+/// surface, or a drawn model transmits (its lobe lies below). Issue 33:
+/// framed for the upper hemisphere, light from below ran off the view.
+fn whole_sphere(scene: &Scene<'_>) -> bool {
+    scene.incident.below() || scene.brdfs.iter().any(|b| b.brdf.transmits())
+}
+
 impl Lobe3dView {
     /// The gonioreflectometer's readings (`plots.gonio`) as dots with 2σ
     /// bars at their detector directions, on the lobes' radius scale: the
