@@ -30,8 +30,9 @@ impl SpherePoint {
 
 /// How the spheres of a view are arranged: `cols` tiles to a row, as many
 /// rows as needed, the last row's tiles centred. One row unless a grid makes
-/// the spheres at least [`Grid::GRID_GAIN`] times larger: four BRDFs side
-/// by side stay a row, Cook & Torrance's twelve materials become 6 × 2
+/// the spheres at least [`Grid::GRID_GAIN`] times larger: three or four
+/// BRDFs side by side stay a row, six on a slide become 3 × 2 (their labels
+/// fit), Cook & Torrance's twelve materials 6 × 2
 /// (LECTURE.md N5, small multiples). A function of the tile count and the
 /// image's aspect only, so the shaders (given `cols`), the CPU reference and
 /// the overlays drawn in points agree.
@@ -46,7 +47,7 @@ pub struct Grid {
 impl Grid {
     /// A grid is used only when its spheres are this much larger than one
     /// row's: a row reads left to right, and scenes with a few BRDFs keep it.
-    pub const GRID_GAIN: f64 = 1.25;
+    pub const GRID_GAIN: f64 = 1.15;
 
     /// The arrangement of `tiles` spheres in an image of `size`.
     pub fn new(tiles: usize, size: DVec2) -> Self {
