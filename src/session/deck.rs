@@ -160,9 +160,53 @@ pub struct Slide {
     pub state: AppState,
     /// Where the scene is kept.
     pub source: Source,
+    /// The entry's stand-ins (`[[scene.stand_in]]`) and what they replaced,
+    /// so that saving writes the entry back as it was read.
+    pub stand_ins: Option<StandIns>,
+}
+
+/// A deck entry's stand-ins as written and what they replaced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StandIns {
+    /// The `[[scene.stand_in]]` array as read.
+    pub raw: toml::Value,
+    /// The caption as written (without the notes of the stand-ins used).
+    pub caption: String,
+    /// The caption as shown (with them).
+    pub shown: String,
+    /// Each BRDF replaced: its id, its spec and name as written, and the
+    /// stand-in's spec drawn instead.
+    pub replaced: Vec<(u64, bv_core::ModelSpec, Option<String>, bv_core::ModelSpec)>,
 }
 
 impl Slide {
+    /// The scene as the deck keeps it: the BRDFs a stand-in replaces as
+    /// written (unless they were edited since), so that saving loses no
+    /// measured file.
+    pub fn state_to_save(&self) -> AppState {
+        let mut state = self.state.clone();
+        if let Some(si) = &self.stand_ins {
+            for (id, spec, name, stand) in &si.replaced {
+                if let Some(b) = state.brdfs.iter_mut().find(|b| b.id == *id)
+                    && b.spec == *stand
+                {
+                    b.spec = spec.clone();
+                    b.name = name.clone();
+                }
+            }
+        }
+        state
+    }
+
+    /// The caption as the deck keeps it (without stand-ins' notes, unless
+    /// it was edited since).
+    pub fn caption_to_save(&self) -> &str {
+        match &self.stand_ins {
+            Some(si) if self.caption == si.shown => &si.caption,
+            _ => &self.caption,
+        }
+    }
+
     /// A slide whose scene is kept in the deck; `view` must be a view id or
     /// alias.
     pub fn inline(title: &str, caption: &str, view: &str, mut state: AppState) -> Option<Self> {
@@ -175,6 +219,7 @@ impl Slide {
             view,
             state: state.sanitised(),
             source: Source::Inline,
+            stand_ins: None,
         })
     }
 }
@@ -207,7 +252,9 @@ pub fn load(path: &Path, builds: Builds) -> Result<Loaded, DeckError> {
 }
 
 const HEADER_KEYS: &[&str] = &["format", "generator", "version", "title", "scene"];
-const ENTRY_KEYS: &[&str] = &["title", "caption", "view", "seed", "file", "state"];
+const ENTRY_KEYS: &[&str] = &[
+    "title", "caption", "view", "seed", "file", "state", "stand_in",
+];
 
 /// Most headings one scene's `seed` names.
 pub const MAX_SEED_HEADINGS: usize = 16;
@@ -363,6 +410,18 @@ fn entry(
         ));
     };
     let prefix = format!("scene[{i}] (\"{}\")", quote(&title_text));
+    let stand_ins = match t.get("stand_in") {
+        None => Vec::new(),
+        Some(v) => stand_ins(v).map_err(|r| bad("stand_in", r))?,
+    };
+    // With stand-ins a BRDF that cannot be built (its file is missing) is
+    // replaced below rather than refusing the scene.
+    let required = builds == Builds::Required;
+    let builds = if stand_ins.is_empty() {
+        builds
+    } else {
+        Builds::Warn
+    };
     let (loaded, source) = match (t.get("file"), t.get("state")) {
         (Some(_), Some(_)) => {
             return Err(bad(
@@ -416,15 +475,78 @@ fn entry(
             (loaded, Source::Inline)
         }
     };
+    let mut state = loaded.state;
+    let written_caption = caption.clone();
+    let mut caption = caption;
+    let mut replaced = Vec::new();
+    let mut record = Vec::new();
+    for si in &stand_ins {
+        let Some(k) = state.brdfs.iter().position(|b| b.id == si.id) else {
+            return Err(bad(
+                "stand_in",
+                format!("no BRDF with id {} in the scene", si.id),
+            ));
+        };
+        // The BRDF itself when it builds (its file is there); else the
+        // stand-in, named as such, and the slide says why.
+        if state.brdfs[k].spec.build().is_ok() {
+            continue;
+        }
+        record.push((
+            si.id,
+            state.brdfs[k].spec.clone(),
+            state.brdfs[k].name.clone(),
+            si.spec.clone(),
+        ));
+        state.brdfs[k].spec = si.spec.clone();
+        state.brdfs[k].name = Some(si.name.clone());
+        replaced.push(format!("brdfs[{k}]"));
+        caption = format!("{caption} [{}]", si.note);
+    }
+    if caption.chars().nth(MAX_TEXT_CHARS).is_some() {
+        return Err(bad(
+            "stand_in",
+            format!(
+                "the caption with the stand-in's note has {} characters; at most {MAX_TEXT_CHARS}",
+                caption.chars().count()
+            ),
+        ));
+    }
+    // Every other BRDF must still build, as `builds` asked.
+    if let Some((k, e)) = state
+        .brdfs
+        .iter()
+        .enumerate()
+        .find_map(|(k, b)| b.spec.build().err().map(|e| (k, e)))
+        && required
+        && !stand_ins.is_empty()
+    {
+        return Err(bad(
+            &format!("state.brdfs[{k}]"),
+            format!(
+                "the `{}` BRDF cannot be built: {e}",
+                state.brdfs[k].spec.id()
+            ),
+        ));
+    }
     for w in loaded.warnings {
+        // The warning about a BRDF a stand-in replaced is the caption's note.
+        if replaced.iter().any(|r| w.contains(&format!("`{r}`"))) {
+            continue;
+        }
         warnings.push(format!("{prefix}: {w}"));
     }
-    let mut state = loaded.state;
     state.maximised = Some(view.id.to_string());
     let mut source = source;
     if let Source::File { on_disk, .. } = &mut source {
         **on_disk = state.clone();
     }
+    let stand_ins = t.get("stand_in").map(|raw| StandIns {
+        raw: raw.clone(),
+        caption: written_caption,
+        shown: caption.clone(),
+        replaced: record,
+    });
     Ok(Slide {
         title: title_text,
         caption,
@@ -432,7 +554,75 @@ fn entry(
         view: view.id.to_string(),
         state,
         source,
+        stand_ins,
     })
+}
+
+/// A BRDF of a scene drawn instead when it cannot be built (LECTURE.md N7:
+/// a measured file the lecturer supplies, absent): the entry's
+/// `[[scene.stand_in]]` with the BRDF's `id`, the stand-in's `name` (its
+/// legend entry: say what it is), its `spec`, and the `note` appended to the
+/// caption when it is used.
+#[derive(Debug, Clone, PartialEq)]
+struct StandIn {
+    id: u64,
+    name: String,
+    spec: bv_core::ModelSpec,
+    note: String,
+}
+
+fn stand_ins(v: &toml::Value) -> Result<Vec<StandIn>, String> {
+    let Some(items) = v.as_array() else {
+        return Err("expected an array of tables ([[scene.stand_in]])".into());
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(k, item)| {
+            let at = |r: String| format!("[{k}]: {r}");
+            let t = item
+                .as_table()
+                .ok_or_else(|| at("expected a table".into()))?;
+            for key in t.keys() {
+                if !["id", "name", "spec", "note"].contains(&key.as_str()) {
+                    return Err(at(format!(
+                        "unknown key `{}` (id, name, spec, note)",
+                        quote(key)
+                    )));
+                }
+            }
+            let id = t
+                .get("id")
+                .and_then(toml::Value::as_integer)
+                .and_then(|i| u64::try_from(i).ok())
+                .ok_or_else(|| at("`id`: expected the BRDF's id".into()))?;
+            let text = |key: &str| match t.get(key) {
+                Some(v) => one_line(v).map_err(|r| at(format!("`{key}`: {r}"))),
+                None => Err(at(format!("`{key}`: missing"))),
+            };
+            let (name, note) = (text("name")?, text("note")?);
+            let spec_v = t.get("spec").ok_or_else(|| at("`spec`: missing".into()))?;
+            let json = serde_json::to_value(spec_v).map_err(|e| at(e.to_string()))?;
+            let model = json
+                .get("model")
+                .and_then(|m| m.as_str())
+                .ok_or_else(|| at("`spec.model`: missing".into()))?;
+            let params = json
+                .get("params")
+                .cloned()
+                .unwrap_or_else(|| serde_json::json!({}));
+            let spec = bv_core::ModelSpec::from_json(model, &params)
+                .map_err(|e| at(format!("`spec`: {e}")))?;
+            spec.build()
+                .map_err(|e| at(format!("the stand-in cannot be built: {e}")))?;
+            Ok(StandIn {
+                id,
+                name,
+                spec,
+                note,
+            })
+        })
+        .collect()
 }
 
 /// A title or caption: one line of at most [`MAX_TEXT_CHARS`] characters.
@@ -518,6 +708,8 @@ struct EntryOut<'a> {
     file: Option<&'a str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     state: Option<toml::Table>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stand_in: Option<&'a toml::Value>,
 }
 
 /// The deck as TOML text for a file at `path` (what [`save`] writes): inline
@@ -529,12 +721,13 @@ pub fn to_toml_for(path: &Path, deck: &Deck) -> Result<String, DeckError> {
         let state = match &s.source {
             Source::File { .. } => None,
             Source::Inline => {
-                let text = scene::to_toml_for(path, &s.state).map_err(|e| DeckError::Entry {
-                    entry: i,
-                    title: Some(s.title.clone()),
-                    key: "state".into(),
-                    reason: e.to_string(),
-                })?;
+                let text =
+                    scene::to_toml_for(path, &s.state_to_save()).map_err(|e| DeckError::Entry {
+                        entry: i,
+                        title: Some(s.title.clone()),
+                        key: "state".into(),
+                        reason: e.to_string(),
+                    })?;
                 let mut t: toml::Table = toml::from_str(&text)
                     .map_err(|e| DeckError::Syntax(e.to_string().trim().to_string()))?;
                 // The deck's header says what these say.
@@ -546,7 +739,7 @@ pub fn to_toml_for(path: &Path, deck: &Deck) -> Result<String, DeckError> {
         };
         entries.push(EntryOut {
             title: &s.title,
-            caption: &s.caption,
+            caption: s.caption_to_save(),
             view: &s.view,
             seed: match s.seed.as_slice() {
                 [] => None,
@@ -560,6 +753,7 @@ pub fn to_toml_for(path: &Path, deck: &Deck) -> Result<String, DeckError> {
                 Source::Inline => None,
             },
             state,
+            stand_in: s.stand_ins.as_ref().map(|si| &si.raw),
         });
     }
     let out = DeckOut {
@@ -590,11 +784,12 @@ pub fn to_toml_for(path: &Path, deck: &Deck) -> Result<String, DeckError> {
 /// the entries' `on_disk` copies are updated.
 pub fn save(path: &Path, deck: &mut Deck) -> Result<(), DeckError> {
     for (i, s) in deck.slides.iter_mut().enumerate() {
+        let keep = s.state_to_save();
         if let Source::File { path: rel, on_disk } = &mut s.source
             && **on_disk != s.state
         {
             let file = resolve(path.parent(), rel);
-            scene::save(&file, &s.state).map_err(|source| DeckError::SaveScene {
+            scene::save(&file, &keep).map_err(|source| DeckError::SaveScene {
                 entry: i,
                 path: file.clone(),
                 source,
@@ -653,6 +848,87 @@ mod tests {
         let _ = std::fs::remove_dir_all(&d);
         std::fs::create_dir_all(&d).unwrap();
         d
+    }
+
+    /// A scene's BRDF that cannot be built (its file is missing) is drawn
+    /// by its stand-in, named as such, with the note in the caption and no
+    /// warning; when the file is there, the BRDF itself is drawn.
+    #[test]
+    fn a_stand_in_replaces_a_missing_file_and_says_so() {
+        let dir = tmp_dir("stand-in");
+        let deck = r#"
+format = "bv-deck"
+version = 1
+[[scene]]
+title = "Measured"
+caption = "A measured material"
+view = "polar"
+[scene.state]
+[[scene.state.brdfs]]
+id = 7
+color = [78, 151, 234]
+visible = true
+name = "measured"
+spec = { model = "merl", params = { path = "table.binary" } }
+[[scene.stand_in]]
+id = 7
+name = "stand-in: Lambert 0.5"
+note = "table.binary is missing: a model stands in"
+spec = { model = "lambert", params = { albedo = 0.5 } }
+"#;
+        let path = dir.join("deck.toml");
+        std::fs::write(&path, deck).unwrap();
+        let l = load(&path, Builds::Required).unwrap();
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let s = &l.deck.slides[0];
+        assert_eq!(s.state.brdfs[0].spec.id(), "lambert");
+        assert_eq!(
+            s.state.brdfs[0].name.as_deref(),
+            Some("stand-in: Lambert 0.5")
+        );
+        assert!(
+            s.caption
+                .ends_with("[table.binary is missing: a model stands in]")
+        );
+        // Saving writes the entry back as it was read: the measured file,
+        // the stand-in table, the caption without the note.
+        let mut d = l.deck.clone();
+        save(&path, &mut d).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.contains("table.binary") && text.contains("[[scene.stand_in]]"),
+            "{text}"
+        );
+        assert!(!text.contains("a model stands in]"), "{text}");
+        let again = load(&path, Builds::Required).unwrap();
+        assert_eq!(again.deck.slides[0].state, l.deck.slides[0].state);
+        assert_eq!(again.deck.slides[0].caption, l.deck.slides[0].caption);
+        // With the file next to the deck (a small table), the file is drawn.
+        let lambert = ModelSpec::new("lambert").unwrap().build().unwrap();
+        let dims = bv_core::measured::merl::MerlDims::new(8, 8, 16).unwrap();
+        bv_core::measured::merl::tabulate(lambert.as_ref(), dims)
+            .unwrap()
+            .write(dir.join("table.binary"))
+            .unwrap();
+        let l = load(&path, Builds::Required).unwrap();
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        let s = &l.deck.slides[0];
+        assert_eq!(s.state.brdfs[0].spec.id(), "merl");
+        assert_eq!(s.state.brdfs[0].name.as_deref(), Some("measured"));
+        assert_eq!(s.caption, "A measured material");
+        // A stand-in for no BRDF, or one that cannot be built, is an error.
+        let bad = deck.replace("id = 7\nname = \"stand-in", "id = 8\nname = \"stand-in");
+        std::fs::write(&path, bad).unwrap();
+        assert!(
+            load(&path, Builds::Required)
+                .unwrap_err()
+                .to_string()
+                .contains("no BRDF with id 8")
+        );
+        let bad = deck.replace("albedo = 0.5", "albedo = 7.0");
+        std::fs::write(&path, bad).unwrap();
+        assert!(load(&path, Builds::Required).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     fn state(model: &str, theta: f64) -> AppState {
