@@ -237,7 +237,12 @@ impl FitJob {
     }
 }
 
-/// The name of a fitted BRDF: "Ward fit (ngan 0.031)".
+/// The name of a fitted BRDF: "Ward fit (Ngan 0.031)", after the model,
+/// the metric (Ngan et al. 2005 or Löw et al. 2012's E2) and its error.
 pub fn fitted_name(model_name: &str, r: &FitResult) -> String {
-    format!("{model_name} fit ({} {:.3})", r.metric.name(), r.error)
+    let metric = match r.metric {
+        Metric::Ngan => "Ngan",
+        Metric::E2 => "E2",
+    };
+    format!("{model_name} fit ({metric} {:.3})", r.error)
 }

@@ -1,0 +1,108 @@
+//! The *Fit…* panel in the window (egui_kittest, no GPU): opened by its key,
+//! driven by its accessible labels, it fits a model to a BRDF of the list and
+//! adds the fit as a new BRDF; a refused start says why.
+
+// Test code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bv::app::Viewer;
+use bv::app::fit_ui::add_command;
+use bv::session::Command;
+use bv::session::state::AppState;
+use bv_core::ModelSpec;
+use eframe::egui;
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use std::time::Duration;
+
+fn ward(alpha: &str) -> ModelSpec {
+    let mut s = ModelSpec::new("ward").unwrap();
+    s.set_str("alpha", alpha).unwrap();
+    s.set_str("ks", "0.3").unwrap();
+    s.set_str("kd", "0.4").unwrap();
+    s
+}
+
+fn viewer(state: AppState) -> Harness<'static, Viewer> {
+    let mut h = Harness::builder()
+        .with_size([1280.0, 800.0])
+        .with_max_steps(12)
+        .build_ui_state(|ui, v: &mut Viewer| v.ui(ui), Viewer::new(state));
+    h.run();
+    h
+}
+
+#[test]
+fn the_panel_fits_the_selected_brdf_and_adds_the_fit() {
+    let mut state = AppState::default();
+    let truth = ward("0.1");
+    state.add(truth.clone());
+    let mut h = viewer(state);
+    assert!(h.query_by_label("Start fit").is_none(), "closed at first");
+    h.key_press(egui::Key::F);
+    h.run();
+    h.get_by_label("Start fit").click();
+    // A spinner turns while the fit runs: single frames, not `run`.
+    h.step();
+    assert!(
+        h.state().fit.job().wait_idle(Duration::from_secs(300)),
+        "the fit did not finish"
+    );
+    for _ in 0..3 {
+        h.run();
+    }
+    let s = h.state().state();
+    assert_eq!(s.brdfs.len(), 2, "the fit is added beside its target");
+    let fit = &s.brdfs[1];
+    let name = fit.name.clone().unwrap();
+    assert!(name.starts_with("Ward fit (Ngan "), "{name}");
+    // Ward fitted to Ward from its defaults: the target's α.
+    let a = fit.spec.params().float("alpha_x").unwrap();
+    assert!((a / 0.1 - 1.0).abs() < 0.01, "alpha {a}");
+    assert_eq!(s.selected, Some(fit.id));
+    // The list and the panel show it; a later frame adds nothing more.
+    assert!(h.get_all_by_label(&name).count() >= 2);
+    h.run();
+    assert_eq!(h.state().state().brdfs.len(), 2);
+}
+
+#[test]
+fn a_start_without_free_parameters_is_refused_with_a_reason() {
+    let mut state = AppState::default();
+    state.add(ward("0.2"));
+    let mut h = viewer(state);
+    h.get_by_label("Fit…").click();
+    h.run();
+    for p in bv_core::fit::default_free(&ward("0.2")) {
+        h.get_by_label(&format!("Free {p}")).click();
+        h.run();
+    }
+    h.get_by_label("Start fit").click();
+    h.run();
+    h.get_by_label("choose at least one free parameter");
+    assert!(!h.state().fit.job().status().running);
+    assert_eq!(h.state().state().brdfs.len(), 1);
+}
+
+#[test]
+fn the_add_command_names_the_fit_after_model_metric_and_error() {
+    let target = ward("0.15");
+    let r = bv_core::fit::fit(
+        &ward("0.3"),
+        &["alpha"],
+        target.build().unwrap().as_ref(),
+        &bv_core::fit::FitOptions::default(),
+        &std::sync::atomic::AtomicBool::new(false),
+        &mut |_| {},
+    )
+    .unwrap();
+    let Command::AddNamed { name, spec } = add_command(&r) else {
+        panic!("not an AddNamed");
+    };
+    assert_eq!(name, format!("Ward fit (Ngan {:.3})", r.error));
+    assert_eq!(spec, r.spec);
+    let mut s = AppState::default();
+    let applied = Command::AddNamed { name, spec }.apply(&mut s);
+    assert!(applied.message.is_none());
+    assert_eq!(s.brdfs.len(), 1);
+}
