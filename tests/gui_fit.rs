@@ -106,3 +106,40 @@ fn the_add_command_names_the_fit_after_model_metric_and_error() {
     assert!(applied.message.is_none());
     assert_eq!(s.brdfs.len(), 1);
 }
+
+fn lambert(albedo: &str) -> ModelSpec {
+    let mut s = ModelSpec::new("lambert").unwrap();
+    s.set_str("albedo", albedo).unwrap();
+    s
+}
+
+/// The image slice's residual mode, switched on by its toggle: Lambert 0.5
+/// against Lambert 0.25 is +100 % everywhere above the horizon; a BRDF
+/// against itself, 0.
+#[test]
+fn the_residual_mode_shows_the_relative_error_against_the_reference() {
+    use bv::views::image_slice::ImageSliceView;
+    let mut state = AppState::default();
+    let quarter = state.add(lambert("0.25"));
+    let half = state.add(lambert("0.5"));
+    state.maximised = Some("slice".into());
+    let mut h = viewer(state);
+    h.get_by_label("residual").click();
+    h.run();
+    let v = h.state().view::<ImageSliceView>().unwrap();
+    assert!(v.settings.residual);
+    // The reference defaults to the first drawn BRDF, and only the other
+    // one is drawn as a residual.
+    assert_eq!(v.reference_id, Some(quarter));
+    assert_eq!(v.image_rects.len(), 1);
+    assert_eq!(v.image_rects[0].0, half);
+    let e = v.residual(half, quarter).unwrap();
+    let valid: Vec<f64> = e.iter().flatten().copied().collect();
+    assert!(valid.len() > 1000);
+    assert!(valid.iter().all(|x| (x - 1.0).abs() < 1e-6), "not +100 %");
+    let e = v.residual(quarter, quarter).unwrap();
+    assert!(e.iter().flatten().all(|x| *x == 0.0));
+    // The colour map's range is offered (the legend is painted, not a
+    // widget: see the screenshot in the report).
+    h.get_by_label("Residual range");
+}
