@@ -143,3 +143,89 @@ fn the_residual_mode_shows_the_relative_error_against_the_reference() {
     // widget: see the screenshot in the report).
     h.get_by_label("Residual range");
 }
+
+/// Just the image slice view (toolbar and image) over a state.
+struct SliceOnly {
+    state: AppState,
+    runtime: bv::session::runtime::Runtime,
+    view: bv::views::image_slice::ImageSliceView,
+}
+
+impl SliceOnly {
+    fn ui(&mut self, ui: &mut egui::Ui) {
+        use bv::views::View as _;
+        let scene = bv::session::build_scene(&self.state, &self.runtime, false);
+        let mut out = Vec::new();
+        egui::CentralPanel::default().show(ui, |ui| {
+            ui.horizontal(|ui| self.view.toolbar(ui, &scene, &mut out));
+            self.view.ui(ui, &scene, &mut out);
+        });
+    }
+}
+
+/// The residual mode drawn (lavapipe where there is no GPU): the deck's
+/// two-lobe Lafortune target against its Phong and Ward fits. Each tile
+/// shows both signs of error (blue and red pixels) and the hatching below
+/// the horizon is absent at φd = 90°. `BV_FIT_RESIDUAL_PNG=path` saves the
+/// image.
+#[test]
+fn headless_residual_tiles_show_both_signs() {
+    let json = |m: &str, p: serde_json::Value| ModelSpec::from_json(m, &p).unwrap();
+    let mut state = AppState::default();
+    let target = state.add(json(
+        "lafortune",
+        serde_json::json!({"kd": 0.1, "lobes": [
+            {"cx": -1.0, "cy": -1.0, "cz": 0.6, "n": 30.0, "ks": 0.6},
+            {"cx": 0.9, "cy": 0.9, "cz": 0.9, "n": 12.0, "ks": 0.05}]}),
+    ));
+    state.add(json(
+        "phong",
+        serde_json::json!({"kd": 0.0338, "ks": 0.0661, "e": 29.66}),
+    ));
+    state.add(json(
+        "ward",
+        serde_json::json!({"kd": 0.1061, "ks": 0.0213, "alpha": 0.2434}),
+    ));
+    let mut runtime = bv::session::runtime::Runtime::default();
+    runtime.sync(&state);
+    let mut view = bv::views::image_slice::ImageSliceView::default();
+    view.settings.residual = true;
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        eframe::egui_wgpu::RendererOptions::PREDICTABLE,
+    );
+    let mut h = Harness::builder()
+        .renderer(egui_kittest::wgpu::WgpuTestRenderer::from_render_state(rs))
+        .with_size([900.0, 480.0])
+        .build_ui_state(
+            |ui, s: &mut SliceOnly| s.ui(ui),
+            SliceOnly {
+                state,
+                runtime,
+                view,
+            },
+        );
+    h.run();
+    assert_eq!(h.state().view.reference_id, Some(target));
+    let rects = h.state().view.image_rects.clone();
+    assert_eq!(rects.len(), 2, "one tile per fit, none for the target");
+    let img = h.render().expect("render");
+    if let Some(path) = std::env::var_os("BV_FIT_RESIDUAL_PNG") {
+        img.save(path).unwrap();
+    }
+    for (_, r) in rects {
+        let (mut blue, mut red) = (0, 0);
+        for y in (r.min.y as u32 + 2..r.max.y as u32 - 2).step_by(3) {
+            for x in (r.min.x as u32 + 2..r.max.x as u32 - 2).step_by(3) {
+                let p = img.get_pixel(x, y).0;
+                if u16::from(p[2]) > u16::from(p[0]) + 40 {
+                    blue += 1;
+                }
+                if u16::from(p[0]) > u16::from(p[2]) + 40 {
+                    red += 1;
+                }
+            }
+        }
+        assert!(blue > 50 && red > 50, "blue {blue}, red {red}");
+    }
+}

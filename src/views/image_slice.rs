@@ -545,6 +545,16 @@ impl View for ImageSliceView {
             return;
         }
         let response = ui.allocate_rect(area, Sense::hover());
+        // The legend's band is the view's too: the readout goes below it.
+        if legend_h > 0.0 {
+            ui.allocate_rect(
+                Rect::from_min_size(
+                    Pos2::new(area.min.x, area.max.y),
+                    Vec2::new(area.width(), legend_h),
+                ),
+                Sense::hover(),
+            );
+        }
         let dark = ui.visuals().dark_mode;
         let shown: Vec<super::SceneBrdf> = self.shown(scene).into_iter().cloned().collect();
         let rects = tiles(area, shown.len());
