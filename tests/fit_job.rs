@@ -2,6 +2,9 @@
 //! model, reports progress, stops when cancelled, and restarts when the key
 //! changes.
 
+// Test code: a panic is how a failure is reported.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bv::derive::Waker;
 use bv::derive::fit::{FitJob, FitKey};
 use bv_core::ModelSpec;
