@@ -41,6 +41,8 @@ fn the_panel_fits_the_selected_brdf_and_adds_the_fit() {
     assert!(h.query_by_label("Start fit").is_none(), "closed at first");
     h.key_press(egui::Key::F);
     h.run();
+    h.state_mut().fit.set_model("ward");
+    h.run();
     h.get_by_label("Start fit").click();
     // A spinner turns while the fit runs: single frames, not `run`.
     h.step();
@@ -71,6 +73,7 @@ fn a_start_without_free_parameters_is_refused_with_a_reason() {
     let mut state = AppState::default();
     state.add(ward("0.2"));
     let mut h = viewer(state);
+    h.state_mut().fit.set_model("ward");
     h.get_by_label("Fit…").click();
     h.run();
     for p in bv_core::fit::default_free(&ward("0.2")) {

@@ -42,12 +42,14 @@ pub struct FitPanel {
 
 impl Default for FitPanel {
     fn default() -> Self {
+        // The first model of the catalogue with something to fit (no view
+        // code names a model).
         let cat = bv_core::catalogue();
         let model = cat
             .iter()
-            .find(|m| m.id == "ward")
-            .or_else(|| cat.first())
-            .map_or("lambert", |m| m.id);
+            .filter(|m| m.file_param().is_none())
+            .find(|m| ModelSpec::new(m.id).is_ok_and(|s| !default_free(&s).is_empty()))
+            .map_or("", |m| m.id);
         let mut p = Self {
             open: false,
             target: None,
@@ -86,9 +88,13 @@ impl FitPanel {
         &self.job
     }
 
-    /// Chooses the model fitted; its free parameters become
-    /// [`default_free`]'s.
-    fn set_model(&mut self, id: &'static str) {
+    /// Chooses the model fitted (a catalogue id; an unknown one changes
+    /// nothing); its free parameters become [`default_free`]'s.
+    pub fn set_model(&mut self, id: &str) {
+        let cat = bv_core::catalogue();
+        let Some(id) = cat.iter().find(|m| m.id == id).map(|m| m.id) else {
+            return;
+        };
         self.model = id;
         self.free = ModelSpec::new(id)
             .map(|s| default_free(&s).into_iter().map(|p| (p, true)).collect())
