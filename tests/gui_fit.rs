@@ -232,3 +232,65 @@ fn headless_residual_tiles_show_both_signs() {
         assert!(blue > 50 && red > 50, "blue {blue}, red {red}");
     }
 }
+
+/// While a fit runs, an edit of its target restarts it for the new values
+/// (the key changed); *Cancel fit* stops it and nothing is added.
+#[test]
+fn an_edited_target_restarts_the_fit_and_cancel_adds_nothing() {
+    let mut target = ModelSpec::new("cook-torrance").unwrap();
+    target.set_str("distribution", "ggx").unwrap();
+    target.set_str("alpha", "0.05").unwrap();
+    let mut state = AppState::default();
+    let id = state.add(target.clone());
+    let mut h = viewer(state);
+    {
+        let v = h.state_mut();
+        v.fit.set_model("cook-torrance");
+        // Far more work than the test waits for: it must be cancelled.
+        v.fit.options.starts = 64;
+        v.fit.options.max_iterations = 400;
+        v.fit.open = true;
+    }
+    h.run();
+    h.get_by_label("Start fit").click();
+    h.step();
+    let job = h.state().fit.job().clone();
+    let t0 = std::time::Instant::now();
+    while job.status().progress.is_none() {
+        assert!(t0.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(job.status().running);
+    h.state_mut().push(Command::SetParam {
+        brdf: id,
+        param: "alpha".into(),
+        value: bv_core::ParamValue::Float(0.3),
+    });
+    h.step();
+    h.step();
+    let st = job.status();
+    assert!(st.running, "restarted");
+    let key = st.key.unwrap();
+    assert_eq!(
+        key.target.params().float("alpha_x").unwrap(),
+        0.3,
+        "the new values"
+    );
+    assert_eq!(key.target, h.state().state().entry(id).unwrap().spec);
+    h.get_by_label("Cancel fit").click();
+    h.step();
+    assert!(
+        job.wait_idle(Duration::from_secs(60)),
+        "the fit did not stop"
+    );
+    for _ in 0..3 {
+        h.step();
+    }
+    assert!(!job.status().running);
+    assert_eq!(
+        h.state().state().brdfs.len(),
+        1,
+        "a cancelled fit adds nothing"
+    );
+    h.get_by_label("Start fit");
+}

@@ -38,6 +38,9 @@ pub struct FitPanel {
     added: bool,
     /// Why *Start* refused to start.
     refused: Option<String>,
+    /// How the fits run (starts, iterations, samples; the metric is the
+    /// panel's).
+    pub options: FitOptions,
 }
 
 impl Default for FitPanel {
@@ -60,6 +63,7 @@ impl Default for FitPanel {
             started: None,
             added: false,
             refused: None,
+            options: FitOptions::default(),
         };
         p.set_model(model);
         p
@@ -132,7 +136,7 @@ impl FitPanel {
     /// Starts the fit of the current settings (the *Start* button).
     pub fn start(&mut self, state: &AppState, waker: &crate::derive::Waker) -> Result<(), String> {
         let (key, id) = self.key(state)?;
-        self.job.start(key.clone(), FitOptions::default(), waker);
+        self.job.start(key.clone(), self.options.clone(), waker);
         self.started = Some((key, id));
         self.added = false;
         Ok(())
@@ -174,7 +178,7 @@ impl FitPanel {
                     ..key.clone()
                 };
                 let id = *id;
-                self.job.start(key.clone(), FitOptions::default(), waker);
+                self.job.start(key.clone(), self.options.clone(), waker);
                 self.started = Some((key, id));
             }
             Some(_) => {}
