@@ -18,7 +18,7 @@ use crate::session::platform;
 use bv_core::ModelSpec;
 use bv_core::fit::{self, FitOptions, FitProgress, FitResult, Metric};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, LazyLock, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
 /// What a fit depends on.
@@ -60,7 +60,8 @@ struct Inner {
     live: usize,
 }
 
-/// The fit job of a window (or a test): at most one fit at a time.
+/// The fit job of a window's *Fit…* panel (or a test): at most one fit at
+/// a time. Clones share the job.
 #[derive(Default, Clone)]
 pub struct FitJob {
     inner: Arc<Mutex<Inner>>,
@@ -70,12 +71,6 @@ impl std::fmt::Debug for FitJob {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("FitJob").finish_non_exhaustive()
     }
-}
-
-/// The process's fit job (the window's panel).
-pub fn job() -> FitJob {
-    static JOB: LazyLock<FitJob> = LazyLock::new(FitJob::default);
-    JOB.clone()
 }
 
 impl FitJob {
