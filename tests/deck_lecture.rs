@@ -114,7 +114,7 @@ fn every_scene_names_real_seed_slides_and_the_deck_covers_the_lecture() {
         100.0 * share
     );
     // What the deck covers today; it only grows (the goal is 90 %).
-    assert!(slides.len() >= 81, "{} scenes", slides.len());
+    assert!(slides.len() >= 82, "{} scenes", slides.len());
     assert!(covered.len() >= 53, "{} headings covered", covered.len());
     // In the seed's order: a scene's first heading never comes before the
     // previous scene's first one, by more than a part of the lecture

@@ -10,6 +10,7 @@
 //!   window once it has drawn and exits.
 
 pub mod badges;
+pub mod fit_ui;
 pub mod measured_ui;
 pub mod panel;
 pub mod presentation;
@@ -205,6 +206,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 },
             );
             let mut viewer = Viewer::new(state);
+            viewer.fit.open = args2.fit;
             for f in &args2.open {
                 viewer.push(Command::OpenFile {
                     path: f.display().to_string(),

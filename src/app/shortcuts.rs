@@ -43,6 +43,8 @@ pub enum Action {
     SaveScene,
     /// Open the figure export dialog.
     ExportFigure,
+    /// Open or close the *Fit…* panel.
+    ToggleFit,
     /// Quit.
     Quit,
     /// Enter or leave presentation mode.
@@ -178,6 +180,11 @@ pub const SHORTCUTS: &[Shortcut] = &[
         keys: &[plain(Key::Escape)],
         action: Action::Escape,
         help: "close this help, or restore the layout",
+    },
+    Shortcut {
+        keys: &[plain(Key::F)],
+        action: Action::ToggleFit,
+        help: "open or close the Fit… panel (fit a model to a BRDF)",
     },
     Shortcut {
         keys: &[plain(Key::T)],

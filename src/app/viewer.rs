@@ -56,6 +56,8 @@ pub struct Viewer {
     pub figure: bool,
     /// Scene files, figure export and toasts.
     pub export: ExportUi,
+    /// The *Fit…* panel.
+    pub fit: super::fit_ui::FitPanel,
     /// The window is cleared to the panels' colour (`Visuals::panel_fill`), so
     /// the panels are drawn without a fill of their own. Why: a software
     /// renderer (lavapipe) shades every pixel of every filled shape, and
@@ -79,6 +81,7 @@ impl Viewer {
             force_interacting: false,
             figure: false,
             export: ExportUi::default(),
+            fit: Default::default(),
             panels_on_clear: false,
         }
     }
@@ -548,6 +551,7 @@ impl Viewer {
         self.shortcuts(&ctx, keyboard_free, &mut out);
         dropped_files(&ctx, &self.ws.state, &self.ws.runtime, &mut out);
         self.help_window(&ctx);
+        self.fit.window(&ctx, &self.ws.state, &mut out);
         if let Some(((), path)) = self.files.show(&ctx) {
             out.push(Command::OpenFile {
                 path: path.display().to_string(),
@@ -615,6 +619,13 @@ impl Viewer {
                     .clicked()
                 {
                     self.export.dialog_open = true;
+                }
+                if ui
+                    .button("Fit…")
+                    .on_hover_text("Fit a model to a BRDF of the list (F)")
+                    .clicked()
+                {
+                    self.fit.open = !self.fit.open;
                 }
                 if ui
                     .button("Present")
@@ -809,6 +820,7 @@ impl Viewer {
                     None => self.export.ask_save_scene(),
                 },
                 Action::ExportFigure => self.export.dialog_open = !self.export.dialog_open,
+                Action::ToggleFit => self.fit.open = !self.fit.open,
                 Action::Quit => ctx.send_viewport_cmd(egui::ViewportCommand::Close),
             }
         }

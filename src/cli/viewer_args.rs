@@ -49,6 +49,11 @@ pub struct ViewerArgs {
     #[arg(long = "open", value_name = "FILE")]
     pub open: Vec<PathBuf>,
 
+    /// Open the Fit… panel (fit a model to a BRDF of the list; also F or
+    /// the top bar's button).
+    #[arg(long)]
+    pub fit: bool,
+
     /// Open this scene file (TOML, see `bv scene --help`) instead of the saved
     /// session.
     #[arg(long, value_name = "FILE")]

@@ -17,6 +17,7 @@
 pub mod albedo;
 pub mod compare;
 pub mod factor;
+pub mod fit;
 pub mod gonio;
 pub mod hemi;
 pub mod interface;

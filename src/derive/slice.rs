@@ -186,10 +186,85 @@ pub fn slice_now(id: u64, key: SliceKey, brdf: &Arc<dyn Brdf>) -> Arc<SliceData>
     done.value.clone()
 }
 
+/// The relative error `(f − f_ref) / f_ref` of slice `fit` against slice
+/// `reference` (the same grid), per pixel, of the Rec. 709 luminances: the
+/// residual of a fit over θh × θd (Ngan et al. 2005 show fits this way,
+/// their Fig. 4). `None` below the horizon (in either slice); where the
+/// reference is 0, 0 if `fit` is too and +∞ otherwise. Slices of different
+/// sizes give no values at all.
+pub fn relative_error(fit: &SliceData, reference: &SliceData) -> Vec<Option<f64>> {
+    if fit.width != reference.width || fit.height != reference.height {
+        return Vec::new();
+    }
+    fit.values
+        .iter()
+        .zip(&reference.values)
+        .map(|(f, r)| {
+            let (f, r) = (luminance((*f)?), luminance((*r)?));
+            Some(if r > 0.0 {
+                (f - r) / r
+            } else if f > 0.0 {
+                f64::INFINITY
+            } else {
+                0.0
+            })
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    fn lambert(albedo: f64) -> Box<dyn Brdf> {
+        bv_core::ModelSpec::from_json("lambert", &serde_json::json!({ "albedo": albedo }))
+            .unwrap()
+            .build()
+            .unwrap()
+    }
+
+    #[test]
+    fn relative_error_of_lamberts_is_their_ratio_minus_one() {
+        let (a, b) = (lambert(0.5), lambert(0.25));
+        let (sa, sb) = (
+            compute(a.as_ref(), 0.0, false, 32),
+            compute(b.as_ref(), 0.0, false, 32),
+        );
+        // Against itself: 0 wherever both are above the horizon.
+        let e = relative_error(&sa, &sa);
+        assert_eq!(e.len(), 32 * 32);
+        assert!(e.iter().flatten().all(|x| *x == 0.0));
+        // 0.5/π against 0.25/π: +1; the other way: −1/2.
+        for (e, want) in [
+            (relative_error(&sa, &sb), 1.0),
+            (relative_error(&sb, &sa), -0.5),
+        ] {
+            let valid: Vec<f64> = e.iter().flatten().copied().collect();
+            assert!(valid.len() > 400, "{}", valid.len());
+            for x in valid {
+                assert!((x - want).abs() < 1e-6, "{x} vs {want}");
+            }
+            // Below the horizon (φd = 0, θh + θd > 90°) stays marked.
+            assert_eq!(
+                e.iter().filter(|x| x.is_none()).count(),
+                sa.values.iter().filter(|x| x.is_none()).count()
+            );
+        }
+        // A zero reference: 0 against 0, +∞ against anything more.
+        let zero = lambert(0.0);
+        let sz = compute(zero.as_ref(), 0.0, false, 8);
+        let sa8 = compute(a.as_ref(), 0.0, false, 8);
+        assert!(relative_error(&sz, &sz).iter().flatten().all(|x| *x == 0.0));
+        assert!(
+            relative_error(&sa8, &sz)
+                .iter()
+                .flatten()
+                .all(|x| *x == f64::INFINITY)
+        );
+        // Grids that differ: nothing.
+        assert!(relative_error(&sa8, &sa).is_empty());
+    }
 
     #[test]
     fn lambert_slice_is_flat_and_the_horizon_is_marked() {

@@ -7,6 +7,12 @@
 //! direction is below the horizon (θh + θd > 90° at φd = 0) are hatched,
 //! so a 0 of the model is never confused with "no such configuration".
 //!
+//! Residual mode shows instead, for each drawn BRDF but a chosen reference
+//! (the data a model was fitted to), the relative error of its luminance
+//! `(f − f_ref) / f_ref` over the same θh × θd grid on a diverging colour
+//! map (blue: below the reference, red: above, grey: equal) with its legend:
+//! where in angle a fit fails (Ngan et al. 2005, Fig. 4).
+//!
 //! The values of a slice are cached per BRDF, keyed by its revision, φd, the
 //! axis and the resolution, so a frame evaluates at most one slice per BRDF
 //! and only when one of those changed; a 256 × 256 slice is 65,536
@@ -50,6 +56,13 @@ pub struct SliceSettings {
     pub chroma: bool,
     /// Every drawn BRDF, or only the selected one.
     pub all: bool,
+    /// Residual mode: the relative error against `reference`.
+    pub residual: bool,
+    /// The BRDF the residuals are taken against (an id of the list); the
+    /// first drawn BRDF when it is not set or not drawn.
+    pub reference: Option<u64>,
+    /// The relative error at either end of the colour map (1 = ±100 %).
+    pub residual_range: f64,
 }
 
 impl Default for SliceSettings {
@@ -61,6 +74,9 @@ impl Default for SliceSettings {
             gamma: 2.2,
             chroma: true,
             all: true,
+            residual: false,
+            reference: None,
+            residual_range: 1.0,
         }
     }
 }
@@ -95,14 +111,7 @@ pub fn display_color(
 
 /// The image of a slice.
 pub fn to_image(d: &SliceData, s: &SliceSettings, dark: bool) -> ColorImage {
-    let hatch = if dark {
-        (Color32::from_rgb(38, 44, 58), Color32::from_rgb(52, 60, 78))
-    } else {
-        (
-            Color32::from_rgb(200, 206, 220),
-            Color32::from_rgb(222, 227, 238),
-        )
-    };
+    let hatch = hatch_colors(dark);
     let mut pixels = Vec::with_capacity(d.width * d.height);
     for row in 0..d.height {
         for col in 0..d.width {
@@ -114,10 +123,49 @@ pub fn to_image(d: &SliceData, s: &SliceSettings, dark: bool) -> ColorImage {
     ColorImage::new([d.width, d.height], pixels)
 }
 
+/// The image of a residual: `(f − f_ref) / f_ref` on the diverging map,
+/// ±`range` at its ends; hatched below the horizon.
+pub fn residual_image(e: &[Option<f64>], n: usize, range: f64, dark: bool) -> ColorImage {
+    let hatch = hatch_colors(dark);
+    let range = range.max(1e-6);
+    let pixels = e
+        .iter()
+        .enumerate()
+        .map(|(k, v)| match v {
+            Some(x) => {
+                super::colormap::cool_warm((0.5 + 0.5 * (x / range).clamp(-1.0, 1.0)) as f32)
+            }
+            None => {
+                let (row, col) = (k / n.max(1), k % n.max(1));
+                if ((row + col) * 256 / n.max(1) / 6) % 2 == 1 {
+                    hatch.0
+                } else {
+                    hatch.1
+                }
+            }
+        })
+        .collect();
+    ColorImage::new([n, e.len() / n.max(1)], pixels)
+}
+
+/// The two colours of the hatching below the horizon.
+fn hatch_colors(dark: bool) -> (Color32, Color32) {
+    if dark {
+        (Color32::from_rgb(38, 44, 58), Color32::from_rgb(52, 60, 78))
+    } else {
+        (
+            Color32::from_rgb(200, 206, 220),
+            Color32::from_rgb(222, 227, 238),
+        )
+    }
+}
+
 struct Cached {
     key: SliceKey,
     data: Arc<SliceData>,
     texture: Option<(SliceSettings, bool, TextureHandle)>,
+    /// The residual's image, for the reference's slice key.
+    residual: Option<(SliceKey, SliceSettings, bool, TextureHandle)>,
 }
 
 /// Exact values at one hovered (θh, θd).
@@ -142,6 +190,8 @@ pub struct ImageSliceView {
     pub readout: Option<SliceReadout>,
     /// Where each BRDF's image was drawn in the last frame.
     pub image_rects: Vec<(u64, Rect)>,
+    /// The reference residual mode drew against in the last frame.
+    pub reference_id: Option<u64>,
 }
 
 impl ImageSliceView {
@@ -155,13 +205,41 @@ impl ImageSliceView {
         self.rebuilds
     }
 
-    /// The BRDFs this view shows.
+    /// The BRDFs this view shows (in residual mode, as residuals).
     fn shown<'s>(&self, scene: &'s Scene<'_>) -> Vec<&'s super::SceneBrdf> {
-        if self.settings.all {
+        let reference = self.reference(scene).map(|r| r.id);
+        let shown: Vec<&super::SceneBrdf> = if self.settings.all {
             scene.brdfs.iter().collect()
         } else {
             scene.primary().into_iter().collect()
+        };
+        if self.settings.residual {
+            shown
+                .into_iter()
+                .filter(|b| Some(b.id) != reference)
+                .collect()
+        } else {
+            shown
         }
+    }
+
+    /// The reference of residual mode: the chosen BRDF if it is drawn, the
+    /// first drawn one otherwise; `None` outside residual mode.
+    pub fn reference<'s>(&self, scene: &'s Scene<'_>) -> Option<&'s super::SceneBrdf> {
+        if !self.settings.residual {
+            return None;
+        }
+        self.settings
+            .reference
+            .and_then(|id| scene.brdfs.iter().find(|b| b.id == id))
+            .or_else(|| scene.brdfs.first())
+    }
+
+    /// The relative error of BRDF `id`'s cached slice against the
+    /// reference's (what residual mode draws), if both are cached.
+    pub fn residual(&self, id: u64, reference: u64) -> Option<Vec<Option<f64>>> {
+        let (a, r) = (self.cache.get(&id)?, self.cache.get(&reference)?);
+        Some(slice::relative_error(&a.data, &r.data))
     }
 
     /// Brings the cached slices up to date (at most one evaluation per BRDF)
@@ -172,7 +250,10 @@ impl ImageSliceView {
         } else {
             IDLE_RESOLUTION
         };
-        let shown = self.shown(scene);
+        let mut shown = self.shown(scene);
+        if let Some(r) = self.reference(scene) {
+            shown.push(r);
+        }
         for b in &shown {
             let key = SliceKey {
                 revision: b.revision,
@@ -191,6 +272,7 @@ impl ImageSliceView {
                     key,
                     data,
                     texture: None,
+                    residual: None,
                 },
             );
         }
@@ -200,6 +282,9 @@ impl ImageSliceView {
 
     fn texture(&mut self, ctx: &egui::Context, id: u64, dark: bool) -> Option<TextureHandle> {
         let s = self.settings;
+        if s.residual {
+            return self.residual_texture(ctx, id, dark);
+        }
         let c = self.cache.get_mut(&id)?;
         if let Some((ts, td, t)) = &c.texture
             && *ts == s
@@ -213,6 +298,31 @@ impl ImageSliceView {
         Some(t)
     }
 
+    /// The residual image of BRDF `id` against the reference.
+    fn residual_texture(
+        &mut self,
+        ctx: &egui::Context,
+        id: u64,
+        dark: bool,
+    ) -> Option<TextureHandle> {
+        let s = self.settings;
+        let reference = self.reference_id?;
+        let rkey = self.cache.get(&reference)?.key;
+        if let Some((k, ts, td, t)) = &self.cache.get(&id)?.residual
+            && *k == rkey
+            && *ts == s
+            && *td == dark
+        {
+            return Some(t.clone());
+        }
+        let e = self.residual(id, reference)?;
+        let c = self.cache.get_mut(&id)?;
+        let img = residual_image(&e, c.data.width, s.residual_range, dark);
+        let t = ctx.load_texture(format!("bv residual {id}"), img, TextureOptions::NEAREST);
+        c.residual = Some((rkey, s, dark, t.clone()));
+        Some(t)
+    }
+
     /// Sets the exposure so that the 99th percentile of the shown slices'
     /// luminance maps to white.
     fn fit_exposure(&self) -> Option<f64> {
@@ -223,6 +333,51 @@ impl ImageSliceView {
             .fold(0.0, f64::max);
         (q > 0.0 && q.is_finite()).then(|| (-q.log2()).clamp(-20.0, 20.0))
     }
+}
+
+/// The legend of residual mode: the diverging colour bar from −range to
+/// +range with its ticks, and what it shows.
+fn residual_legend(painter: &egui::Painter, at: Pos2, width: f32, range: f64, text: Color32) {
+    let bar_w = (width * 0.5).clamp(120.0, 320.0);
+    let x0 = at.x + (width - bar_w) * 0.5;
+    let bar = Rect::from_min_size(Pos2::new(x0, at.y + 6.0), Vec2::new(bar_w, 10.0));
+    const STEPS: usize = 64;
+    for k in 0..STEPS {
+        let t0 = k as f32 / STEPS as f32;
+        let t1 = (k + 1) as f32 / STEPS as f32;
+        let seg = Rect::from_min_max(
+            Pos2::new(bar.min.x + t0 * bar_w, bar.min.y),
+            Pos2::new(bar.min.x + t1 * bar_w, bar.max.y),
+        );
+        painter.rect_filled(seg, 0.0, super::colormap::cool_warm((t0 + t1) * 0.5));
+    }
+    let small = FontId::proportional(11.0);
+    let pct = range * 100.0;
+    for (t, label) in [
+        (0.0, format!("−{pct:.0} %")),
+        (0.5, "0".to_string()),
+        (1.0, format!("+{pct:.0} %")),
+    ] {
+        let x = bar.min.x + t * bar_w;
+        painter.line_segment(
+            [Pos2::new(x, bar.max.y), Pos2::new(x, bar.max.y + 3.0)],
+            Stroke::new(1.0, text),
+        );
+        painter.text(
+            Pos2::new(x, bar.max.y + 3.0),
+            Align2::CENTER_TOP,
+            label,
+            small.clone(),
+            text,
+        );
+    }
+    painter.text(
+        Pos2::new(bar.min.x - 8.0, bar.center().y),
+        Align2::RIGHT_CENTER,
+        "(f − f_ref) / f_ref",
+        small.clone(),
+        text,
+    );
 }
 
 /// Where the tiles go: the largest square images that fit `n` in `area`,
@@ -257,7 +412,7 @@ fn tiles(area: Rect, n: usize) -> Vec<Rect> {
 }
 
 impl View for ImageSliceView {
-    fn toolbar(&mut self, ui: &mut Ui, _scene: &Scene<'_>, _out: &mut Vec<Command>) {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let s = &mut self.settings;
         ui.spacing_mut().slider_width = 90.0;
         let row = crate::widgets::params_ui::slider_row(
@@ -331,16 +486,75 @@ impl View for ImageSliceView {
         {
             s.all = !s.all;
         }
+        if super::toolbar_toggle(
+            ui,
+            s.residual,
+            "residual",
+            "Relative error (f − f_ref)/f_ref of each BRDF against a reference (the data a \
+             model was fitted to)",
+        ) {
+            s.residual = !s.residual;
+        }
+        if s.residual {
+            let current = self
+                .reference(scene)
+                .map_or_else(|| "(none)".to_string(), |b| b.label.clone());
+            let mut chosen = None;
+            egui::ComboBox::from_id_salt(super::view_id("image_slice").with("reference"))
+                .selected_text(format!("vs {current}"))
+                .show_ui(ui, |ui| {
+                    for b in &scene.brdfs {
+                        if ui.selectable_label(b.label == current, &b.label).clicked() {
+                            chosen = Some(b.id);
+                        }
+                    }
+                })
+                .response
+                .on_hover_text("The reference f_ref of the residuals")
+                .widget_info(|| WidgetInfo::labeled(Role::ComboBox, true, "Residual reference"));
+            let s = &mut self.settings;
+            if chosen.is_some() {
+                s.reference = chosen;
+            }
+            let mut pct = s.residual_range * 100.0;
+            let r = ui
+                .add(
+                    egui::DragValue::new(&mut pct)
+                        .range(1.0..=1000.0)
+                        .speed(1.0)
+                        .fixed_decimals(0)
+                        .prefix("± ")
+                        .suffix(" %")
+                        .update_while_editing(false),
+                )
+                .on_hover_text("The relative error at the ends of the colour map");
+            r.widget_info(|| WidgetInfo::labeled(Role::SpinButton, true, "Residual range"));
+            s.residual_range = pct / 100.0;
+        }
     }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
         let readout_h = if scene.figure { 0.0 } else { 22.0 };
+        let reference = self.reference(scene).cloned();
+        self.reference_id = reference.as_ref().map(|r| r.id);
+        // Residual mode: a band for the colour map's legend under the tiles.
+        let legend_h = if reference.is_some() { 34.0 } else { 0.0 };
         let area = ui.available_rect_before_wrap();
-        let area = Rect::from_min_max(area.min, area.max - Vec2::new(0.0, readout_h));
+        let area = Rect::from_min_max(area.min, area.max - Vec2::new(0.0, readout_h + legend_h));
         if area.width() < 40.0 || area.height() < 40.0 {
             return;
         }
         let response = ui.allocate_rect(area, Sense::hover());
+        // The legend's band is the view's too: the readout goes below it.
+        if legend_h > 0.0 {
+            ui.allocate_rect(
+                Rect::from_min_size(
+                    Pos2::new(area.min.x, area.max.y),
+                    Vec2::new(area.width(), legend_h),
+                ),
+                Sense::hover(),
+            );
+        }
         let dark = ui.visuals().dark_mode;
         let shown: Vec<super::SceneBrdf> = self.shown(scene).into_iter().cloned().collect();
         let rects = tiles(area, shown.len());
@@ -381,10 +595,14 @@ impl View for ImageSliceView {
                 Stroke::new(1.0, grid),
                 egui::StrokeKind::Outside,
             );
+            let title = match &reference {
+                Some(r) => format!("{} vs {}", b.label, r.label),
+                None => b.label.clone(),
+            };
             painter.text(
                 rect.left_top() - Vec2::new(0.0, 3.0),
                 Align2::LEFT_BOTTOM,
-                &b.label,
+                title,
                 FontId::proportional(12.5),
                 b.color(),
             );
@@ -451,11 +669,27 @@ impl View for ImageSliceView {
                 weak,
             );
         }
+        if reference.is_some() && !shown.is_empty() {
+            residual_legend(
+                &ui.painter_at(Rect::from_min_size(
+                    Pos2::new(area.min.x, area.max.y),
+                    Vec2::new(area.width(), legend_h),
+                )),
+                Pos2::new(area.min.x, area.max.y),
+                area.width(),
+                s.residual_range,
+                text,
+            );
+        }
         if shown.is_empty() {
             painter.text(
                 area.center(),
                 Align2::CENTER_CENTER,
-                "No BRDF shown: add one on the left",
+                if reference.is_some() {
+                    "Residuals need a second drawn BRDF besides the reference"
+                } else {
+                    "No BRDF shown: add one on the left"
+                },
                 FontId::proportional(15.0),
                 weak,
             );
@@ -478,6 +712,7 @@ impl View for ImageSliceView {
                 theta_d_deg: td.to_degrees(),
                 values: shown
                     .iter()
+                    .chain(reference.as_ref())
                     .map(|b| {
                         (
                             b.label.clone(),
