@@ -478,7 +478,10 @@ fn entry(
     let mut state = loaded.state;
     let written_caption = caption.clone();
     let mut caption = caption;
-    let mut replaced = Vec::new();
+    // The BRDFs the scene could not build and a stand-in replaces: the
+    // BRDF itself when it builds (its file is there); else the stand-in,
+    // named as such, and the slide says why.
+    let mut replaced: Vec<&scene::Unbuilt> = Vec::new();
     let mut record = Vec::new();
     for si in &stand_ins {
         let Some(k) = state.brdfs.iter().position(|b| b.id == si.id) else {
@@ -487,11 +490,9 @@ fn entry(
                 format!("no BRDF with id {} in the scene", si.id),
             ));
         };
-        // The BRDF itself when it builds (its file is there); else the
-        // stand-in, named as such, and the slide says why.
-        if state.brdfs[k].spec.build().is_ok() {
+        let Some(u) = loaded.unbuilt.iter().find(|u| u.id == si.id) else {
             continue;
-        }
+        };
         record.push((
             si.id,
             state.brdfs[k].spec.clone(),
@@ -500,7 +501,7 @@ fn entry(
         ));
         state.brdfs[k].spec = si.spec.clone();
         state.brdfs[k].name = Some(si.name.clone());
-        replaced.push(format!("brdfs[{k}]"));
+        replaced.push(u);
         caption = format!("{caption} [{}]", si.note);
     }
     if caption.chars().nth(MAX_TEXT_CHARS).is_some() {
@@ -512,29 +513,22 @@ fn entry(
             ),
         ));
     }
-    // Every other BRDF must still build, as `builds` asked.
-    if let Some((k, e)) = state
-        .brdfs
-        .iter()
-        .enumerate()
-        .find_map(|(k, b)| b.spec.build().err().map(|e| (k, e)))
-        && required
-        && !stand_ins.is_empty()
+    // Any other BRDF that could not be built refuses the scene, as
+    // `builds` asked (loading ran leniently only for the stand-ins).
+    if required
+        && let Some(u) = loaded
+            .unbuilt
+            .iter()
+            .find(|u| !replaced.iter().any(|r| r.id == u.id))
     {
-        return Err(bad(
-            &format!("state.brdfs[{k}]"),
-            format!(
-                "the `{}` BRDF cannot be built: {e}",
-                state.brdfs[k].spec.id()
-            ),
-        ));
+        return Err(bad(&format!("state.{}", u.key), u.reason.clone()));
     }
+    // The warning about a BRDF a stand-in replaced is the caption's note.
+    let dropped: Vec<String> = replaced.iter().map(|u| u.warning()).collect();
     for w in loaded.warnings {
-        // The warning about a BRDF a stand-in replaced is the caption's note.
-        if replaced.iter().any(|r| w.contains(&format!("`{r}`"))) {
-            continue;
+        if !dropped.contains(&w) {
+            warnings.push(format!("{prefix}: {w}"));
         }
-        warnings.push(format!("{prefix}: {w}"));
     }
     state.maximised = Some(view.id.to_string());
     let mut source = source;

@@ -110,6 +110,28 @@ pub struct Loaded {
     pub state: AppState,
     /// Keys that were ignored and other non-fatal remarks, one line each.
     pub warnings: Vec<String>,
+    /// The BRDFs that could not be built ([`Builds::Warn`]; each also has
+    /// its line in `warnings`), so that a caller can act on them (a deck's
+    /// stand-ins) without building them again.
+    pub unbuilt: Vec<Unbuilt>,
+}
+
+/// A BRDF of a loaded scene that could not be built.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unbuilt {
+    /// Its id.
+    pub id: u64,
+    /// Where it is in the file (`brdfs[2]`).
+    pub key: String,
+    /// Why (`the `merl` BRDF cannot be built: …`).
+    pub reason: String,
+}
+
+impl Unbuilt {
+    /// Its line in [`Loaded::warnings`].
+    pub fn warning(&self) -> String {
+        format!("`{}`: {}; it draws nothing", self.key, self.reason)
+    }
 }
 
 /// The scene as TOML text (what [`save`] writes).
@@ -315,18 +337,24 @@ fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
     }
     // Every BRDF must build: a MERL table that cannot be read would
     // otherwise vanish from the figure without a word.
+    let mut unbuilt = Vec::new();
     for (i, b) in state.brdfs.iter().enumerate() {
         if let Err(e) = b.spec.build() {
-            let reason = format!("the `{}` BRDF cannot be built: {e}", b.spec.id());
+            let u = Unbuilt {
+                id: b.id,
+                key: format!("brdfs[{i}]"),
+                reason: format!("the `{}` BRDF cannot be built: {e}", b.spec.id()),
+            };
             match builds {
                 Builds::Required => {
                     return Err(SceneError::BadValue {
-                        key: format!("brdfs[{i}]"),
-                        reason,
+                        key: u.key,
+                        reason: u.reason,
                     });
                 }
                 Builds::Warn => {
-                    warnings.push(format!("`brdfs[{i}]`: {reason}; it draws nothing"));
+                    warnings.push(u.warning());
+                    unbuilt.push(u);
                 }
             }
         }
@@ -336,6 +364,7 @@ fn from_toml_in_dir(text: &str, base: Option<&Path>, builds: Builds) -> Result<L
     Ok(Loaded {
         state: clean,
         warnings,
+        unbuilt,
     })
 }
 
