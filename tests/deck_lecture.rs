@@ -373,10 +373,9 @@ fn the_facet_normals_follow_d() {
     scene.figure = true;
     let specimen = microsurface::specimen(&scene);
     assert_eq!(specimen.describe(), "Beckmann α 0.30");
-    let shown = microsurface::request(&Waker::none(), &scene, &specimen);
-    let done = shown.done.expect("a figure computes its simulation");
-    let sim = &done.value;
-    let h = &sim.ndf;
+    let shown = microsurface::ndf(&Waker::none(), &scene, &specimen);
+    let done = shown.done.expect("a figure computes its histogram");
+    let h = &done.value;
     // Σ expected (θ bins and the steeper rest) is ∫ D cos θm dω = 1.
     let total: f64 = h.expected.iter().sum();
     assert!((total - 1.0).abs() < 1e-9, "{total}");

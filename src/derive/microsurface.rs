@@ -109,19 +109,50 @@ pub struct Simulation {
     /// ρhd of the single-scattering Cook–Torrance model with the same D,
     /// height-correlated Smith G and F = 1 (bin quadrature).
     pub analytic_rho: f64,
-    /// The facet normals' histogram against D: [`NDF_BINS`] bins in θm,
-    /// all azimuths together, of a [`NDF_SIZE`]² surface with the same
-    /// statistics.
-    pub ndf: NdfHistogram,
 }
 
-/// θm bins of [`Simulation::ndf`].
+/// θm bins of [`ndf`]'s histogram.
 pub const NDF_BINS: usize = 16;
 
-/// Grid side of the surface whose normals [`Simulation::ndf`] counts: the
-/// drawn 128² patch holds about (128/4)² independent slopes, and its
-/// histogram strays 5–8 % from D at the peak; 512² holds 16 times more.
+/// Grid side of the surface whose normals [`ndf`] counts: the drawn 128²
+/// patch holds about (128/4)² independent slopes, and its histogram strays
+/// 5–8 % from D at the peak; 512² holds 16 times more.
 pub const NDF_SIZE: usize = 512;
+
+/// What a facet-normal histogram was computed for: distribution, αx and αy
+/// (bits). Not the light: the histogram does not depend on it.
+pub type NdfKey = (SlopeDistribution, u64, u64);
+
+/// The histograms of the process (one slot).
+pub fn ndf_slots() -> Arc<Slots<NdfKey, Arc<NdfHistogram>>> {
+    jobs::slots("microsurface NDF")
+}
+
+/// The facet normals' histogram of the specimen against D (the view's
+/// *NDF* chart): [`NDF_BINS`] bins in θm, all azimuths together, of a
+/// [`NDF_SIZE`]² surface with the specimen's statistics. Computed once
+/// per specimen, only when asked for, and kept while the light moves.
+pub fn ndf(
+    waker: &Waker,
+    scene: &Scene<'_>,
+    specimen: &Specimen,
+) -> Shown<NdfKey, Arc<NdfHistogram>> {
+    let (ax, ay) = (specimen.alpha_x, specimen.alpha_y);
+    let key = (specimen.distribution, ax.to_bits(), ay.to_bits());
+    let opts = SurfaceOptions::new(specimen.distribution, ax, ay, NDF_SIZE, 1);
+    ndf_slots().for_frame(
+        waker,
+        0,
+        key,
+        scene.figure,
+        Duration::from_millis(50),
+        move || {
+            // A bad option cannot come from the view (it clamps α).
+            let surface = Surface::generate(&opts).ok()?;
+            Some(Arc::new(measure::ndf_histogram(&surface, NDF_BINS, 1)))
+        },
+    )
+}
 
 /// The simulations of the process (one slot).
 pub fn slots() -> Arc<Slots<Key, Arc<Simulation>>> {
@@ -130,12 +161,7 @@ pub fn slots() -> Arc<Slots<Key, Arc<Simulation>>> {
 
 enum Phase {
     Start,
-    Rays(
-        Arc<Surface>,
-        Vec<(Vec<DVec3>, DVec3)>,
-        Box<GonioJob>,
-        Box<NdfHistogram>,
-    ),
+    Rays(Arc<Surface>, Vec<(Vec<DVec3>, DVec3)>, Box<GonioJob>),
     Done,
 }
 
@@ -159,18 +185,12 @@ impl Steps<Arc<Simulation>> for Job {
                 let mut g = GonioOptions::new(theta, RAYS, 1);
                 g.phi_i = self.wi.y.atan2(self.wi.x);
                 let job = GonioJob::new(Arc::clone(&surface), g).ok()?;
-                let big = Surface::generate(&SurfaceOptions {
-                    size: NDF_SIZE,
-                    ..self.opts
-                })
-                .ok()?;
-                let ndf = measure::ndf_histogram(&big, NDF_BINS, 1);
-                self.phase = Phase::Rays(surface, paths, Box::new(job), Box::new(ndf));
+                self.phase = Phase::Rays(surface, paths, Box::new(job));
                 None
             }
-            Phase::Rays(surface, paths, mut job, ndf) => {
+            Phase::Rays(surface, paths, mut job) => {
                 let Some(gonio) = job.step(4) else {
-                    self.phase = Phase::Rays(surface, paths, job, ndf);
+                    self.phase = Phase::Rays(surface, paths, job);
                     return None;
                 };
                 let o = gonio.opts;
@@ -187,7 +207,6 @@ impl Steps<Arc<Simulation>> for Job {
                     gonio,
                     g1,
                     analytic_rho,
-                    ndf: *ndf,
                 }))
             }
             Phase::Done => None,
@@ -196,7 +215,7 @@ impl Steps<Arc<Simulation>> for Job {
 
     fn progress(&self) -> Option<(usize, usize)> {
         match &self.phase {
-            Phase::Rays(_, _, job, _) => Some(job.progress()),
+            Phase::Rays(_, _, job) => Some(job.progress()),
             _ => None,
         }
     }

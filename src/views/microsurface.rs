@@ -24,6 +24,7 @@ use crate::derive::microsurface::{self, Simulation, Specimen};
 use crate::session::command::Command;
 use crate::session::state::{MicrosurfaceSettings, PlotSettings};
 use bv_core::microsurface::SlopeDistribution;
+use bv_core::microsurface::measure::NdfHistogram;
 use eframe::egui::{self, Align2, Color32, FontId, Pos2, Rect, Sense, Stroke, Ui, epaint::Mesh};
 use glam::DVec3;
 use std::any::Any;
@@ -137,10 +138,12 @@ impl View for MicrosurfaceView {
             return;
         };
         let sim = &done.value;
-        if show_ndf {
+        if show_ndf
+            && let Some(done) = microsurface::ndf(&super::waker(ui.ctx()), scene, &specimen).done
+        {
             let chart_rect = Rect::from_min_max(Pos2::new(rect.max.x + 8.0, full.min.y), full.max);
             let dark = ui.visuals().dark_mode;
-            let chart = ndf_chart(sim, &specimen, dark);
+            let chart = ndf_chart(&done.value, &specimen, dark);
             let id = super::view_id(crate::session::views::MICROSURFACE.id).with("ndf");
             ui.scope_builder(egui::UiBuilder::new().max_rect(chart_rect), |ui| {
                 // Presenting, the legend is a column beside the chart.
@@ -257,11 +260,10 @@ fn summary(sim: &Simulation, specimen: &Specimen) -> Vec<String> {
 }
 
 /// The facet normals against the model: the measured D averaged over each
-/// θm bin (`Simulation::ndf`, joined at the bins' centres) and the model's
-/// D(θm) averaged over azimuth, in 1/sr.
-pub fn ndf_chart(sim: &Simulation, specimen: &Specimen, dark: bool) -> super::chart::Chart {
+/// θm bin (`derive::microsurface::ndf`, joined at the bins' centres) and
+/// the specimen's D(θm) averaged over azimuth, in 1/sr.
+pub fn ndf_chart(h: &NdfHistogram, specimen: &Specimen, dark: bool) -> super::chart::Chart {
     use super::chart::{self, Chart, Series};
-    let h = &sim.ndf;
     let dt = h.theta_max / h.n_theta as f64;
     // Each bin's mean D at its centre.
     let stairs: Vec<[f64; 2]> = (0..h.n_theta)
@@ -270,7 +272,11 @@ pub fn ndf_chart(sim: &Simulation, specimen: &Specimen, dark: bool) -> super::ch
             [((t as f64 + 0.5) * dt).to_degrees(), d]
         })
         .collect();
-    let mf = sim.surface.microfacet();
+    let mf = bv_core::microfacet::Microfacet::new(
+        specimen.distribution.distribution(),
+        specimen.alpha_x,
+        specimen.alpha_y,
+    );
     let model: Vec<[f64; 2]> = (0..=200)
         .map(|k| {
             let th = h.theta_max * k as f64 / 200.0;
