@@ -730,19 +730,7 @@ fn fit(
         })
         .map_err(bv_error)?;
     let brdf = result.spec.build().map_err(bv_error)?;
-    let v = serde_json::json!({
-        "model": result.spec.id(),
-        "params": result.spec.params().to_json(),
-        "metric": result.metric.name(),
-        "error": result.error,
-        "initial_error": result.initial_error,
-        "residuals": result.residuals,
-        "free": result.unknowns,
-        "target": target.spec.to_json(),
-        "pairs": result.pairs,
-        "iterations": result.iterations,
-        "evaluations": result.evaluations,
-    });
+    let v = bv::cli::fit::report_json(&result, &target.spec);
     let json = serde_json::to_string(&v).map_err(bv_error)?;
     Ok((
         Model {

@@ -95,6 +95,26 @@ fn target_spec(to: &str, params: &[String]) -> Result<bv_core::ModelSpec> {
     Ok(spec)
 }
 
+/// The result as `bv fit --json` prints it (less the time taken): the
+/// fitted model and every parameter, the metric and its error (and at the
+/// given values), the residuals per θi band, the unknowns, the target and
+/// the effort. The Python module returns the same.
+pub fn report_json(result: &fit::FitResult, target: &bv_core::ModelSpec) -> serde_json::Value {
+    json!({
+        "model": result.spec.id(),
+        "params": result.spec.params().to_json(),
+        "metric": result.metric.name(),
+        "error": result.error,
+        "initial_error": result.initial_error,
+        "residuals": result.residuals,
+        "free": result.unknowns,
+        "target": target.to_json(),
+        "pairs": result.pairs,
+        "iterations": result.iterations,
+        "evaluations": result.evaluations,
+    })
+}
+
 /// Runs `bv fit`.
 pub fn run(args: &FitArgs) -> Result<()> {
     let model = spec_from_cli(&args.model, &args.params)?;
@@ -202,20 +222,8 @@ pub fn run(args: &FitArgs) -> Result<()> {
     }
 
     if args.json {
-        let v = json!({
-            "model": result.spec.id(),
-            "params": result.spec.params().to_json(),
-            "metric": result.metric.name(),
-            "error": result.error,
-            "initial_error": result.initial_error,
-            "residuals": result.residuals,
-            "free": result.unknowns,
-            "target": target.to_json(),
-            "pairs": result.pairs,
-            "iterations": result.iterations,
-            "evaluations": result.evaluations,
-            "seconds": seconds,
-        });
+        let mut v = report_json(&result, &target);
+        v["seconds"] = json!(seconds);
         return print(&format!("{}\n", serde_json::to_string_pretty(&v)?));
     }
     let mut text = format!(
