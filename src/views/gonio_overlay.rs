@@ -57,6 +57,63 @@ pub fn control(ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
     }
 }
 
+/// One detector stop as the views draw it: its signed angle in the plane
+/// of incidence (radians, positive on the mirror side), the reading and
+/// its 2σ bounds in the quantity drawn (f, or f |cos θo|), never negative.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stop {
+    /// Signed θo of the detector (radians).
+    pub theta_s: f64,
+    /// The reading.
+    pub value: f64,
+    /// Reading − 2σ.
+    pub lo: f64,
+    /// Reading + 2σ.
+    pub hi: f64,
+}
+
+/// The finite readings of a set as [`Stop`]s (`cosine`: the views show
+/// f cos θo).
+pub fn stops(readings: &[bv_core::analysis::gonio::Reading], cosine: bool) -> Vec<Stop> {
+    let shown = |f: f64, theta_s: f64| {
+        let v = if cosine { f * theta_s.cos().abs() } else { f };
+        v.max(0.0)
+    };
+    readings
+        .iter()
+        .filter(|r| r.f.is_finite() && r.sigma.is_finite())
+        .map(|r| Stop {
+            theta_s: r.theta_s,
+            value: shown(r.f, r.theta_s),
+            lo: shown(r.f - 2.0 * r.sigma, r.theta_s),
+            hi: shown(r.f + 2.0 * r.sigma, r.theta_s),
+        })
+        .collect()
+}
+
+/// The selected BRDF's lobe with F = 1 (`Brdf::furnace`) in the plane of
+/// incidence of `setup`, `n` samples of (signed θo, value): what a simulated
+/// surface's one-bounce readings follow. `None` for a BRDF without one.
+pub fn f1_section(
+    scene: &Scene<'_>,
+    setup: &bv_core::analysis::gonio::GonioSetup,
+    n: usize,
+) -> Option<Vec<(f64, f64)>> {
+    let f = scene.primary()?.brdf.furnace()?;
+    Some(
+        crate::derive::slices::plane_of_incidence(
+            f.as_ref(),
+            setup.theta_i,
+            setup.phi_i,
+            n,
+            scene.state.display.cosine,
+        )
+        .iter()
+        .map(|p| (p.x, p.value))
+        .collect(),
+    )
+}
+
 /// One set of readings as the lobe view draws them: the detector's
 /// directions (unit, in the surface frame), each with its reading and 2σ
 /// bounds in the quantity drawn (f, or f cos θo).
@@ -87,57 +144,25 @@ pub fn readings_3d(scene: &Scene<'_>, waker: &crate::derive::jobs::Waker) -> Opt
     let done = shown.done?;
     let m = &done.value;
     let cosine = scene.state.display.cosine;
-    let set = |label: String, filled: bool, rs: &[bv_core::analysis::gonio::Reading]| {
-        let shown = |f: f64, theta_s: f64| {
-            let v = if cosine { f * theta_s.cos().abs() } else { f };
-            v.max(0.0)
-        };
-        Readings3d {
-            label,
-            filled,
-            stops: rs
-                .iter()
-                .filter(|r| r.f.is_finite() && r.sigma.is_finite())
-                .map(|r| {
-                    (
-                        crate::derive::slices::plane_direction(r.theta_s, m.setup.phi_i),
-                        shown(r.f, r.theta_s),
-                        shown(r.f - 2.0 * r.sigma, r.theta_s),
-                        shown(r.f + 2.0 * r.sigma, r.theta_s),
-                    )
-                })
-                .collect(),
-        }
+    let dir = |theta_s: f64| crate::derive::slices::plane_direction(theta_s, m.setup.phi_i);
+    let set = |label: &str, filled: bool, rs: &[bv_core::analysis::gonio::Reading]| Readings3d {
+        label: label.into(),
+        filled,
+        stops: stops(rs, cosine)
+            .iter()
+            .map(|s| (dir(s.theta_s), s.value, s.lo, s.hi))
+            .collect(),
     };
-    let mut sets = Vec::new();
-    let mut reference = None;
-    match &m.single {
-        Some(single) => {
-            sets.push(set(
-                "simulated surface, all bounces".into(),
-                true,
-                &m.readings,
-            ));
-            sets.push(set("simulated surface, one bounce".into(), false, single));
-            reference = scene.primary().and_then(|b| b.brdf.furnace()).map(|f| {
-                crate::derive::slices::plane_of_incidence(
-                    f.as_ref(),
-                    m.setup.theta_i,
-                    m.setup.phi_i,
-                    181,
-                    cosine,
-                )
-                .iter()
-                .map(|p| {
-                    (
-                        crate::derive::slices::plane_direction(p.x, m.setup.phi_i),
-                        p.value.max(0.0),
-                    )
-                })
-                .collect()
-            });
-        }
-        None => sets.push(set("gonioreflectometer".into(), true, &m.readings)),
-    }
+    let (sets, reference) = match &m.single {
+        Some(single) => (
+            vec![
+                set("simulated surface, all bounces", true, &m.readings),
+                set("simulated surface, one bounce", false, single),
+            ],
+            f1_section(scene, &m.setup, 181)
+                .map(|c| c.into_iter().map(|(t, v)| (dir(t), v.max(0.0))).collect()),
+        ),
+        None => (vec![set("gonioreflectometer", true, &m.readings)], None),
+    };
     Some(Overlay3d { sets, reference })
 }

@@ -841,27 +841,16 @@ fn dot_set(
     readings: &[bv_core::analysis::gonio::Reading],
     d: crate::session::state::Display,
 ) -> DotSet {
-    let shown_value = |f: f64, theta_s: f64| {
-        let v = if d.cosine { f * theta_s.cos().abs() } else { f };
-        v.max(0.0)
-    };
-    let mut dots = Vec::new();
-    let mut bars = Vec::new();
-    for r in readings {
-        if !(r.f.is_finite() && r.sigma.is_finite()) {
-            continue;
-        }
-        let rad = radius(shown_value(r.f, r.theta_s), d.log);
-        dots.push(polar_point(rad, r.theta_s));
-        let lo = radius(shown_value(r.f - 2.0 * r.sigma, r.theta_s), d.log);
-        let hi = radius(shown_value(r.f + 2.0 * r.sigma, r.theta_s), d.log);
-        bars.push([polar_point(lo, r.theta_s), polar_point(hi, r.theta_s)]);
-    }
+    let at = |v: f64, theta_s: f64| polar_point(radius(v, d.log), theta_s);
+    let stops = super::gonio_overlay::stops(readings, d.cosine);
     DotSet {
         label,
         filled,
-        dots,
-        bars,
+        dots: stops.iter().map(|s| at(s.value, s.theta_s)).collect(),
+        bars: stops
+            .iter()
+            .map(|s| [at(s.lo, s.theta_s), at(s.hi, s.theta_s)])
+            .collect(),
     }
 }
 
@@ -895,24 +884,15 @@ fn gonio_dots(scene: &Scene<'_>, waker: &crate::derive::jobs::Waker) -> Option<G
             } else {
                 format!("αx {ax:.2}, αy {ay:.2}")
             };
-            let reference = b.brdf.furnace().map(|f| {
-                let n = 2 * SAMPLES;
-                let points = slices::plane_of_incidence(
-                    f.as_ref(),
-                    m.setup.theta_i,
-                    m.setup.phi_i,
-                    n,
-                    d.cosine,
-                )
-                .iter()
-                .map(|s| polar_point(radius(s.value, d.log), s.x))
-                .collect();
-                RefCurve {
+            let reference =
+                super::gonio_overlay::f1_section(scene, &m.setup, 2 * SAMPLES).map(|c| RefCurve {
                     label: format!("{}, F = 1: one bounce", b.label),
                     color: b.color(),
-                    points,
-                }
-            });
+                    points: c
+                        .into_iter()
+                        .map(|(t, v)| polar_point(radius(v, d.log), t))
+                        .collect(),
+                });
             Some(GonioDots {
                 sets: vec![
                     dot_set(
