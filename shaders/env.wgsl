@@ -124,13 +124,19 @@ fn glass_path(model: u32, o: u32, n: vec3<f32>) -> vec3<f32> {
     return l;
 }
 
+// The environment mirrored at s about its normal, seen from v (towards the
+// eye), weighted by the delta model's reflectance there.
+fn mirrored(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
+    let c = dot(v, s.n);
+    return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
+}
+
 // Radiance of the delta parts of a (non-mix) model at sphere point s seen
 // from v (towards the eye, view space).
 fn delta_leaf(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
     let kind = dispatch::delta_kind(model);
     if (kind == dispatch::DELTA_REFLECTION) {
-        let c = dot(v, s.n);
-        return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
+        return mirrored(model, o, s, v);
     }
     if (kind == dispatch::DELTA_REFRACTION) {
         return glass_path(model, o, s.n);
@@ -142,12 +148,10 @@ fn delta_leaf(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
 // (LECTURE.md N13, "a glass-coated dark floor"): what it reflects, F; what
 // it refracts is absorbed below and never comes back.
 fn delta_leaf_plane(model: u32, o: u32, s: SpherePoint, v: vec3<f32>) -> vec3<f32> {
-    let kind = dispatch::delta_kind(model);
-    if (kind == dispatch::DELTA_REFLECTION || kind == dispatch::DELTA_REFRACTION) {
-        let c = dot(v, s.n);
-        return dispatch::delta_reflectance(model, o, c) * envmap::radiance(2.0 * c * s.n - v);
+    if (dispatch::delta_kind(model) == dispatch::DELTA_NONE) {
+        return vec3<f32>(0.0);
     }
-    return vec3<f32>(0.0);
+    return mirrored(model, o, s, v);
 }
 
 // The environment seen from torus point p (normal n) along d: 0 where the

@@ -628,7 +628,7 @@ impl PolarView {
                 pui.text(
                     Text::new(
                         "",
-                        PlotPoint::new(s.label_at(outer)[0], s.label_at(outer)[1]),
+                        PlotPoint::from(s.label_at(outer)),
                         RichText::new(s.text()).size(11.0),
                     )
                     .color(s.color)

@@ -521,17 +521,11 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn a_transmitting_interface_shows_what_it_passes_and_its_tir() {
-        let state = AppState::default();
-        let rd = ModelSpec::from_json(
-            "rough-dielectric",
-            &serde_json::json!({"alpha": 0.3, "eta": 1.5}),
-        )
-        .unwrap();
-        let scene = Scene {
-            state: &state,
-            brdfs: scene_of(&state, &[rd]),
+    /// A figure of `specs` with the light at θi = 30°.
+    fn figure_at_30<'a>(state: &'a AppState, specs: &[ModelSpec]) -> Scene<'a> {
+        Scene {
+            state,
+            brdfs: scene_of(state, specs),
             incident: crate::session::state::Incident {
                 theta_deg: 30.0,
                 phi_deg: 0.0,
@@ -541,7 +535,18 @@ mod tests {
             transparent: false,
             line_scale: 1.0,
             presenting: false,
-        };
+        }
+    }
+
+    #[test]
+    fn a_transmitting_interface_shows_what_it_passes_and_its_tir() {
+        let state = AppState::default();
+        let rd = ModelSpec::from_json(
+            "rough-dielectric",
+            &serde_json::json!({"alpha": 0.3, "eta": 1.5}),
+        )
+        .unwrap();
+        let scene = figure_at_30(&state, &[rd]);
         let c = term_charts(&scene, TermToggles::default(), true);
         let f = c.f.unwrap();
         assert_eq!(f.series.len(), 3);
@@ -572,19 +577,7 @@ mod tests {
         )
         .unwrap();
         let lambert = ModelSpec::new("lambert").unwrap();
-        let scene = Scene {
-            state: &state,
-            brdfs: scene_of(&state, &[ct, lambert]),
-            incident: crate::session::state::Incident {
-                theta_deg: 30.0,
-                phi_deg: 0.0,
-            },
-            interacting: false,
-            figure: true,
-            transparent: false,
-            line_scale: 1.0,
-            presenting: false,
-        };
+        let scene = figure_at_30(&state, &[ct, lambert]);
         let c = term_charts(&scene, TermToggles::default(), true);
         assert_eq!(c.lines.len(), 2);
         assert!(c.lines[0].contains("D = GGX") && c.lines[0].contains("F = dielectric"));
