@@ -56,17 +56,7 @@ impl Grid {
             let rows = tiles.div_ceil(cols);
             (size.x / cols as f64).min(size.y / rows as f64)
         };
-        // The largest spheres; on a tie the fewest empty cells (3 + 3
-        // rather than 4 + 2), then the fewest rows.
-        let empty = |cols: usize| cols * tiles.div_ceil(cols) - tiles;
-        let mut best = tiles;
-        for cols in (1..tiles).rev() {
-            let (r, rb) = (radius(cols), radius(best));
-            let tie = (r - rb).abs() <= 1e-9 * rb;
-            if (!tie && r > rb) || (tie && empty(cols) < empty(best)) {
-                best = cols;
-            }
-        }
+        let best = best_columns(tiles, 1e-9, radius);
         let cols = if radius(best) > Self::GRID_GAIN * radius(tiles) {
             best
         } else {
@@ -163,6 +153,24 @@ impl Grid {
         };
         [x0, x1, y0, y1]
     }
+}
+
+/// How many of `n` panels to put in a row so that `scale(cols)` (the size
+/// a panel gets) is largest; on a tie (within `tol`, relative) the fewest
+/// empty cells in the last row (3 + 3 rather than 4 + 2), then the fewest
+/// rows. The sphere grid and the polar view's small multiples use it.
+pub fn best_columns(n: usize, tol: f64, scale: impl Fn(usize) -> f64) -> usize {
+    let n = n.max(1);
+    let empty = |cols: usize| cols * n.div_ceil(cols) - n;
+    let mut best = n;
+    for cols in (1..n).rev() {
+        let (r, rb) = (scale(cols), scale(best));
+        let tie = (r - rb).abs() <= tol * rb;
+        if (!tie && r > rb) || (tie && empty(cols) < empty(best)) {
+            best = cols;
+        }
+    }
+    best
 }
 
 /// The sphere point under position `p` (pixels, y down, pixel centres at +0.5)

@@ -706,14 +706,7 @@ fn multiples_grid(n: usize, size: [f32; 2], title_h: f32, transmits: bool) -> [u
         let (w, h) = (size[0] / cols as f32, size[1] / rows as f32 - title_h);
         w.min(h / aspect)
     };
-    let mut best = n;
-    for cols in (1..n).rev() {
-        let (r, rb) = (scale(cols), scale(best));
-        let empty = |c: usize| c * n.div_ceil(c) - n;
-        if r > rb * 1.0001 || ((r - rb).abs() <= rb * 1e-4 && empty(cols) < empty(best)) {
-            best = cols;
-        }
-    }
+    let best = crate::gpu::sphere::best_columns(n, 1e-4, |c| f64::from(scale(c)));
     [best, n.div_ceil(best)]
 }
 
