@@ -236,6 +236,7 @@ const WITH_KERNEL: &[&str] = &[
     "mirror",
     "glass",
     "rough-dielectric",
+    "coated",
 ];
 
 #[test]
@@ -355,6 +356,39 @@ fn every_rough_dielectric_combination_is_checked() {
                     let dirs = sphere_pairs(b.as_ref(), 12);
                     if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
                         panic!("{p}: {e}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_coated_combination_is_checked() {
+    // Both distributions and bases, a sharp, a medium and a very rough
+    // coat, a thin and an absorbing layer, indices near 1 and high, and a
+    // base conductor whose index is below the coat's (total internal
+    // reflection inside the base's Fresnel is then possible).
+    let dirs = pairs(9);
+    for dist in ["ggx", "beckmann"] {
+        for base in ["lambert", "conductor"] {
+            for (ax, ay) in [(0.001, 0.001), (0.3, 0.1), (2.0, 2.0)] {
+                for eta in [1.01, 1.5, 4.0] {
+                    for (thickness, absorption) in [
+                        (0.0, [0.0; 3]),
+                        (2.0, [0.1, 0.5, 1.0]),
+                        (10.0, [0.02, 0.2, 1.0]),
+                    ] {
+                        let p = serde_json::json!({"distribution": dist, "base": base,
+                            "alpha_x": ax, "alpha_y": ay, "eta": eta,
+                            "thickness": thickness, "absorption": absorption,
+                            "base_albedo": [0.9, 0.5, 0.1], "base_alpha": ax,
+                            "base_eta": [0.2, 0.92, 1.1], "base_k": [3.9, 2.45, 2.14]});
+                        let b = ModelSpec::from_json("coated", &p).unwrap().build().unwrap();
+                        assert!(b.batch_kernel().is_some(), "{p}");
+                        if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
+                            panic!("{p}: {e}");
+                        }
                     }
                 }
             }

@@ -49,10 +49,11 @@
 //! Reflection only (the base is opaque): `f = 0` when either direction is at
 //! or below the horizon.
 
-use crate::fresnel;
-use crate::microfacet::{self, Distribution, Microfacet};
+use crate::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, math};
+use crate::fresnel::{self, FresnelLanes};
+use crate::microfacet::{self, Distribution, Microfacet, ScaleLanes};
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
-use crate::models::rough_dielectric::{Geometry, RoughDielectric};
+use crate::models::rough_dielectric::{Geometry, ReflectionLanes, RoughDielectric};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, BvError, Claims, FresnelTerm, Ndf, Result, Rgb, frame, quadrature, sampling};
@@ -210,6 +211,7 @@ pub struct Coated {
     base: Base,
     /// The conductor base's distribution (unused for Lambert).
     base_ndf: Microfacet,
+    kernel: Option<CoatedKernel>,
 }
 
 fn parse_dist(name: &str) -> Result<Distribution> {
@@ -329,6 +331,7 @@ impl Coated {
                 reason: format!("the internal reflection series diverges ({ms})"),
             });
         }
+        let kernel = CoatedKernel::new(&coat, eta, depth, ms, &base, &base_ndf);
         Ok(Self {
             ms,
             coat,
@@ -336,6 +339,7 @@ impl Coated {
             depth,
             base,
             base_ndf,
+            kernel,
         })
     }
 
@@ -569,6 +573,10 @@ impl Brdf for Coated {
         Some(self.coat.microfacet())
     }
 
+    fn batch_kernel(&self) -> Option<&dyn Kernel> {
+        self.kernel.as_ref().map(|k| k as &dyn Kernel)
+    }
+
     /// The coat's interface alone, untinted (the rough dielectric's
     /// furnace): with no base to return light, what it reflects and
     /// transmits in one scattering, `ρR + ρT`, is what a single-scattering
@@ -585,6 +593,177 @@ impl Brdf for Coated {
             },
             source: "exact dielectric (the coat)".into(),
         })
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Batch kernel.
+
+/// The base in f32 lanes.
+#[derive(Debug, Clone, Copy)]
+enum BaseLanes {
+    /// `albedo/π` per channel.
+    Lambert([f32; 3]),
+    /// Walter's eq. 20 with the coat's distribution at the base's roughness
+    /// and the conductor's Fresnel relative to the coat (`(η + ik)/η_coat`).
+    Conductor(ScaleLanes, FresnelLanes),
+}
+
+/// [`Coated::eval`] in f32 lanes: the coat's reflection from the
+/// `rough-dielectric` kernel's own lane code, plus the base seen through the
+/// coat, term by term as in [`Coated::eval_through`].
+#[derive(Debug, Clone, Copy)]
+struct CoatedKernel {
+    coat: ReflectionLanes,
+    /// 1/η and 1/η².
+    inv_eta: f32,
+    inv_eta2: f32,
+    /// η².
+    eta2: f32,
+    /// `σa d` per channel.
+    depth: [f32; 3],
+    /// The inter-reflection factor over η² per channel (`ms/η²`).
+    gain: [f32; 3],
+    base: BaseLanes,
+}
+
+impl CoatedKernel {
+    fn new(
+        coat: &RoughDielectric,
+        eta: f64,
+        depth: Rgb,
+        ms: Rgb,
+        base: &Base,
+        base_ndf: &Microfacet,
+    ) -> Option<Self> {
+        let coat = ReflectionLanes::of(coat)?;
+        let base = match *base {
+            Base::Lambert { albedo } => BaseLanes::Lambert(math::rgb(albedo * FRAC_1_PI)),
+            Base::Conductor { eta: be, k, .. } => {
+                let (tag, scale) = ScaleLanes::new(&base_ndf.first)?;
+                // The base shares the coat's distribution, so one const tag
+                // serves both lane calls.
+                if tag != coat.dist() {
+                    return None;
+                }
+                let f = fresnel::Fresnel::Conductor {
+                    eta: be / eta,
+                    k: k / eta,
+                };
+                BaseLanes::Conductor(scale, FresnelLanes::new(&f))
+            }
+        };
+        Some(Self {
+            coat,
+            inv_eta: (1.0 / eta) as f32,
+            inv_eta2: (1.0 / (eta * eta)) as f32,
+            eta2: (eta * eta) as f32,
+            depth: math::rgb(depth),
+            gain: math::rgb(ms / (eta * eta)),
+            base,
+        })
+    }
+}
+
+/// Fresnel transmittance `1 − F` of the coat's macro interface for light
+/// from above at `c = cos θ` (> 0), written out so that it does not cancel
+/// near grazing incidence: with `g = η cos θt = √(η² − 1 + c²)`,
+/// `T = ½ [4cg/(c + g)² + 4η²cg/(η²c + g)²]` (the complements of
+/// `((c − g)/(c + g))²` and `((η²c − g)/(η²c + g))²`, the s and p
+/// reflectances of [`fresnel::dielectric`]).
+#[inline(always)]
+fn transmittance<V: Lanes>(c: V, eta2: f32) -> V {
+    let g = (c * c + (eta2 - 1.0)).sqrt();
+    let (s1, s2) = (c + g, c * eta2 + g);
+    let cg4 = c * g * 4.0;
+    (cg4 / (s1 * s1) + cg4 * eta2 / (s2 * s2)) * 0.5
+}
+
+/// One monomorphised combination of distribution and base
+/// (`CONDUCTOR = false`: Lambert).
+#[derive(Debug)]
+struct CoatedLane<'a, const D: u8, const CONDUCTOR: bool>(&'a CoatedKernel);
+
+impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedLane<'_, D, CONDUCTOR> {
+    #[inline(always)]
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let k = self.0;
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let (zi, zo) = (wi[2], wo[2]);
+        let above = zi.gt(zero) & zo.gt(zero);
+        let coat = k.coat.lane::<D, V>(wi, wo);
+        // The refracted directions inside the coat (`Coated::inside`), with
+        // sin²θ as x² + y², which does not cancel near normal incidence.
+        let s2 = V::splat(k.inv_eta2);
+        let sin2_i = wi[0] * wi[0] + wi[1] * wi[1];
+        let sin2_o = wo[0] * wo[0] + wo[1] * wo[1];
+        let ti_z = (one - sin2_i * s2).max(zero).sqrt();
+        let to_z = (one - sin2_o * s2).max(zero).sqrt();
+        let trans = transmittance(zi, k.eta2) * transmittance(zo, k.eta2);
+        let path = one / ti_z + one / to_z;
+        let base: [V; 3] = if CONDUCTOR {
+            let BaseLanes::Conductor(scale, fres) = k.base else {
+                return [zero; 3];
+            };
+            let s = V::splat(k.inv_eta);
+            let ti = [wi[0] * s, wi[1] * s, ti_z];
+            let to = [wo[0] * s, wo[1] * s, to_z];
+            // The tangential half vector as (wi + wo)/η, summed before it
+            // is scaled: near the mirror pair the sum cancels (exactly, in
+            // f32), and two rounded products would leave an error that a
+            // base as sharp as α = 0.001 turns into 1e-4 of D.
+            let hu = [(wi[0] + wo[0]) * s, (wi[1] + wo[1]) * s, ti_z + to_z];
+            let h = math::scale3(hu, one / math::dot(hu, hu).sqrt());
+            let c = math::dot(ti, h);
+            let d = scale.d::<D, V>(h);
+            let g = one / (scale.one_plus_lambda::<D, V>(ti) * scale.one_plus_lambda::<D, V>(to));
+            let lobe = d * g / (ti_z * to_z * 4.0);
+            let f = fres.eval::<{ FresnelLanes::CONDUCTOR }, V>(c);
+            let ok = c.gt(zero);
+            math::channels!(|ch| ok.select(f[ch] * lobe, zero))
+        } else {
+            let BaseLanes::Lambert(a) = k.base else {
+                return [zero; 3];
+            };
+            math::splat3(a)
+        };
+        math::channels!(|ch| {
+            let through = base[ch] * math::exp(-path * k.depth[ch]) * trans * k.gain[ch];
+            let v = coat + through;
+            (above & v.is_finite()).select(v.max(zero), zero)
+        })
+    }
+}
+
+impl Kernel for CoatedKernel {
+    fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        let conductor = matches!(self.base, BaseLanes::Conductor(..));
+        match (self.coat.dist(), conductor) {
+            (ScaleLanes::BECKMANN, false) => batch::run(
+                &CoatedLane::<{ ScaleLanes::BECKMANN }, false>(self),
+                isa,
+                dirs,
+                out,
+            ),
+            (ScaleLanes::BECKMANN, true) => batch::run(
+                &CoatedLane::<{ ScaleLanes::BECKMANN }, true>(self),
+                isa,
+                dirs,
+                out,
+            ),
+            (_, false) => batch::run(
+                &CoatedLane::<{ ScaleLanes::GGX }, false>(self),
+                isa,
+                dirs,
+                out,
+            ),
+            (_, true) => batch::run(
+                &CoatedLane::<{ ScaleLanes::GGX }, true>(self),
+                isa,
+                dirs,
+                out,
+            ),
+        }
     }
 }
 

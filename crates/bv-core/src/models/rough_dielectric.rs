@@ -543,6 +543,38 @@ impl RdKernel {
     }
 }
 
+/// This interface's reflected lobe (Walter et al. 2007, eq. 20) in f32
+/// lanes, for a model that lays the interface over something else (the
+/// `coated` model's kernel): the same lane code as this model's own kernel,
+/// so the two cannot drift apart.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ReflectionLanes(RdKernel);
+
+impl ReflectionLanes {
+    /// The lane form of `rd`'s reflection, `None` when `rd` has no kernel,
+    /// is tinted or uses the height-correlated G (a coat is built untinted
+    /// with the separable G, which is all this form evaluates).
+    pub(crate) fn of(rd: &RoughDielectric) -> Option<Self> {
+        rd.kernel
+            .filter(|k| !k.correlated && k.tint == [1.0; 3])
+            .map(Self)
+    }
+
+    /// The distribution's const tag ([`ScaleLanes::BECKMANN`] or
+    /// [`ScaleLanes::GGX`]), which [`ReflectionLanes::lane`] must be called with.
+    pub(crate) fn dist(&self) -> u8 {
+        self.0.dist
+    }
+
+    /// `f_r(wi, wo)` (untinted, one value) for lanes with both directions
+    /// above the surface; other lanes are the model's value for them.
+    #[inline(always)]
+    pub(crate) fn lane<const D: u8, V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> V {
+        let [r, _, _] = RdLane::<D, false>(&self.0).lane(wi, wo);
+        r
+    }
+}
+
 /// `ln(1 + z)` for `z ≥ 0`, accurate relative to the result for small `z`.
 #[inline(always)]
 fn ln1p<V: Lanes>(z: V) -> V {
