@@ -232,6 +232,75 @@ function difference(a, b, [x0, y0, x1, y1] = [0, 0, a.width, a.height], tol = 24
   return diff / n;
 }
 
+// The scene `toml` with its BRDFs replaced by one of `model` with `params`
+// (TOML lines), the environment view maximised at `spp` samples per pixel.
+function withOnlyBrdf(toml, model, params, spp) {
+  const start = toml.indexOf("[[brdfs]]");
+  const end = toml.indexOf("[incident]");
+  const brdf = `[[brdfs]]\nid = 1\ncolor = [78, 151, 234]\nvisible = true\n\n` +
+    `[brdfs.spec]\nmodel = "${model}"\n\n[brdfs.spec.params]\n${params.join("\n")}\n\n`;
+  const one = toml.slice(0, start).replace(/^selected = .*$/m, "selected = 1").replace(/^next_id = .*$/m, "next_id = 2") +
+    brdf + toml.slice(end);
+  return withMaximised(one.replace(/^target_spp = .*$/m, `target_spp = ${spp}`)
+    .replace(/^object = .*$/m, 'object = "Sphere"'), "environment");
+}
+
+// Glass in the environment view on WebGPU (issue 33 part 5): a clear
+// rough-dielectric sphere shows the studio through it, upside down (the
+// floor at the top of the sphere, the bright wall at the bottom), where the
+// studio behind it is bright above and dark below. The sphere's pixels are
+// found from the same scene with a black Lambertian sphere. Without the
+// paths through the object the sphere shows only its few per cent of
+// reflection: dark, and not inverted.
+async function glassInTheStudio(context, toml, base) {
+  const area = [330, 50, W - 20, H - 50];
+  const draw = async (model, params, name) => {
+    const p = await open(context, linkOf(base, withOnlyBrdf(toml, model, params, 64)), name);
+    await p.page.waitForTimeout(SETTLE_MS);
+    const img = await shot(p.page, name);
+    checkWebGpu(p, name, true);
+    noErrors(p, name);
+    await p.page.close();
+    return img;
+  };
+  const black = await draw("lambert", ["albedo = 0.0"], "webgpu-env-black-sphere");
+  const glass = await draw("rough-dielectric",
+    ["alpha_x = 0.05", "alpha_y = 0.05", 'distribution = "ggx"', "eta = 1.5", 'geometry = "smith"',
+      "tint = [1.0, 1.0, 1.0]"], "webgpu-env-glass-sphere");
+  const lum = (img, i) => 0.2126 * img.px[i] + 0.7152 * img.px[i + 1] + 0.0722 * img.px[i + 2];
+  // The sphere: what the black sphere leaves black inside the view.
+  let y0 = Infinity, y1 = -Infinity, n = 0;
+  for (let y = area[1]; y < area[3]; y++) {
+    for (let x = area[0]; x < area[2]; x++) {
+      const i = (y * W + x) * 4;
+      if (lum(black, i) < 3) { n++; y0 = Math.min(y0, y); y1 = Math.max(y1, y); }
+    }
+  }
+  const share = n / ((area[2] - area[0]) * (area[3] - area[1]));
+  check(share > 0.05, `environment view: the black sphere covers ${(100 * share).toFixed(1)}% of the view`);
+  if (share <= 0.05) return;
+  const cy = (y0 + y1) / 2;
+  const mean = (img, upper, sphere) => {
+    let s = 0, c = 0;
+    for (let y = area[1]; y < area[3]; y++) {
+      if ((y < cy) !== upper) continue;
+      for (let x = area[0]; x < area[2]; x++) {
+        const i = (y * W + x) * 4;
+        if ((lum(black, i) < 3) === sphere) { s += lum(img, i); c++; }
+      }
+    }
+    return s / Math.max(c, 1);
+  };
+  const [gUp, gDown] = [mean(glass, true, true), mean(glass, false, true)];
+  const [bUp, bDown] = [mean(black, true, false), mean(black, false, false)];
+  const through = (gUp + gDown) / Math.max(bUp + bDown, 1);
+  check(through > 0.5,
+    `glass on WebGPU: the studio is seen through the sphere (its mean luminance ${(100 * through).toFixed(0)}% of the studio's)`);
+  check(bUp > bDown && gDown > gUp * 1.2,
+    `glass on WebGPU: the studio seen through it is upside down (sphere top ${gUp.toFixed(0)} / bottom ${gDown.toFixed(0)}; ` +
+    `studio top ${bUp.toFixed(0)} / bottom ${bDown.toFixed(0)})`);
+}
+
 // ---- the links (the same encoding as the Rust side: deflate, base64url) ----
 function linkToml(url) {
   const frag = new URL(url).hash.replace(/^#/, "");
@@ -640,6 +709,7 @@ async function webgpuChecks(context, base, keeps) {
     noErrors(p, `view ${view}`);
     await p.page.close();
   }
+  if (keeps) await glassInTheStudio(context, toml, base);
   if (keeps) await forcedLoss(context, toml, base);
 
   // A scene file dropped on the page opens.
