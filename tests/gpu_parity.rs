@@ -321,6 +321,20 @@ fn param_sets(model: &str) -> Vec<(String, ModelSpec)> {
             }
         }
     }
+    if model == "cook-torrance" {
+        // Kulla–Conty's anisotropic table: the azimuthal harmonics the port
+        // reads from the table buffer.
+        for dist in ["ggx", "beckmann"] {
+            let p = serde_json::json!({"kd": 0.1, "ks": 0.8, "distribution": dist,
+                "geometry": "smith-correlated", "alpha_x": 0.8, "alpha_y": 0.2,
+                "fresnel": "conductor", "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14],
+                "multiscatter": "kulla-conty"});
+            sets.push((
+                format!("kulla-conty {dist} 0.8/0.2"),
+                ModelSpec::from_json(model, &p).unwrap(),
+            ));
+        }
+    }
     if model == "mix" {
         // Every other ported model as a component, one nested mix included.
         let comps: Vec<serde_json::Value> = catalogue()

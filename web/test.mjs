@@ -233,8 +233,8 @@ function difference(a, b, [x0, y0, x1, y1] = [0, 0, a.width, a.height], tol = 24
 }
 
 // The scene `toml` with its BRDFs replaced by one of `model` with `params`
-// (TOML lines), the environment view maximised at `spp` samples per pixel.
-function withOnlyBrdf(toml, model, params, spp) {
+// (TOML lines), `view` maximised, the environment at `spp` samples per pixel.
+function withOnlyBrdf(toml, model, params, spp, view = "environment") {
   const start = toml.indexOf("[[brdfs]]");
   const end = toml.indexOf("[incident]");
   const brdf = `[[brdfs]]\nid = 1\ncolor = [78, 151, 234]\nvisible = true\n\n` +
@@ -242,7 +242,7 @@ function withOnlyBrdf(toml, model, params, spp) {
   const one = toml.slice(0, start).replace(/^selected = .*$/m, "selected = 1").replace(/^next_id = .*$/m, "next_id = 2") +
     brdf + toml.slice(end);
   return withMaximised(one.replace(/^target_spp = .*$/m, `target_spp = ${spp}`)
-    .replace(/^object = .*$/m, 'object = "Sphere"'), "environment");
+    .replace(/^object = .*$/m, 'object = "Sphere"'), view);
 }
 
 // Glass in the environment view on WebGPU (issue 33 part 5): a clear
@@ -254,8 +254,8 @@ function withOnlyBrdf(toml, model, params, spp) {
 // reflection: dark, and not inverted.
 async function glassInTheStudio(context, toml, base) {
   const area = [330, 50, W - 20, H - 50];
-  const draw = async (model, params, name) => {
-    const p = await open(context, linkOf(base, withOnlyBrdf(toml, model, params, 64)), name);
+  const draw = async (model, params, name, view = "environment") => {
+    const p = await open(context, linkOf(base, withOnlyBrdf(toml, model, params, 64, view)), name);
     await p.page.waitForTimeout(SETTLE_MS);
     const img = await shot(p.page, name);
     checkWebGpu(p, name, true);
@@ -263,10 +263,25 @@ async function glassInTheStudio(context, toml, base) {
     await p.page.close();
     return img;
   };
+  const glassParams = ["alpha_x = 0.05", "alpha_y = 0.05", 'distribution = "ggx"', "eta = 1.5",
+    'geometry = "smith"', "tint = [1.0, 1.0, 1.0]"];
+  // The polar view of the same glass is a full circle: its transmitted lobe
+  // is drawn below the surface, in the BRDF's colour (78, 151, 234).
+  {
+    const polar = await draw("rough-dielectric", glassParams, "webgpu-polar-glass", "polar");
+    let below = 0;
+    const mid = Math.round((area[1] + area[3]) / 2);
+    for (let y = mid + 20; y < area[3]; y++) {
+      for (let x = area[0]; x < area[2]; x++) {
+        const i = (y * W + x) * 4;
+        const d = Math.abs(polar.px[i] - 78) + Math.abs(polar.px[i + 1] - 151) + Math.abs(polar.px[i + 2] - 234);
+        if (d < 60) below++;
+      }
+    }
+    check(below > 300, `glass on WebGPU: the polar view draws the transmitted lobe below the surface (${below} pixels)`);
+  }
   const black = await draw("lambert", ["albedo = 0.0"], "webgpu-env-black-sphere");
-  const glass = await draw("rough-dielectric",
-    ["alpha_x = 0.05", "alpha_y = 0.05", 'distribution = "ggx"', "eta = 1.5", 'geometry = "smith"',
-      "tint = [1.0, 1.0, 1.0]"], "webgpu-env-glass-sphere");
+  const glass = await draw("rough-dielectric", glassParams, "webgpu-env-glass-sphere");
   const lum = (img, i) => 0.2126 * img.px[i] + 0.7152 * img.px[i + 1] + 0.0722 * img.px[i + 2];
   // The sphere: what the black sphere leaves black inside the view.
   let y0 = Infinity, y1 = -Infinity, n = 0;

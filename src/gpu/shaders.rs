@@ -173,23 +173,46 @@ impl ShaderLibrary {
         // A module without an import path cannot be named: it is registered
         // with the first shader composed, as every module used to be.
         needed.extend((0..self.modules.len()).filter(|&i| self.modules[i].name.is_none()));
-        for i in 0..self.modules.len() {
-            let m = &self.modules[i];
-            if m.registered || !needed.contains(&i) {
-                continue;
+        // In dependency order (naga_oil needs a module's imports registered
+        // before it): each round registers the needed modules whose imports
+        // are all registered; registration order breaks ties, and a cycle
+        // is left to naga_oil to report.
+        let mut pending: Vec<usize> = (0..self.modules.len())
+            .filter(|i| needed.contains(i) && !self.modules[*i].registered)
+            .collect();
+        while !pending.is_empty() {
+            let ready: Vec<usize> = pending
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    self.modules[i].imports.iter().all(|import| {
+                        self.modules
+                            .iter()
+                            .all(|m| m.registered || !m.provides(import))
+                    })
+                })
+                .collect();
+            let batch = if ready.is_empty() {
+                std::mem::take(&mut pending)
+            } else {
+                pending.retain(|i| !ready.contains(i));
+                ready
+            };
+            for i in batch {
+                let m = &self.modules[i];
+                let added = self
+                    .composer
+                    .add_composable_module(ComposableModuleDescriptor {
+                        source: &m.source,
+                        file_path: &m.path,
+                        language: ShaderLanguage::Wgsl,
+                        ..Default::default()
+                    });
+                if let Err(e) = added {
+                    return Err(anyhow!("{}: {}", m.path, e.emit_to_string(&self.composer)));
+                }
+                self.modules[i].registered = true;
             }
-            let added = self
-                .composer
-                .add_composable_module(ComposableModuleDescriptor {
-                    source: &m.source,
-                    file_path: &m.path,
-                    language: ShaderLanguage::Wgsl,
-                    ..Default::default()
-                });
-            if let Err(e) = added {
-                return Err(anyhow!("{}: {}", m.path, e.emit_to_string(&self.composer)));
-            }
-            self.modules[i].registered = true;
         }
         Ok(())
     }

@@ -340,6 +340,31 @@ fn every_cook_torrance_combination_is_checked() {
 }
 
 #[test]
+fn anisotropic_kulla_conty_is_checked() {
+    // The compensation's azimuthal harmonics (`multiscatter`), read by the
+    // kernel per lane: both distributions and Smith forms, with a Fresnel
+    // colour, and an isotropic lobe beside them.
+    let dirs = pairs(10);
+    for dist in ["beckmann", "ggx"] {
+        for geo in ["smith", "smith-correlated"] {
+            for (ax, ay) in [(0.8, 0.2), (0.1, 0.5), (0.4, 0.4)] {
+                let p = serde_json::json!({"kd": 0.1, "ks": 0.8, "distribution": dist,
+                    "geometry": geo, "fresnel": "conductor", "alpha_x": ax, "alpha_y": ay,
+                    "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14],
+                    "multiscatter": "kulla-conty"});
+                let b = ModelSpec::from_json("cook-torrance", &p)
+                    .unwrap()
+                    .build()
+                    .unwrap();
+                if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
+                    panic!("{p}: {e}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn every_rough_dielectric_combination_is_checked() {
     // Both distributions and geometries, sharp to very rough, indices on
     // both sides of 1 and at the ends of the range, on the whole sphere.

@@ -11,8 +11,8 @@ use crate::fresnel::{self, Fresnel, FresnelLanes};
 use crate::microfacet::{
     self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
 };
-use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
-use crate::multiscatter::{self, KullaConty, TABLE_LEN};
+use crate::model::{ALPHA_ALIAS, Build, GpuBlob, GpuPort, GpuTables, ModelInfo, TABLE_ALIGN};
+use crate::multiscatter::{self, HARMONICS, HarmonicRows, KullaConty, TABLE_LEN};
 use crate::params::decl::{Applies, ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, Claims, FresnelTerm, MicrofacetTerms, Ndf, Result, Rgb, mean_rgb, sampling};
@@ -132,7 +132,10 @@ pub static INFO: ModelInfo = ModelInfo {
 /// distribution is `blinn` (each costs a quadrature, done once here rather
 /// than per shaded pixel); then Kulla–Conty's colour `F_ms / (π (1 − E_avg))`
 /// (0 with `multiscatter = none`) and its table of the loss 1 − E
-/// ([`TABLE_LEN`] entries uniform in √μ, `crate::multiscatter`).
+/// ([`TABLE_LEN`] entries uniform in √μ, `crate::multiscatter`); then, for
+/// an anisotropic lobe, where its azimuthal harmonics' rows sit in the table
+/// buffer (in units of [`TABLE_ALIGN`] floats) and how many there are (0:
+/// none, the lobe is isotropic).
 const DERIVED_SLOTS: &[&str] = &[
     "blinn_norm",
     "blinn_norm2",
@@ -171,12 +174,14 @@ const DERIVED_SLOTS: &[&str] = &[
     "ms_l29",
     "ms_l30",
     "ms_l31",
+    "ms_harmonics",
+    "ms_n_harmonics",
 ];
 
 // The slot list spells the table out: keep it the table's length.
-const _: () = assert!(DERIVED_SLOTS.len() == 5 + TABLE_LEN);
+const _: () = assert!(DERIVED_SLOTS.len() == 7 + TABLE_LEN);
 
-fn derive_slots(spec: &ModelSpec, _tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
+fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
     let p = spec.params();
     let mut v = if p.text("distribution")? == "blinn" {
         vec![
@@ -192,8 +197,16 @@ fn derive_slots(spec: &ModelSpec, _tables: &mut dyn GpuTables) -> Result<Vec<f32
         Some(ms) => {
             v.extend([ms.scale.x as f32, ms.scale.y as f32, ms.scale.z as f32]);
             v.extend(ms.loss_f32());
+            match ms.harmonic_loss_f32() {
+                Some(rows) => {
+                    let blob: Arc<dyn GpuBlob> = rows;
+                    let at = tables.offset_of(blob) / TABLE_ALIGN;
+                    v.extend([at as f32, (HARMONICS - 1) as f32]);
+                }
+                None => v.extend([0.0, 0.0]),
+            }
         }
-        None => v.extend([0.0; 3 + TABLE_LEN]),
+        None => v.extend([0.0; 5 + TABLE_LEN]),
     }
     Ok(v)
 }
@@ -443,10 +456,11 @@ impl Brdf for CookTorrance {
         //   for F_avg, E_avg in [0, 1]); with F = 1 it is 1 at every θi (up
         //   to the table's accuracy, 1e-3; `crate::multiscatter`). E is
         //   clamped to ≤ 1, so Blinn with Smith (E > 1 at grazing) stays
-        //   without a claim as before. With αx ≠ αy the table holds E averaged
-        //   over the azimuth (`crate::multiscatter`), and at one azimuth
-        //   E(μ, φ) + 1 − Ē(μ) exceeds 1 by up to ~4 % (αx/αy = 2, measured in
-        //   `tests/kulla_conty.rs`): no claim then. The table's error (below
+        //   without a claim as before. With αx ≠ αy the table holds E's
+        //   cosine series in 2φ (`crate::multiscatter`): within 1e-3 at
+        //   αx/αy up to 4 (`tests/kulla_conty.rs`), but the range allows
+        //   αx/αy = 2000, where eight harmonics cannot follow E's azimuthal
+        //   spike: no claim for an anisotropic lobe. The table's error (below
         //   1e-3, `crate::multiscatter`) can put ρhd a few 1e-4 above 1 at
         //   ks = 1, F = 1, so the claim keeps that margin: kd + ks (1 + 1e-3) ≤ 1.
         let blinn_smith = self.ndf.first.dist == Distribution::Blinn
@@ -508,7 +522,7 @@ impl Brdf for CookTorrance {
 /// cosθo)` with the lane forms of D, Λ and F. Each combination of D (Beckmann,
 /// GGX), G, F and mixture on/off is its own monomorphised loop ([`CtLane`]),
 /// so the lane code has no branch on the model's choices.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct CtKernel {
     diffuse: [f32; 3],
     ks: f32,
@@ -520,10 +534,15 @@ struct CtKernel {
     mix: bool,
     geometry: u8,
     fresnel: FresnelLanes,
-    /// Kulla–Conty: `ks F_ms / (π (1 − E_avg))` per channel and the table of
-    /// the loss 1 − E, when chosen.
-    multiscatter: Option<([f32; 3], [f32; TABLE_LEN])>,
+    /// Kulla–Conty, when chosen: `ks F_ms / (π (1 − E_avg))` per channel,
+    /// the table of the mean loss 1 − E and, for an anisotropic lobe, its
+    /// harmonics' rows (`crate::multiscatter`).
+    multiscatter: Option<MsLanes>,
 }
+
+/// Kulla–Conty in the kernel: the colour, the mean loss table and the
+/// harmonics' rows (see [`CtKernel::multiscatter`]).
+type MsLanes = ([f32; 3], [f32; TABLE_LEN], Option<Arc<HarmonicRows>>);
 
 const VGROOVE: u8 = 0;
 const SMITH: u8 = 1;
@@ -564,25 +583,32 @@ impl CtKernel {
             fresnel: FresnelLanes::new(fresnel),
             multiscatter: multiscatter.map(|ms| {
                 let c = ms.scale * ks;
-                ([c.x as f32, c.y as f32, c.z as f32], ms.loss_f32())
+                (
+                    [c.x as f32, c.y as f32, c.z as f32],
+                    ms.loss_f32(),
+                    ms.harmonic_loss_f32(),
+                )
             }),
         })
     }
 }
 
-/// `1 − E(μ)` per lane from the loss table (`multiscatter::lookup`'s
-/// arithmetic in f32, as the WGSL port does it): lanes have no gather, so
-/// through a scalar loop over the stored lanes.
+/// `1 − E(ω)` per lane from the loss tables (`multiscatter::loss_dir_f32`,
+/// the WGSL port's arithmetic): lanes have no gather, so through a scalar
+/// loop over the stored lanes.
 #[inline(always)]
-fn lookup_lanes<V: Lanes>(e: &[f32; TABLE_LEN], mu: V) -> V {
+fn loss_lanes<V: Lanes>(mean: &[f32; TABLE_LEN], harmonics: Option<&[f32]>, w: [V; 3]) -> V {
     const MAX_LANES: usize = 64;
     let n = V::LANES.min(MAX_LANES);
-    let mut buf = [0.0f32; MAX_LANES];
-    mu.store(&mut buf[..n]);
-    for x in &mut buf[..n] {
-        *x = multiscatter::lookup_f32(e, *x);
+    let mut buf = [[0.0f32; MAX_LANES]; 3];
+    for (b, c) in buf.iter_mut().zip(w) {
+        c.store(&mut b[..n]);
     }
-    V::load(&buf[..n])
+    let mut out = [0.0f32; MAX_LANES];
+    for (i, o) in out[..n].iter_mut().enumerate() {
+        *o = multiscatter::loss_dir_f32(mean, harmonics, [buf[0][i], buf[1][i], buf[2][i]]);
+    }
+    V::load(&out[..n])
 }
 
 /// One monomorphised combination of [`CtKernel`]'s choices.
@@ -649,8 +675,9 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
         match &k.multiscatter {
             // Kulla–Conty's lobe (see `crate::multiscatter`): a branch on the
             // model's choice, the same for every lane.
-            Some((c, loss)) => {
-                let m = lookup_lanes(loss, wi[2]) * lookup_lanes(loss, wo[2]);
+            Some((c, loss, harmonics)) => {
+                let h = harmonics.as_deref().map(GpuBlob::gpu_data);
+                let m = loss_lanes(loss, h, wi) * loss_lanes(loss, h, wo);
                 math::channels!(|ch| above.select(fr[ch] * scalar + k.diffuse[ch] + m * c[ch], zero))
             }
             None => math::channels!(|c| above.select(fr[c] * scalar + k.diffuse[c], zero)),
