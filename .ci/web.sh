@@ -29,4 +29,12 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     chmod 700 "$XDG_RUNTIME_DIR"
     export XDG_RUNTIME_DIR
 fi
+# The desktop binary writes the RGL file the page test drops (`bv tabulate
+# --format rgl`): .ci/run's cargo test has built it; alone, this builds it
+# (as .ci/python.sh does, resolved with the workspace's features).
+if [ -z "${BV_BIN:-}" ]; then
+    BV_BIN="${CARGO_TARGET_DIR:-target}/debug/bv"
+    [ -x "$BV_BIN" ] || cargo build -q --workspace --bin bv
+fi
+export BV_BIN
 node web/test.mjs

@@ -699,6 +699,34 @@ fn the_g_slide_shows_g2_alone_v_groove_against_smith() {
     // mirror direction and in backscatter, and below the v-groove's 1.
     assert!((at_x(s, 80.0) - at_x(s, -80.0)).abs() < 1e-9);
     assert!((at_x(s, 80.0) - 0.56).abs() < 0.01, "{}", at_x(s, 80.0));
+    // The v-groove cross-sections (LECTURE.md N9) under the chart, at the
+    // mirror direction, the normal and back towards the light: flat
+    // grooves all lit and seen; at θo = 0 the facets tilt 40° and the light
+    // reaches 2 cos 80° of each; towards the light the grooves are 80°
+    // deep and 2 cos² 80° of each facet is both lit and seen. Each panel's
+    // G is the curve's value there.
+    let sl = slide(&slides, "G: shadowing and masking");
+    assert!(sl.state.plots.terms.vgroove);
+    let mut rt = Runtime::default();
+    rt.sync(&sl.state);
+    let scene = build_scene(&sl.state, &rt, false);
+    let panels = bv::views::terms::vgroove_sections(&scene);
+    let at: Vec<_> = panels.iter().map(|p| p.theta_o_deg).collect();
+    assert_eq!(at, vec![80.0, 0.0, -80.0]);
+    let c80 = 80f64.to_radians().cos();
+    for (p, tilt, lit, seen) in [
+        (&panels[0], 0.0, 1.0, 1.0),
+        (&panels[1], 40.0, 2.0 * c80, 1.0),
+        (&panels[2], 80.0, 2.0 * c80 * c80, 2.0 * c80 * c80),
+    ] {
+        let s = p.section.unwrap();
+        assert!((s.tilt.to_degrees() - tilt).abs() < 1e-9, "{p:?}");
+        assert!(
+            (s.lit - lit).abs() < 1e-12 && (s.seen - seen).abs() < 1e-12,
+            "{p:?}"
+        );
+        assert!((s.g - at_x(v, p.theta_o_deg)).abs() < 1e-9, "{p:?}");
+    }
 }
 
 /// `|got − want| ≤ tol · want`, with the scene and quantity in the message.

@@ -30,6 +30,8 @@ import fs from "node:fs";
 import path from "node:path";
 import zlib from "node:zlib";
 import { fileURLToPath } from "node:url";
+import { execFileSync } from "node:child_process";
+import os from "node:os";
 
 const here = path.dirname(fileURLToPath(import.meta.url));
 const dist = path.join(here, "dist");
@@ -254,8 +256,11 @@ function withOnlyBrdf(toml, model, params, spp, view = "environment") {
 // reflection: dark, and not inverted.
 async function glassInTheStudio(context, toml, base) {
   const area = [330, 50, W - 20, H - 50];
-  const draw = async (model, params, name, view = "environment") => {
-    const p = await open(context, linkOf(base, withOnlyBrdf(toml, model, params, 64, view)), name);
+  // Few samples per pixel: the checks below are means over thousands of
+  // pixels (the glass sphere at 16 spp still draws for a minute on a
+  // software adapter; the black one needs one sample).
+  const draw = async (model, params, name, view = "environment", spp = 16) => {
+    const p = await open(context, linkOf(base, withOnlyBrdf(toml, model, params, spp, view)), name);
     await p.page.waitForTimeout(SETTLE_MS);
     const img = await shot(p.page, name);
     checkWebGpu(p, name, true);
@@ -280,7 +285,7 @@ async function glassInTheStudio(context, toml, base) {
     }
     check(below > 300, `glass on WebGPU: the polar view draws the transmitted lobe below the surface (${below} pixels)`);
   }
-  const black = await draw("lambert", ["albedo = 0.0"], "webgpu-env-black-sphere");
+  const black = await draw("lambert", ["albedo = 0.0"], "webgpu-env-black-sphere", "environment", 1);
   const glass = await draw("rough-dielectric", glassParams, "webgpu-env-glass-sphere");
   const lum = (img, i) => 0.2126 * img.px[i] + 0.7152 * img.px[i + 1] + 0.0722 * img.px[i + 2];
   // The sphere: what the black sphere leaves black inside the view.
@@ -940,8 +945,8 @@ async function downloadChecks(context, gl, toml) {
   await p.page.close();
 }
 
-// Files dropped on the page open: a MERL table, a .brdf model, an
-// environment map.
+// Files dropped on the page open: a MERL table, an RGL material, a .brdf
+// model, an environment map.
 async function openFileChecks(context, gl, toml) {
   const p = await open(context, linkOf(gl, withMaximised(toml, "polar")), "a page files are opened on");
   await p.page.waitForTimeout(SETTLE_MS);
@@ -964,6 +969,22 @@ async function openFileChecks(context, gl, toml) {
   };
   await opened("test.binary", [{ name: "test.binary", base64: merlTable().toString("base64") }],
     "a dropped MERL table");
+  // An RGL material (.bsdf tensor file, issue 34), written by the desktop
+  // binary (BV_BIN, which .ci/web.sh finds or builds): GGX α 0.2 over a
+  // blue base, tabulated as the RGL database stores materials.
+  {
+    const bin = process.env.BV_BIN;
+    const file = path.join(fs.mkdtempSync(path.join(os.tmpdir(), "bv-web-")), "ggx.bsdf");
+    let bytes = null;
+    try {
+      execFileSync(bin || "bv", ["tabulate", "--format", "rgl", "-m", "cook-torrance", "-p", "distribution=ggx",
+        "-p", "alpha=0.2", "-p", "kd=0.05,0.1,0.4", "-p", "ks=0.6", "--out", file], { stdio: "ignore" });
+      bytes = fs.readFileSync(file);
+    } catch (e) {
+      check(false, `an RGL file is written for the drop (BV_BIN=${bin}): ${e}`);
+    }
+    if (bytes) await opened("ggx.bsdf", [{ name: "ggx.bsdf", base64: bytes.toString("base64") }], "a dropped RGL material");
+  }
   await opened("phong.brdf", [{ name: "phong.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
     "a dropped .brdf model");
   // Hostile .brdf files (tests/data/brdf/hostile/: a 7,000-term sum and

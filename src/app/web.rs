@@ -12,7 +12,8 @@
 //!
 //! Files dropped on the page or picked in the browser's file chooser (what
 //! the viewer's *Open* dialogs open in a page) arrive as bytes and open as on
-//! the desktop: scene files, MERL tables, `.brdf` models, environment maps.
+//! the desktop: scene files, MERL tables, RGL materials, `.brdf` models,
+//! environment maps.
 //! What the desktop writes to a file (*Save scene*, figures) becomes a
 //! download.
 //!
@@ -311,9 +312,9 @@ impl WebApp {
 
     /// Opens a file the page was handed as bytes, as the desktop opens the
     /// file of that name: a scene file replaces the scene; an environment
-    /// map becomes the environment view's; a MERL table or a `.brdf` model
-    /// becomes a BRDF (or the selected BRDF's file, as a drop on the desktop
-    /// does). The bytes are handed to bv's readers under the file's name
+    /// map becomes the environment view's; a MERL table, an RGL material or a
+    /// `.brdf` model becomes a BRDF (or the selected BRDF's file, as a drop on
+    /// the desktop does). The bytes are handed to bv's readers under the file's name
     /// ([`bv_core::fsio::provide`]), so the one loading path reads them.
     fn open_bytes(&mut self, name: &str, bytes: Vec<u8>, several: bool) {
         let ext = name
@@ -356,7 +357,7 @@ impl WebApp {
             return;
         }
         self.message = Some(format!(
-            "{name}: not a file bv opens (scene files .{}, MERL tables, .brdf models, \
+            "{name}: not a file bv opens (scene files .{}, MERL tables, RGL materials, .brdf models, \
              environment maps)",
             scene_file::EXTENSION
         ));

@@ -402,6 +402,9 @@ pub struct TermToggles {
     pub g2: bool,
     /// F(θd).
     pub f: bool,
+    /// The v-groove cross-sections (Torrance & Sparrow's grooves, lit and
+    /// seen parts) at three outgoing directions, under the charts.
+    pub vgroove: bool,
 }
 
 impl Default for TermToggles {
@@ -412,6 +415,7 @@ impl Default for TermToggles {
             g1: true,
             g2: true,
             f: true,
+            vgroove: false,
         }
     }
 }

@@ -10,6 +10,15 @@
 //! - F(θd): the Fresnel factor against the angle between ωi and h (mean of
 //!   the RGB channels when they differ).
 //!
+//! With *v-groove* on, a strip under the charts draws Torrance & Sparrow's
+//! V-grooves in the plane of incidence (`bv_core::microfacet::
+//! v_groove_section`) at three outgoing directions, the mirror direction,
+//! the normal and back towards the light: the grooves whose facets reflect
+//! ωi into ωo, the part of the facet the light reaches (from the rim down:
+//! the partner facet shadows the rest) and the part the viewer sees, and
+//! their overlap, the v-groove G (LECTURE.md N9, scene "G: shadowing and
+//! masking").
+//!
 //! Loading several Cook-Torrance BRDFs compares Beckmann, Blinn and GGX, or
 //! v-groove, separable and height-correlated Smith, side by side. Models
 //! without terms are listed as such. The numbers are the models' own
@@ -24,7 +33,8 @@ use crate::derive::slices;
 use crate::session::command::Command;
 use crate::session::state::PlotSettings;
 use bv_core::frame;
-use eframe::egui::{self, RichText, Ui};
+use bv_core::microfacet::{VGrooveSection, v_groove_section};
+use eframe::egui::{self, Color32, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoints, VLine};
 use std::f64::consts::FRAC_PI_2;
 
@@ -193,7 +203,12 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
     if show.g1 || show.g2 {
         let mut c = Chart {
             x_label: "θo (°) in the plane of incidence, negative on the light's side".into(),
-            y_label: "G1 (dashed), G2".into(),
+            y_label: match (show.g1, show.g2) {
+                (true, true) => "G1 (dashed), G2",
+                (true, false) => "G1",
+                _ => "G2",
+            }
+            .into(),
             x_range: (-90.0, 90.0),
             // Headroom above 1 for the legend.
             y_range: (0.0, 1.45),
@@ -415,6 +430,230 @@ pub fn plot_chart(
     }
 }
 
+/// One panel of the v-groove strip: the outgoing direction's signed θo
+/// (the charts' convention: + on the mirror side), its name, and the
+/// section there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VGroovePanel {
+    /// The light's θi, degrees.
+    pub theta_i_deg: f64,
+    /// Signed θo, degrees.
+    pub theta_o_deg: f64,
+    /// "ωr", "n" or "towards the light".
+    pub name: &'static str,
+    /// The grooves, or `None` where there is none (light at the horizon).
+    pub section: Option<VGrooveSection>,
+}
+
+/// The strip's panels for the scene's light: θo = +θi (the mirror
+/// direction), 0 and −θi (back towards the light); one panel at normal
+/// incidence.
+pub fn vgroove_sections(scene: &Scene<'_>) -> Vec<VGroovePanel> {
+    let theta_i = scene.incident.theta_deg;
+    let phi_i = scene.incident.phi_deg.to_radians();
+    let wi = scene.wi();
+    // The plane's horizontal direction towards the light.
+    let u = glam::DVec3::new(phi_i.cos(), phi_i.sin(), 0.0);
+    let mut out: Vec<VGroovePanel> = Vec::new();
+    for (t, name) in [(theta_i, "ωr"), (0.0, "n"), (-theta_i, "towards the light")] {
+        if out.iter().any(|p| (p.theta_o_deg - t).abs() < 1e-9) {
+            continue;
+        }
+        let wo = slices::plane_direction(t.to_radians(), phi_i);
+        out.push(VGroovePanel {
+            theta_i_deg: theta_i,
+            theta_o_deg: t,
+            name,
+            section: v_groove_section(wi, wo, u),
+        });
+    }
+    out
+}
+
+/// Draws the v-groove panels side by side in `rect`.
+fn paint_vgrooves(painter: &egui::Painter, rect: egui::Rect, panels: &[VGroovePanel], dark: bool) {
+    let text = super::strong_text_color(dark);
+    let n = panels.len().max(1) as f32;
+    let w = rect.width() / n;
+    for (k, p) in panels.iter().enumerate() {
+        let r = egui::Rect::from_min_size(
+            egui::pos2(rect.left() + k as f32 * w, rect.top()),
+            egui::vec2(w, rect.height()),
+        )
+        .shrink(6.0);
+        paint_vgroove(painter, r, p, dark, text);
+    }
+}
+
+/// The light's and the viewer's colours in the v-groove panels.
+const LIGHT: Color32 = Color32::from_rgb(250, 200, 60);
+const VIEW: Color32 = Color32::from_rgb(90, 170, 255);
+
+/// One v-groove panel in `r`. Screen x runs as the charts' θo: the light on
+/// the left (at −θi), the mirror direction on the right; a direction at
+/// signed angle θ is `(sin θ, cos θ)`, and the facets' normal, the half
+/// vector, is at `−tilt`.
+fn paint_vgroove(
+    painter: &egui::Painter,
+    r: egui::Rect,
+    p: &VGroovePanel,
+    dark: bool,
+    text: Color32,
+) {
+    let font = egui::FontId::proportional(13.0);
+    let sign = if p.theta_o_deg > 0.0 { "+" } else { "" };
+    let title = format!("θo = {sign}{:.0}° ({})", p.theta_o_deg, p.name);
+    let head = painter.text(
+        r.center_top(),
+        egui::Align2::CENTER_TOP,
+        title,
+        font.clone(),
+        text,
+    );
+    let Some(s) = p.section else {
+        painter.text(
+            r.center(),
+            egui::Align2::CENTER_CENTER,
+            "no groove",
+            font,
+            text,
+        );
+        return;
+    };
+    let foot_text = format!("lit {:.2} · seen {:.2} · G = {:.2}", s.lit, s.seen, s.g);
+    let foot = painter.text(
+        r.center_bottom(),
+        egui::Align2::CENTER_BOTTOM,
+        foot_text,
+        font,
+        text,
+    );
+    let fig = egui::Rect::from_x_y_ranges(r.x_range(), head.bottom() + 4.0..=foot.top() - 4.0);
+    if fig.height() < 20.0 || fig.width() < 40.0 {
+        return;
+    }
+    // Two grooves of half-width 1 and depth t = tan|tilt|, with room above
+    // for the rays. A deep groove (a low light) is cut below what matters,
+    // 2.5 times the deeper of the lit and seen parts, at least one unit: its
+    // rims, where the light and the view reach, stay large enough to read.
+    let t = s.tilt.abs().min(89f64.to_radians()).tan() as f32;
+    let reach = s.lit.max(s.seen) as f32 * t;
+    let depth = t.min((2.5 * reach).max(1.0));
+    let scale = (fig.width() / 4.8).min(fig.height() / (depth + 1.3));
+    let origin = egui::pos2(fig.center().x, fig.top() + 1.2 * scale);
+    let at = |(x, z): (f32, f32)| egui::pos2(origin.x + x * scale, origin.y - z * scale);
+    let cut = depth < t;
+    let unclipped = painter;
+    let painter = &painter.with_clip_rect(egui::Rect::from_x_y_ranges(
+        fig.x_range(),
+        fig.top()..=at((0.0, -depth - 0.12)).y,
+    ));
+    let profile = [(-2.0, 0.0), (-1.0, -t), (0.0, 0.0), (1.0, -t), (2.0, 0.0)];
+    let material = if dark {
+        Color32::from_gray(70)
+    } else {
+        Color32::from_gray(190)
+    };
+    // The material under the profile, one quad per facet.
+    let bottom = -t - 0.15;
+    // (The clip above cuts a deep groove's material and facets.)
+    for w2 in profile.windows(2) {
+        let (a, b) = (w2[0], w2[1]);
+        let quad = vec![at(a), at(b), at((b.0, bottom)), at((a.0, bottom))];
+        painter.add(egui::Shape::convex_polygon(
+            quad,
+            material,
+            egui::Stroke::NONE,
+        ));
+    }
+    painter.add(egui::Shape::line(
+        profile.iter().map(|&q| at(q)).collect(),
+        egui::Stroke::new(1.5, text.gamma_multiply(0.6)),
+    ));
+    if cut {
+        // The groove goes on below the cut, to depth t.
+        let y = at((0.0, -depth - 0.12)).y - 1.0;
+        painter.add(egui::Shape::dashed_line(
+            &[
+                egui::pos2(at((-2.0, 0.0)).x, y),
+                egui::pos2(at((2.0, 0.0)).x, y),
+            ],
+            egui::Stroke::new(1.5, text),
+            6.0,
+            5.0,
+        ));
+        unclipped.text(
+            egui::pos2(at((-2.0, 0.0)).x - 6.0, y),
+            egui::Align2::RIGHT_CENTER,
+            format!("{:.1}× deeper", t / depth),
+            egui::FontId::proportional(11.0),
+            text,
+        );
+    }
+    // The reflecting facets (rim, foot): with the light on the left, a
+    // tilt towards it (> 0) is the facets that rise to the right.
+    let facets: [((f32, f32), (f32, f32)); 2] = if s.tilt >= 0.0 {
+        [((0.0, 0.0), (-1.0, -t)), ((2.0, 0.0), (1.0, -t))]
+    } else {
+        [((-2.0, 0.0), (-1.0, -t)), ((0.0, 0.0), (1.0, -t))]
+    };
+    let lerp =
+        |a: (f32, f32), b: (f32, f32), f: f32| (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
+    let shadow = egui::Stroke::new(4.0, text.gamma_multiply(0.35));
+    for (rim, base) in facets {
+        let lit_end = lerp(rim, base, s.lit as f32);
+        let seen_end = lerp(rim, base, s.seen as f32);
+        painter.line_segment([at(lit_end), at(base)], shadow);
+        painter.line_segment([at(rim), at(lit_end)], egui::Stroke::new(4.0, LIGHT));
+        // The seen part: a blue band just above the facet.
+        let d = at(base) - at(rim);
+        let mut n = egui::vec2(-d.y, d.x).normalized();
+        if n.y > 0.0 {
+            n = -n;
+        }
+        let off = n * 5.0;
+        painter.line_segment(
+            [at(rim) + off, at(seen_end) + off],
+            egui::Stroke::new(2.5, VIEW),
+        );
+    }
+    // On the first groove: rays from the light onto the lit part and from
+    // the seen part to the viewer, and the limiting ray (dashed), which
+    // grazes the partner facet's rim.
+    let dir = |deg: f64| {
+        let a = deg.to_radians() as f32;
+        egui::vec2(a.sin(), -a.cos())
+    };
+    let (rim, base) = facets[0];
+    for (frac, ray, colour, incoming) in [
+        (s.lit as f32, dir(-p.theta_i_deg), LIGHT, true),
+        (s.seen as f32, dir(p.theta_o_deg), VIEW, false),
+    ] {
+        let len = 1.1 * scale;
+        for q in [0.3, 0.8] {
+            let on = at(lerp(rim, base, q * frac));
+            let away = on + ray * len;
+            if incoming {
+                painter.arrow(away, on - away, egui::Stroke::new(1.3, colour));
+            } else {
+                painter.arrow(on, away - on, egui::Stroke::new(1.3, colour));
+            }
+        }
+        if frac < 0.999 {
+            let edge = lerp(rim, base, frac);
+            // Up to the rims' height and a little beyond.
+            let reach = (-edge.1 / (-ray.y).max(0.05) + 0.5) * scale;
+            let e = at(edge);
+            painter.add(egui::Shape::dashed_line(
+                &[e, e + ray * reach],
+                egui::Stroke::new(1.2, colour),
+                5.0,
+                4.0,
+            ));
+        }
+    }
+}
+
 impl View for TermsView {
     fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
         let before = scene.state.plots.terms;
@@ -425,6 +664,12 @@ impl View for TermsView {
             (&mut s.g1, "G1", "Smith's masking G1(ωo) (dashed)"),
             (&mut s.g2, "G2", "The model's masking-shadowing G2(ωi, ωo)"),
             (&mut s.f, "F", "The Fresnel factor F(θd)"),
+            (
+                &mut s.vgroove,
+                "v-groove",
+                "Torrance & Sparrow's V-grooves at three outgoing directions: the facets' lit \
+                 and seen parts, whose overlap is the v-groove G",
+            ),
         ] {
             if super::toolbar_toggle(ui, *on, label, hint) {
                 *on = !*on;
@@ -445,9 +690,19 @@ impl View for TermsView {
             ui.label(RichText::new(line).weak().size(11.0));
         }
         let shown = charts.shown();
-        if shown.is_empty() {
-            ui.label(RichText::new("no term is switched on").weak());
+        // The v-groove strip takes the bottom of the view (half of it beside
+        // one chart: the grooves towards a low light are deep).
+        let strip_h = if !scene.state.plots.terms.vgroove {
+            0.0
+        } else if shown.is_empty() {
+            ui.available_height()
         } else {
+            let share = if shown.len() == 1 { 0.42 } else { 0.32 };
+            (share * ui.available_height()).max(80.0)
+        };
+        if shown.is_empty() && strip_h == 0.0 {
+            ui.label(RichText::new("no term is switched on").weak());
+        } else if !shown.is_empty() {
             // One width for all three, taken before any is drawn (a
             // legend may widen the ui), and one legend width, so that their
             // axes align.
@@ -462,8 +717,13 @@ impl View for TermsView {
                 0.0
             };
             let spacing = ui.spacing().item_spacing.y;
-            let height =
-                (ui.available_height() - spacing * (shown.len() as f32 - 1.0)) / shown.len() as f32;
+            let strip_gap = if strip_h > 0.0 {
+                strip_h + spacing
+            } else {
+                0.0
+            };
+            let height = (ui.available_height() - strip_gap - spacing * (shown.len() as f32 - 1.0))
+                / shown.len() as f32;
             for (k, c) in shown.iter().enumerate() {
                 let log_y = scene.state.plots.terms.log_d
                     && charts.d.as_ref().is_some_and(|d| std::ptr::eq(d, *c));
@@ -471,6 +731,13 @@ impl View for TermsView {
                 let id = super::view_id(crate::session::views::TERMS.id).with((k, log_y));
                 plot_chart(ui, id, c, egui::vec2(width, height), log_y, scene, legend_w);
             }
+        }
+        if strip_h > 0.0 {
+            let (r, _) = ui.allocate_exact_size(
+                egui::vec2(ui.available_width(), strip_h.min(ui.available_height())),
+                egui::Sense::hover(),
+            );
+            paint_vgrooves(&ui.painter_at(r), r, &vgroove_sections(scene), dark);
         }
         self.last = Some(charts);
     }

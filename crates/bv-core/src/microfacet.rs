@@ -126,6 +126,49 @@ pub fn v_groove_g(wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
     1.0f64.min(k * wo.z).min(k * wi.z)
 }
 
+/// One V-groove of the Torrance–Sparrow surface seen in the plane of
+/// incidence, for drawing what [`v_groove_g`] counts: the groove whose
+/// facets have the half vector of `(wi, wo)` as normal, and how much of that
+/// facet (from its rim down) is lit and how much is seen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VGrooveSection {
+    /// The facets' tilt from the normal, radians, signed in the plane:
+    /// positive when the reflecting facet faces the light's azimuth (the
+    /// facet of the groove that descends towards +u, `u` the plane's unit
+    /// horizontal direction towards the light).
+    pub tilt: f64,
+    /// The lit fraction of the reflecting facet, `min(1, 2(n·h)(n·wi)/(wi·h))`.
+    pub lit: f64,
+    /// The seen fraction, `min(1, 2(n·h)(n·wo)/(wo·h))`.
+    pub seen: f64,
+    /// Lit and seen: `min(lit, seen)`, [`v_groove_g`]. Both parts start at
+    /// the rim (the other facet hides the bottom of this one), so one holds
+    /// the other.
+    pub g: f64,
+}
+
+/// The V-groove section for `wi`, `wo` (both above the surface) in the plane
+/// of incidence whose horizontal direction is `u` (unit, z = 0); `None`
+/// when a direction is at or below the horizon or they are opposite.
+pub fn v_groove_section(wi: DVec3, wo: DVec3, u: DVec3) -> Option<VGrooveSection> {
+    if wi.z <= 0.0 || wo.z <= 0.0 {
+        return None;
+    }
+    let h = (wi + wo).try_normalize()?;
+    let c = wi.dot(h);
+    if c <= 0.0 || h.z <= 0.0 {
+        return None;
+    }
+    let k = 2.0 * h.z / c;
+    let (lit, seen) = ((k * wi.z).min(1.0), (k * wo.z).min(1.0));
+    Some(VGrooveSection {
+        tilt: h.dot(u).atan2(h.z),
+        lit,
+        seen,
+        g: lit.min(seen),
+    })
+}
+
 /// The kinks of [`v_groove_g`] for light from `wi` (see [`crate::Kink`]):
 /// where either shadowing term reaches 1 and where the two swap (`θo = θi`).
 pub fn v_groove_kinks(wi: DVec3) -> Vec<crate::Kink<'static>> {
@@ -679,6 +722,38 @@ impl ScaleLanes {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    #[test]
+    fn v_groove_section_is_what_v_groove_g_counts() {
+        // In the plane φ = 0.4: G of the section equals v_groove_g, and the
+        // lit and seen fractions are the two terms of its min. At the mirror
+        // direction the grooves are flat (tilt 0) and everything is lit and
+        // seen; towards the light (wo = wi) the facets turn to face it and
+        // the partner facet hides all but 2 cos²θi of each.
+        let phi: f64 = 0.4;
+        let u = DVec3::new(phi.cos(), phi.sin(), 0.0);
+        let dir = |t: f64| (u * t.sin() + DVec3::Z * t.cos()).normalize();
+        let ti = 80f64.to_radians();
+        for k in -17..=17 {
+            let to = (k as f64 * 5.0).to_radians();
+            let (wi, wo) = (dir(ti), dir(to));
+            let s = v_groove_section(wi, wo, u).unwrap();
+            let h = (wi + wo).normalize();
+            assert!((s.g - v_groove_g(wi, wo, h)).abs() < 1e-12, "{k}");
+            assert!(s.lit <= 1.0 && s.seen <= 1.0 && s.g <= s.lit.min(s.seen) + 1e-15);
+            // The tilt is the half vector's angle in the plane.
+            assert!((s.tilt - (ti + to) / 2.0).abs() < 1e-12, "{k}: {}", s.tilt);
+        }
+        let mirror = v_groove_section(dir(ti), dir(-ti), u).unwrap();
+        assert!(mirror.tilt.abs() < 1e-12 && mirror.g == 1.0);
+        let back = v_groove_section(dir(ti), dir(ti), u).unwrap();
+        let want = 2.0 * ti.cos() * ti.cos();
+        assert!(
+            (back.g - want).abs() < 1e-12 && (back.tilt - ti).abs() < 1e-12,
+            "{back:?}"
+        );
+        assert!(v_groove_section(dir(ti), DVec3::new(0.0, 0.0, -1.0), u).is_none());
+    }
     use crate::frame::from_spherical;
     use crate::sampling;
 
