@@ -243,7 +243,9 @@ function withOnlyBrdf(toml, model, params, spp, view = "environment") {
     `[brdfs.spec]\nmodel = "${model}"\n\n[brdfs.spec.params]\n${params.join("\n")}\n\n`;
   const one = toml.slice(0, start).replace(/^selected = .*$/m, "selected = 1").replace(/^next_id = .*$/m, "next_id = 2") +
     brdf + toml.slice(end);
+  // The light at 45° (the copied link's is where the slider drag left it).
   return withMaximised(one.replace(/^target_spp = .*$/m, `target_spp = ${spp}`)
+    .replace(/^theta_deg = .*$/m, "theta_deg = 45.0")
     .replace(/^object = .*$/m, 'object = "Sphere"'), view);
 }
 
@@ -969,22 +971,6 @@ async function openFileChecks(context, gl, toml) {
   };
   await opened("test.binary", [{ name: "test.binary", base64: merlTable().toString("base64") }],
     "a dropped MERL table");
-  // An RGL material (.bsdf tensor file, issue 34), written by the desktop
-  // binary (BV_BIN, which .ci/web.sh finds or builds): GGX α 0.2 over a
-  // blue base, tabulated as the RGL database stores materials.
-  {
-    const bin = process.env.BV_BIN;
-    const file = path.join(fs.mkdtempSync(path.join(os.tmpdir(), "bv-web-")), "ggx.bsdf");
-    let bytes = null;
-    try {
-      execFileSync(bin || "bv", ["tabulate", "--format", "rgl", "-m", "cook-torrance", "-p", "distribution=ggx",
-        "-p", "alpha=0.2", "-p", "kd=0.05,0.1,0.4", "-p", "ks=0.6", "--out", file], { stdio: "ignore" });
-      bytes = fs.readFileSync(file);
-    } catch (e) {
-      check(false, `an RGL file is written for the drop (BV_BIN=${bin}): ${e}`);
-    }
-    if (bytes) await opened("ggx.bsdf", [{ name: "ggx.bsdf", base64: bytes.toString("base64") }], "a dropped RGL material");
-  }
   await opened("phong.brdf", [{ name: "phong.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
     "a dropped .brdf model");
   // Hostile .brdf files (tests/data/brdf/hostile/: a 7,000-term sum and
@@ -1013,6 +999,23 @@ async function openFileChecks(context, gl, toml) {
   }
   await opened("phong2.brdf", [{ name: "phong2.brdf", base64: Buffer.from(BRDF_FILE).toString("base64") }],
     "a .brdf model dropped after the hostile ones");
+  // An RGL material (.bsdf tensor file, issue 34), written by the desktop
+  // binary (BV_BIN, which .ci/web.sh finds or builds): a sharp GGX lobe
+  // (α 0.05, its peak rescales the plot) over a blue base, tabulated as the
+  // RGL database stores materials.
+  {
+    const bin = process.env.BV_BIN;
+    const file = path.join(fs.mkdtempSync(path.join(os.tmpdir(), "bv-web-")), "ggx.bsdf");
+    let bytes = null;
+    try {
+      execFileSync(bin || "bv", ["tabulate", "--format", "rgl", "-m", "cook-torrance", "-p", "distribution=ggx",
+        "-p", "alpha=0.05", "-p", "kd=0.05,0.1,0.4", "-p", "ks=1", "--out", file], { stdio: "ignore" });
+      bytes = fs.readFileSync(file);
+    } catch (e) {
+      check(false, `an RGL file is written for the drop (BV_BIN=${bin}): ${e}`);
+    }
+    if (bytes) await opened("ggx.bsdf", [{ name: "ggx.bsdf", base64: bytes.toString("base64") }], "a dropped RGL material");
+  }
   {
     const hdr = fs.readFileSync(path.join(here, "..", "assets", "studio.hdr"));
     await drop(p.page, [{ name: "studio.hdr", base64: hdr.toString("base64") }]);

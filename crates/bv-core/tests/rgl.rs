@@ -788,6 +788,51 @@ fn anisotropic_and_folded_files_sample_as_they_evaluate() {
     }
 }
 
+/// The GPU port draws files with one φi; an anisotropic file is refused
+/// when the views pack it (they then say why) instead of drawing black, and
+/// an isotropic one packs.
+#[test]
+fn the_gpu_port_refuses_anisotropic_files_by_name() {
+    struct Blobs(usize);
+    impl bv_core::model::GpuTables for Blobs {
+        fn offset_of(&mut self, blob: Arc<dyn bv_core::model::GpuBlob>) -> usize {
+            self.0 += blob.gpu_data().len();
+            0
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("bv-rgl-gpu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let derive = bv_core::find("rgl")
+        .unwrap()
+        .gpu
+        .as_ref()
+        .unwrap()
+        .derive
+        .unwrap();
+    for (name, nphi, span) in [("aniso.bsdf", 9, 2.0 * PI), ("iso.bsdf", 1, 0.0)] {
+        let path = dir.join(name);
+        std::fs::write(&path, random_file(7, nphi, span)).unwrap();
+        let spec = bv_core::ModelSpec::from_json(
+            "rgl",
+            &serde_json::json!({"path": path.display().to_string()}),
+        )
+        .unwrap();
+        let mut blobs = Blobs(0);
+        let r = derive(&spec, &mut blobs);
+        if nphi > 1 {
+            let e = r.unwrap_err().to_string();
+            assert!(
+                e.contains("one φi") && e.contains("9") && e.contains(name),
+                "{e}"
+            );
+            assert_eq!(blobs.0, 0);
+        } else {
+            assert!(r.is_ok() && blobs.0 > 0);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Towards the horizon `f` stays bounded and near the model: a GGX lobe
 /// written and read back, at θo from 85° to 89.99° on both sides of the
 /// normal, is within 8 % of the model (without the hold at 87° it read

@@ -71,13 +71,19 @@ const DERIVED_SLOTS: &[&str] = &[
 
 fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
     // Through the cache: the same material as the built model's.
-    let m = material::read_cached(spec.params().text("path")?, &mut |_, _| {})?;
+    let path = spec.params().text("path")?;
+    let m = material::read_cached(path, &mut |_, _| {})?;
+    // A file the port cannot draw is refused here rather than packed as
+    // zeros: the GPU views then say why instead of drawing it black.
+    if m.gpu_data_len() == 0 {
+        return Err(BvError::Invalid(format!(
+            "{path}: the GPU port draws RGL files with one φi (isotropic); this one has {} \
+             (anisotropic): the CPU views (lobe, polar, slices, albedo) draw it",
+            m.phi_i().len()
+        )));
+    }
     let slots = m.gpu_slots();
-    let offset = if m.gpu_data_len() > 0 {
-        tables.offset_of(m) / TABLE_ALIGN
-    } else {
-        0
-    };
+    let offset = tables.offset_of(m) / TABLE_ALIGN;
     let mut out = vec![offset as f32];
     out.extend_from_slice(&slots);
     Ok(out)
