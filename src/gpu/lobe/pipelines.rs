@@ -35,7 +35,7 @@ struct PipelineParts {
 /// formats and multisampling is cheap, else 1, whose edges the copy into
 /// egui's pass smooths with FXAA (`blit.wgsl`'s `fs_smooth`). A CPU
 /// rasteriser (lavapipe) pays for every sample: four made a 1600 × 1200
-/// figure's lobe pass two to three times as long as one (0.3–0.48 s against
+/// figure's lobe pass two to three times as long as one (0.24–0.48 s against
 /// 0.13–0.15 s on a 2-core Xeon), for edges the FXAA copy smooths as well.
 /// `BV_MSAA=1` or `BV_MSAA=4` overrides the choice (4 only where
 /// supported).
