@@ -28,11 +28,14 @@ struct Seg {
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) color: vec4<f32>,
-    // Signed distance from the line's centre across it, in pixels, in
-    // screen space (linear: no perspective division).
-    @location(1) @interpolate(linear) across: f32,
+    // Signed distance from the line's centre across it in pixels, times
+    // the clip w: divided by the interpolated w it is interpolated linearly
+    // in screen space, which the ends of a line at different depths need
+    // (WebGL2 has no `@interpolate(linear)`).
+    @location(1) across_w: f32,
+    @location(2) w: f32,
     // The line's width in pixels.
-    @location(2) @interpolate(flat) width: f32,
+    @location(3) width: f32,
 };
 
 @vertex
@@ -61,7 +64,8 @@ fn vs_main(@builtin(vertex_index) vi: u32, seg: Seg) -> VsOut {
     var o: VsOut;
     o.clip = c;
     o.color = seg.color;
-    o.across = side[vi] * half;
+    o.across_w = side[vi] * half * c.w;
+    o.w = c.w;
     o.width = seg.width.x;
     return o;
 }
@@ -71,6 +75,7 @@ fn fs_main(v: VsOut) -> @location(0) vec4<f32> {
     // The share of a pixel at this distance the line covers: all of it
     // inside, falling to none half a pixel beyond the edge, and at most the
     // width for a line thinner than a pixel.
-    let cover = clamp(min(0.5 * v.width + 0.5 - abs(v.across), v.width), 0.0, 1.0);
+    let across = v.across_w / v.w;
+    let cover = clamp(min(0.5 * v.width + 0.5 - abs(across), v.width), 0.0, 1.0);
     return vec4<f32>(v.color.rgb, v.color.a * cover);
 }
