@@ -643,8 +643,8 @@ fn a_slider_step_redraws_the_mesh_as_a_fresh_upload_would() {
         "a refilled mesh draws differently from a fresh one"
     );
 
-    // A drag frame (one sample on a software renderer, its pipelines made
-    // at the first drag) draws the lobe too.
+    // A drag frame (copied without FXAA on a software renderer) draws the
+    // lobe too.
     let drag = frame_at(40.0, true);
     let img = render(&mut stepped, &drag);
     let differs = img

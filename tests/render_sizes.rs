@@ -185,7 +185,7 @@ fn run_all(runs: &[(String, u32, u32)], dir: &Path, views: &[String]) -> Vec<Str
 /// Every view at 800×600 on its own, `all` (every view, through the same
 /// drawing code on one device) and the window at 800×600 and 1600×1200; at
 /// 4096×3072 the views whose GPU resources grow with the image (the
-/// environment's accumulation, the lobe's multisampled target) and the
+/// environment's accumulation, the lobe's target) and the
 /// window. Every view at 4096×3072 is the test below (about two minutes on
 /// lavapipe).
 #[test]

@@ -22,6 +22,44 @@ fn every_entry_shader_validates_and_round_trips() {
 }
 
 #[test]
+fn the_lobe_view_shaders_translate_to_webgl2() {
+    // The browser page falls back to WebGL2, whose shaders wgpu writes as
+    // GLSL ES 3.00: a construct that lacks (`@interpolate(linear)`) would
+    // leave the page's lobe view without lines or without the figure.
+    let mut lib = ShaderLibrary::new().unwrap();
+    for name in ["lobe", "lines", "blit"] {
+        let module = lib.module(name).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        let info = validate(&module).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+        assert!(!module.entry_points.is_empty(), "{name}: no entry point");
+        for ep in &module.entry_points {
+            let options = naga::back::glsl::Options {
+                version: naga::back::glsl::Version::Embedded {
+                    version: 300,
+                    is_webgl: true,
+                },
+                ..Default::default()
+            };
+            let pipeline = naga::back::glsl::PipelineOptions {
+                shader_stage: ep.stage,
+                entry_point: ep.name.clone(),
+                multiview: None,
+            };
+            let mut out = String::new();
+            naga::back::glsl::Writer::new(
+                &mut out,
+                &module,
+                &info,
+                &options,
+                &pipeline,
+                naga::proc::BoundsCheckPolicies::default(),
+            )
+            .and_then(|mut w| w.write())
+            .unwrap_or_else(|e| panic!("{name} {}: GLSL ES 3.00: {e}", ep.name));
+        }
+    }
+}
+
+#[test]
 fn every_entry_composes_on_a_fresh_library() {
     // Modules are registered as shaders need them: each entry, first on its
     // library, must find everything it imports (directly or not).

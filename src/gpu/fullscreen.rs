@@ -14,6 +14,19 @@ pub fn pipeline(
     module: &wgpu::ShaderModule,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    pipeline_with(device, label, layout, module, "fs_main", format)
+}
+
+/// [`pipeline`] with the fragment entry point `fragment` instead of
+/// `fs_main` (a shader with two ways of shading the same triangle).
+pub fn pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: Option<&wgpu::PipelineLayout>,
+    module: &wgpu::ShaderModule,
+    fragment: &str,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout,
@@ -28,7 +41,7 @@ pub fn pipeline(
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(fragment),
             compilation_options: Default::default(),
             targets: &[Some(format.into())],
         }),

@@ -1,12 +1,13 @@
 //! The lobe view's renderer (the GPU side of the 3D lobe): a [`LobeFrame`]
 //! (camera matrices, meshes, line segments) is drawn into an offscreen
-//! multisampled colour + depth target, which is then either read back
-//! ([`LobeRenderer::render_to_image`], what `bv render` and the snapshot
-//! tests use) or copied into a render pass someone else began
-//! ([`LobeRenderer::paint`]: egui's, through the paint callback in
-//! `views::lobe_gpu`). Drawing offscreen gives the lobe a depth buffer and
-//! MSAA whatever egui's own pass has (eframe's window has neither; kittest's
-//! has neither).
+//! colour + depth target, which is then either copied into a render pass
+//! someone else began ([`LobeRenderer::paint`]: egui's, through the paint
+//! callback in `views::lobe_gpu`; what the window, `bv render` and the
+//! snapshot tests show) or read back as drawn
+//! ([`LobeRenderer::render_to_image`]). Drawing offscreen gives the lobe a
+//! depth buffer and anti-aliased edges whatever egui's own pass has
+//! (eframe's window has neither; kittest's has neither): four samples where
+//! the GPU makes them cheap, else one sample and FXAA in the copy.
 //!
 //! Per view (a key chosen by the caller) it keeps the uniform, line and mesh
 //! buffers and the target, re-uploading only what changed and redrawing only
@@ -63,28 +64,22 @@ pub struct PixelSize {
 
 /// Pipelines and per-view GPU resources of every lobe view.
 pub struct LobeRenderer {
-    /// Pipelines at the full sample count.
-    at_rest: Pipelines,
-    /// Pipelines at one sample for frames drawn while something is dragged
-    /// (software renderers with multisampling only), made at the first one.
-    dragging: Option<Pipelines>,
-    /// Whether frames drawn during a drag use one sample: on a CPU rasteriser
-    /// (which pays for every sample) that multisamples at rest.
-    drag_at_one_sample: bool,
-    /// What more pipelines are made from.
-    parts: pipelines::PipelineParts,
+    /// The drawing pipelines, at the offscreen sample count.
+    pipelines: Pipelines,
     globals_layout: wgpu::BindGroupLayout,
     style_layout: wgpu::BindGroupLayout,
     blit_layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
     blit: wgpu::RenderPipeline,
+    /// The copy through FXAA, where the target has one sample.
+    blit_smooth: Option<wgpu::RenderPipeline>,
     views: HashMap<u64, ViewResources>,
 }
 
 impl LobeRenderer {
     /// The offscreen sample count of frames drawn at rest.
     pub fn samples(&self) -> u32 {
-        self.at_rest.samples
+        self.pipelines.samples
     }
 
     /// Uploads what changed in `frame` and records its offscreen pass for view
@@ -102,16 +97,9 @@ impl LobeRenderer {
         let size = fit_texture(asked, device.limits().max_texture_dimension_2d);
         // Line widths follow a target made smaller than asked.
         let ppp = ppp * size[0] as f32 / asked[0].max(1) as f32;
-        let fast = frame.interacting && self.drag_at_one_sample;
-        if fast && self.dragging.is_none() {
-            self.dragging = Some(self.parts.make_set(device, 1));
-        }
-        let set = match &self.dragging {
-            Some(one) if fast => one,
-            _ => &self.at_rest,
-        };
+        let set = &self.pipelines;
         let samples = set.samples;
-        let fingerprint = frame.fingerprint(size, ppp) ^ u64::from(samples);
+        let fingerprint = frame.fingerprint(size, ppp);
         let (style_layout, blit_layout, sampler) =
             (&self.style_layout, &self.blit_layout, &self.sampler);
         let (opaque, blended, wire, lines_pl) = (&set.opaque, &set.blended, &set.wire, &set.lines);
@@ -219,6 +207,9 @@ impl LobeRenderer {
         vr.meshes.retain(|_, m| m.used);
 
         let Some(target) = &mut vr.target else { return };
+        // A drag's frames are copied as drawn: they follow each other too
+        // fast for their edges to be seen, and the frame at rest is smoothed.
+        target.smooth = self.blit_smooth.is_some() && !frame.interacting;
         if target.drawn == Some(fingerprint) {
             // Same image as last time: egui repainted for something else.
             return;
@@ -317,18 +308,24 @@ impl LobeRenderer {
         let Some(target) = self.views.get(&view).and_then(|v| v.target.as_ref()) else {
             return;
         };
+        let pipeline = match &self.blit_smooth {
+            Some(smooth) if target.smooth => smooth,
+            _ => &self.blit,
+        };
         fullscreen::draw(
             pass,
             &fullscreen::Draw {
-                pipeline: &self.blit,
+                pipeline,
                 bind_group: &target.blit_bg,
                 scissor: None,
             },
         );
     }
 
-    /// Renders `frame` headless at `width × height` pixels and reads it back
-    /// (for `bv render` and tests). `ppp` scales line widths.
+    /// Renders `frame` headless at `width × height` pixels and reads the
+    /// target back as drawn (for tests: one sample on a CPU rasteriser, whose
+    /// edges only the copy into egui's pass smooths). `ppp` scales line
+    /// widths.
     pub fn render_to_image(
         &mut self,
         device: &wgpu::Device,

@@ -1,5 +1,6 @@
-//! The lobe's offscreen targets: a multisampled colour and depth pair
-//! resolved into a single-sample colour texture, which is read back headless
+//! The lobe's offscreen targets: a colour and depth pair (multisampled,
+//! then resolved into a single-sample colour texture, where multisampling is
+//! cheap), which is read back headless
 //! or copied into egui's pass; sized to fit the device.
 
 use super::{DEPTH_FORMAT, OFFSCREEN_FORMAT};
@@ -9,6 +10,9 @@ pub(super) struct Target {
     pub(super) samples: u32,
     /// Fingerprint of the frame the target holds.
     pub(super) drawn: Option<u64>,
+    /// Whether it is copied into egui's pass through FXAA (one sample, at
+    /// rest).
+    pub(super) smooth: bool,
     pub(super) msaa_color: Option<wgpu::TextureView>,
     pub(super) depth: wgpu::TextureView,
     pub(super) resolve: wgpu::Texture,
@@ -99,6 +103,7 @@ pub(super) fn create_target(
         size,
         samples,
         drawn: None,
+        smooth: false,
         msaa_color,
         depth,
         resolve,
