@@ -133,6 +133,20 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         Vec::new()
     }
 
+    /// An outgoing direction on `wi`'s side at which `f(wi, ·)` has a point
+    /// cusp that dominates its shape: `f` depends on the angle from it like
+    /// `|wo − c|` rather than smoothly (Hapke's opposition surge at `wo = wi`,
+    /// Hapke 1981 eq. 30 with `tan(g/2)`). The albedo quadrature then
+    /// integrates the part on `wi`'s side in polar coordinates about `c`,
+    /// where the cusp becomes the pole and every ring about it is smooth,
+    /// instead of over the half vector, where it is a 2-D cusp that both axes
+    /// must resolve. Name one only when the model has no other narrow lobe
+    /// (a half-vector lobe is better served by the half vector); other
+    /// [`Brdf::peaks`] on that side still break the rings. Default: none.
+    fn cusp(&self, _wi: DVec3) -> Option<DVec3> {
+        None
+    }
+
     /// The kinks of `f(wi, ·)` (see [`Kink`]) over the outgoing directions on
     /// `wi`'s side, so that the albedo quadrature breaks its panels where
     /// they cross a circle of integration instead of bisecting towards them:

@@ -143,6 +143,12 @@ impl Brdf for Rotated {
             .collect()
     }
 
+    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
+        self.inner
+            .cusp(self.to_inner(wi))
+            .map(|w| self.to_rotated(w))
+    }
+
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
         self.inner
             .kinks(self.to_inner(wi))

@@ -41,6 +41,12 @@
 //! - The kinks a model names ([`Brdf::kinks`]: Oren-Nayar's clamps,
 //!   V-groove's `min`) are located on each inner circle by regula falsi and
 //!   become panel breaks, instead of a cloud of bisections about each.
+//! - A model with a point cusp on the light's side ([`Brdf::cusp`]: Hapke's
+//!   opposition surge at `wo = wi`) is integrated there in polar
+//!   coordinates about the cusp, by the rule of the transmitted part (see
+//!   [`transmitted`]) on the model's mirror image: the cusp is then the pole
+//!   and each ring about it smooth, where over the half vector it is a 2-D
+//!   cusp at `h = wi` that both axes must bisect towards.
 
 use super::directions::below;
 use super::estimate::{AlbedoParts, Estimate, Method};
@@ -307,7 +313,18 @@ pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) ->
     let sin_ti = (1.0 - cos_ti * cos_ti).max(0.0).sqrt();
     let theta_i = cos_ti.acos();
     let phi_i = if sin_ti > 0.0 { wi.y.atan2(wi.x) } else { 0.0 };
-    let upper = reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts);
+    // A model with a point cusp on wi's side (Hapke's surge at wo = wi) is
+    // integrated in polar coordinates about it, by the rule of the
+    // transmitted part applied to the model's mirror image through the
+    // surface ([`AboutCusp`]).
+    let cusp = brdf
+        .cusp(wi)
+        .filter(|c| c.is_finite() && c.z > 0.0)
+        .and_then(DVec3::try_normalize);
+    let upper = match cusp {
+        Some(cusp) => transmitted(&AboutCusp { brdf, cusp }, wi, opts),
+        None => reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts),
+    };
     let reflected = quad_estimate(
         upper.value + delta_r,
         upper.error,
@@ -357,9 +374,58 @@ impl Brdf for Flipped<'_> {
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         self.0.peaks(below(wi)).into_iter().map(below).collect()
     }
+    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
+        self.0.cusp(below(wi)).map(below)
+    }
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
         self.0
             .kinks(below(wi))
+            .into_iter()
+            .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
+            .collect()
+    }
+}
+
+/// A reflection model seen through the surface plane on the outgoing side
+/// only (`wo → −wo.z`): its reflected hemisphere becomes the lower one, which
+/// [`transmitted`] integrates in polar coordinates about the first peak below
+/// (here the mirror image of the model's [`Brdf::cusp`]), the cusp then at
+/// the pole. The other peaks and the kinks on `wi`'s side are mirrored with
+/// it.
+#[derive(Debug)]
+struct AboutCusp<'a> {
+    brdf: &'a dyn Brdf,
+    cusp: DVec3,
+}
+
+impl Brdf for AboutCusp<'_> {
+    fn id(&self) -> &'static str {
+        self.brdf.id()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        self.brdf.eval(wi, below(wo))
+    }
+    fn claims(&self) -> crate::Claims {
+        self.brdf.claims()
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        // The cusp itself is the pole, which the rule grades already.
+        let others = self
+            .brdf
+            .peaks(wi)
+            .into_iter()
+            .filter(|p| p.z > 0.0 && p.normalize().dot(self.cusp) < 1.0 - 1e-12);
+        std::iter::once(self.cusp)
+            .chain(others)
+            .map(below)
+            .collect()
+    }
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.brdf
+            .kinks(wi)
             .into_iter()
             .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
             .collect()
