@@ -186,9 +186,14 @@ fn mirror_symmetric(brdf: &dyn Brdf, wi: DVec3, phi_i: f64, below: bool) -> bool
 /// left to the verified bisection).
 const KINK_SCAN: usize = 8;
 
-/// Adds to `out` the azimuths in `(lo, hi)` where a kink of the model
+/// Points of the scan along the plane of incidence in θh for the outer
+/// breaks where a kink's roots appear on the circles (see [`reflected`]).
+const OUTER_KINK_SCAN: usize = 32;
+
+/// Adds to `out` the parameters in `(lo, hi)` (an azimuth on a circle, or
+/// θh along the plane of incidence) where a kink of the model
 /// ([`Brdf::kinks`]) changes sign along the directions `dir(φ)` (`None`
-/// where there is no direction), each to within 1e-12 rad by the Illinois
+/// where there is no direction), looked for at `scan` steps, each to within 1e-12 rad by the Illinois
 /// variant of regula falsi (superlinear, and it keeps the root bracketed):
 /// panel breaks, so that no Gauss–Kronrod panel straddles a kink.
 fn kink_roots(
@@ -196,16 +201,17 @@ fn kink_roots(
     dir: impl Fn(f64) -> Option<DVec3>,
     lo: f64,
     hi: f64,
+    scan: usize,
     out: &mut Vec<f64>,
 ) {
     if kinks.is_empty() || hi - lo <= 0.0 {
         return;
     }
-    let step = (hi - lo) / KINK_SCAN as f64;
-    let dirs: Vec<Option<DVec3>> = (0..=KINK_SCAN).map(|k| dir(lo + step * k as f64)).collect();
+    let step = (hi - lo) / scan as f64;
+    let dirs: Vec<Option<DVec3>> = (0..=scan).map(|k| dir(lo + step * k as f64)).collect();
     for kink in kinks {
         let value = |phi: f64| dir(phi).map(kink);
-        for k in 0..KINK_SCAN {
+        for k in 0..scan {
             let (Some(a), Some(b)) = (dirs[k], dirs[k + 1]) else {
                 continue;
             };
@@ -463,6 +469,12 @@ fn reflected(
             let h = (wi + p.normalize()).try_normalize()?;
             Some((h.z.clamp(-1.0, 1.0).acos(), h.y.atan2(h.x)))
         })
+        // A peak at the mirror direction (a Lafortune lobe `(−1, −1, 1)`)
+        // has its half vector at the normal, which the square-law grading of
+        // the first panel resolves already: geometric breaks there would be
+        // a dozen panels of inner integrals for nothing, and its azimuth
+        // (rounding's) a break on every circle.
+        .filter(|&(t, _)| t > FINEST)
         .collect();
     let mut breaks = vec![0.0, theta_end];
     if theta_full > 0.0 && theta_full < theta_end {
@@ -479,6 +491,29 @@ fn reflected(
     // inside any lobe the contract covers, so bisection finds it), at
     // θ_full from above and towards the end (square-root points of the arc
     // width).
+    // Where a kink's curve on the hemisphere crosses the plane of incidence,
+    // a pair of its roots appears on (or leaves) the circles of θh: there
+    // the inner integral has a kink of its own in θh, which bisection and
+    // verification would otherwise chase (V-groove's `2 (n·h)(n·wi) = wi·h`
+    // at θh = 90° − θi, its and Oren-Nayar's `θo = θi` at θh = θi). Those θh
+    // are found as the inner roots are, along the plane on both sides of the
+    // normal, and become outer breaks. A crossing elsewhere (a kink that is
+    // not symmetric about the plane) is left to bisection.
+    let kinks = brdf.kinks(wi);
+    if !kinks.is_empty() {
+        for side in [0.0, PI] {
+            let (sp, cp) = (phi_i + side).sin_cos();
+            let along = |theta_h: f64| {
+                let (sh, ch) = theta_h.sin_cos();
+                let h = DVec3::new(sh * cp, sh * sp, ch);
+                let wo = 2.0 * wi.dot(h) * h - wi;
+                (wo.z > 0.0).then(|| wo.normalize())
+            };
+            kink_roots(&kinks, along, 0.0, theta_end, OUTER_KINK_SCAN, &mut breaks);
+        }
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
+    }
     let segs = polar_segments(&breaks, theta_full, theta_end);
     let anisotropic = !brdf.claims().isotropic;
     let mut fixed_phis: Vec<f64> = Vec::new();
@@ -496,7 +531,6 @@ fn reflected(
     let half = !anisotropic
         && peaks.iter().all(|&(t, p)| t < 1e-9 || in_plane(p, phi_i))
         && mirror_symmetric(brdf, wi, phi_i, false);
-    let kinks = brdf.kinks(wi);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta_h: f64| -> (Rgb, Rgb) {
@@ -531,7 +565,7 @@ fn reflected(
             let wo = 2.0 * wi.dot(h) * h - wi;
             (wo.z > 0.0).then(|| wo.normalize())
         };
-        kink_roots(&kinks, dir, lo, hi, &mut br);
+        kink_roots(&kinks, dir, lo, hi, KINK_SCAN, &mut br);
         let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
         inner_evals += r.evaluations;
         (r.value, r.error)
@@ -689,6 +723,7 @@ fn transmitted(
             },
             lo,
             hi,
+            KINK_SCAN,
             &mut br,
         );
         let mut inner = |psi: f64| -> (Rgb, Rgb) {
