@@ -143,9 +143,9 @@ impl Brdf for Rotated {
             .collect()
     }
 
-    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
         self.inner
-            .cusp(self.to_inner(wi))
+            .pole(self.to_inner(wi))
             .map(|w| self.to_rotated(w))
     }
 

@@ -736,7 +736,7 @@ fn named_kinks_save_work_not_accuracy() {
 
 /// A diffuse base plus a cone-shaped lobe about the light, `0.3/π +
 /// a exp(−|wo − wi|/r)` (defined here): a point cusp at `wo = wi` like
-/// Hapke's opposition surge, named through [`Brdf::cusp`] or not.
+/// Hapke's opposition surge, named through [`Brdf::pole`] or not.
 #[derive(Debug)]
 struct Cone {
     a: f64,
@@ -760,7 +760,7 @@ impl Brdf for Cone {
             isotropic: true,
         }
     }
-    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
         self.named.then_some(wi)
     }
 }
@@ -815,4 +815,66 @@ fn a_named_cusp_is_integrated_about_its_pole() {
         2 * with < without,
         "{with} evaluations with the cusp named, {without} without"
     );
+}
+
+/// Banks' model about its fibre `t = +x`: with `wo = (cos α, sin α cos β,
+/// sin α sin β)`, above the surface for `β ∈ (0, π)`, `cos θo = sin α sin β`
+/// and `dω = sin α dα dβ`, and `f` depends on `α` alone, so
+/// `ρhd = 2 ∫₀^π f(α) sin² α dα` (the β integral of `sin β` is 2): a 1-D
+/// integral, here by composite Gauss–Legendre with breaks at the clamp's
+/// cone (`α + αi = π/2` or `3π/2`) and graded about the lobe's `α = π − αi`, its own
+/// error the difference of two resolutions. The polar rule about the fibre
+/// ([`Brdf::pole`]) must match it within its stated error, for a kinked
+/// (`e = 1`), a broad and a narrow lobe, off the axes.
+#[test]
+fn banks_about_its_fibre_matches_a_one_dimensional_reference() {
+    let opts = QuadratureOptions::default();
+    let (kd, ks) = (0.2, 0.5);
+    let one_d = |e: f64, wi: DVec3, split: usize| -> f64 {
+        let ci = wi.x;
+        let si = (1.0 - ci * ci).sqrt();
+        let ai = ci.acos();
+        let f = |a: f64| {
+            let base = (si * a.sin() - ci * a.cos()).max(0.0);
+            kd * si + ks * base.powf(e)
+        };
+        let mut b = breaks(0.0, PI, 64, &[PI - ai]);
+        // −cos(α + αi) = 0 at α + αi = π/2 or 3π/2.
+        b.extend([FRAC_PI_2 - ai, 3.0 * FRAC_PI_2 - ai]);
+        b.retain(|&x| (0.0..=PI).contains(&x));
+        b.sort_by(f64::total_cmp);
+        let gl = gauss_legendre(8);
+        let mut sum = 0.0;
+        for w in b.windows(2) {
+            for k in 0..split {
+                let lo = w[0] + (w[1] - w[0]) * k as f64 / split as f64;
+                let hi = w[0] + (w[1] - w[0]) * (k + 1) as f64 / split as f64;
+                for &(x, wt) in &gl {
+                    let a = lo + (hi - lo) * x;
+                    sum += (hi - lo) * wt * f(a) * a.sin().powi(2);
+                }
+            }
+        }
+        2.0 * sum
+    };
+    for e in [1.0, 20.0, 1000.0] {
+        let b = build("banks", &json!({"kd": kd, "ks": ks, "e": e}));
+        for (deg, phi) in [(0.0f64, 0.0), (40.0, 0.6), (70.0, 2.0), (89.0, 1.0)] {
+            let wi = frame::from_spherical(deg.to_radians(), phi);
+            let (coarse, fine) = (one_d(e, wi, 2), one_d(e, wi, 3));
+            let ref_err = (fine - coarse).abs();
+            assert!(
+                ref_err < 1e-9,
+                "e={e} θi={deg}: reference unconverged {ref_err:e}"
+            );
+            let q = quadrature::rho_hd_dir(b.as_ref(), wi, &opts);
+            let dev = (q.value.x - fine).abs();
+            assert!(
+                dev <= 1e-5 && dev <= q.std_error.x + ref_err + 1e-9,
+                "banks e={e} θi={deg}: {} ± {:e} vs {fine}",
+                q.value.x,
+                q.std_error.x
+            );
+        }
+    }
 }

@@ -41,12 +41,13 @@
 //! - The kinks a model names ([`Brdf::kinks`]: Oren-Nayar's clamps,
 //!   V-groove's `min`) are located on each inner circle by regula falsi and
 //!   become panel breaks, instead of a cloud of bisections about each.
-//! - A model with a point cusp on the light's side ([`Brdf::cusp`]: Hapke's
-//!   opposition surge at `wo = wi`) is integrated there in polar
-//!   coordinates about the cusp, by the rule of the transmitted part (see
-//!   [`transmitted`]) on the model's mirror image: the cusp is then the pole
-//!   and each ring about it smooth, where over the half vector it is a 2-D
-//!   cusp at `h = wi` that both axes must bisect towards.
+//! - A model that names a pole on the light's side ([`Brdf::pole`]: Hapke's
+//!   opposition surge, a cusp at `wo = wi`; Banks' fibre, on whose rings
+//!   `f` is constant) is integrated there in polar coordinates about it, by
+//!   the rule of the transmitted part (see [`transmitted`]) on the model's
+//!   mirror image: each ring about the pole is then smooth, where over the
+//!   half vector Hapke's cusp is a 2-D feature at `h = wi` that both axes
+//!   must bisect towards and Banks' cone a ridge across every circle.
 
 use super::directions::below;
 use super::estimate::{AlbedoParts, Estimate, Method};
@@ -319,16 +320,16 @@ pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) ->
     let sin_ti = (1.0 - cos_ti * cos_ti).max(0.0).sqrt();
     let theta_i = cos_ti.acos();
     let phi_i = if sin_ti > 0.0 { wi.y.atan2(wi.x) } else { 0.0 };
-    // A model with a point cusp on wi's side (Hapke's surge at wo = wi) is
-    // integrated in polar coordinates about it, by the rule of the
-    // transmitted part applied to the model's mirror image through the
-    // surface ([`AboutCusp`]).
-    let cusp = brdf
-        .cusp(wi)
-        .filter(|c| c.is_finite() && c.z > 0.0)
+    // A model that names a pole on wi's side (Hapke's cusp at wo = wi,
+    // Banks' fibre) is integrated in polar coordinates about it, by the rule
+    // of the transmitted part applied to the model's mirror image through
+    // the surface ([`AboutPole`]).
+    let pole = brdf
+        .pole(wi)
+        .filter(|c| c.is_finite() && c.z >= 0.0)
         .and_then(DVec3::try_normalize);
-    let upper = match cusp {
-        Some(cusp) => transmitted(&AboutCusp { brdf, cusp }, wi, opts),
+    let upper = match pole {
+        Some(pole) => transmitted(&AboutPole(brdf), wi, Some(below(pole)), opts),
         None => reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts),
     };
     let reflected = quad_estimate(
@@ -338,7 +339,7 @@ pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) ->
         upper.converged,
     );
     let transmitted = if transmits {
-        let lower = transmitted(brdf, wi, opts);
+        let lower = transmitted(brdf, wi, None, opts);
         quad_estimate(
             lower.value + delta_t,
             lower.error,
@@ -380,8 +381,8 @@ impl Brdf for Flipped<'_> {
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         self.0.peaks(below(wi)).into_iter().map(below).collect()
     }
-    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
-        self.0.cusp(below(wi)).map(below)
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        self.0.pole(below(wi)).map(below)
     }
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
         self.0
@@ -394,43 +395,31 @@ impl Brdf for Flipped<'_> {
 
 /// A reflection model seen through the surface plane on the outgoing side
 /// only (`wo → −wo.z`): its reflected hemisphere becomes the lower one, which
-/// [`transmitted`] integrates in polar coordinates about the first peak below
-/// (here the mirror image of the model's [`Brdf::cusp`]), the cusp then at
-/// the pole. The other peaks and the kinks on `wi`'s side are mirrored with
-/// it.
+/// [`transmitted`] integrates in polar coordinates about the mirror image of
+/// the model's [`Brdf::pole`]. The peaks and the kinks on `wi`'s side are
+/// mirrored with it.
 #[derive(Debug)]
-struct AboutCusp<'a> {
-    brdf: &'a dyn Brdf,
-    cusp: DVec3,
-}
+struct AboutPole<'a>(&'a dyn Brdf);
 
-impl Brdf for AboutCusp<'_> {
+impl Brdf for AboutPole<'_> {
     fn id(&self) -> &'static str {
-        self.brdf.id()
+        self.0.id()
     }
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
-        self.brdf.eval(wi, below(wo))
+        self.0.eval(wi, below(wo))
     }
     fn claims(&self) -> crate::Claims {
-        self.brdf.claims()
+        self.0.claims()
     }
     fn transmits(&self) -> bool {
         true
     }
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
-        // The cusp itself is the pole, which the rule grades already.
-        let others = self
-            .brdf
-            .peaks(wi)
-            .into_iter()
-            .filter(|p| p.z > 0.0 && p.normalize().dot(self.cusp) < 1.0 - 1e-12);
-        std::iter::once(self.cusp)
-            .chain(others)
-            .map(below)
-            .collect()
+        let up = self.0.peaks(wi).into_iter().filter(|p| p.z > 0.0);
+        up.map(below).collect()
     }
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
-        self.brdf
+        self.0
             .kinks(wi)
             .into_iter()
             .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
@@ -605,6 +594,7 @@ fn reflected(
 fn transmitted(
     brdf: &dyn Brdf,
     wi: DVec3,
+    pole: Option<DVec3>,
     opts: &QuadratureOptions,
 ) -> gauss_kronrod::Integral<Rgb> {
     let below_peaks: Vec<DVec3> = brdf
@@ -613,7 +603,9 @@ fn transmitted(
         .filter(|p| p.is_finite() && p.z < 0.0)
         .filter_map(|p| p.try_normalize())
         .collect();
-    let p = below_peaks.first().copied().unwrap_or(DVec3::NEG_Z);
+    let p = pole
+        .or_else(|| below_peaks.first().copied())
+        .unwrap_or(DVec3::NEG_Z);
     let phi_i = wi.y.atan2(wi.x);
     let up = DVec3::Z - p.z * p;
     let e1 = if up.length() > 1e-9 {
@@ -633,10 +625,11 @@ fn transmitted(
         let (sp, cp) = psi.sin_cos();
         ct * p - st * (cp * e1 + sp * e2)
     };
-    // The other peaks, as (θ, ψ) about p.
+    // The other peaks, as (θ, ψ) about p (the pole itself is graded
+    // already).
     let others: Vec<(f64, f64)> = below_peaks
         .iter()
-        .skip(1)
+        .filter(|q| q.dot(p) < 1.0 - 1e-12)
         .map(|q| {
             let t = q.dot(p).clamp(-1.0, 1.0).acos();
             (t, (-q.dot(e2)).atan2(-q.dot(e1)))
@@ -658,6 +651,17 @@ fn transmitted(
         let gamma = c.acos();
         breaks.extend([gamma + beta, gamma - beta, beta - gamma]);
     }
+    // The rings where a kink's roots appear, along the great circle through
+    // the pole and the vertical (ψ = 0 and ψ = π), as in [`reflected`]:
+    // Banks' cone `αi + αo = 90°`, a ring about its fibre.
+    let kinks = brdf.kinks(wi);
+    for side in [0.0, PI] {
+        let along = |theta: f64| {
+            let wo = at(theta, side);
+            (wo.z < 0.0).then_some(wo)
+        };
+        kink_roots(&kinks, along, 0.0, theta_end, OUTER_KINK_SCAN, &mut breaks);
+    }
     breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
@@ -669,7 +673,6 @@ fn transmitted(
         && (p.z <= -1.0 + 1e-12 || in_plane(p.y.atan2(p.x), phi_i))
         && others.iter().all(|&(t, a)| t < 1e-9 || in_plane(a, 0.0))
         && mirror_symmetric(brdf, wi, phi_i, true);
-    let kinks = brdf.kinks(wi);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta: f64| -> (Rgb, Rgb) {

@@ -254,7 +254,7 @@ impl Brdf for Hapke {
     /// sign there), while every other term is smooth: integrated in polar
     /// coordinates about `wi`, it is a smooth function of the polar angle
     /// alone (`|wi ± wo| = 2 cos, 2 sin` of half of it).
-    fn cusp(&self, wi: DVec3) -> Option<DVec3> {
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
         Some(wi)
     }
 
