@@ -571,9 +571,11 @@ fn reflected(
     r
 }
 
-/// The transmitted part, in polar coordinates `(θ, ψ)` about the model's
-/// first peak below the surface `p` ([`Brdf::peaks`]: a rough dielectric's
-/// refracted direction; the pole −z when it names none):
+/// The transmitted part, in polar coordinates `(θ, ψ)` about `pole` when
+/// given (a reflection model's [`Brdf::pole`], mirrored through the surface
+/// by [`AboutPole`]; it may lie in the surface's plane), else about the
+/// model's first peak below the surface `p` ([`Brdf::peaks`]: a rough
+/// dielectric's refracted direction; the pole −z when it names none):
 /// `wo = cos θ p − sin θ (cos ψ e₁ + sin ψ e₂)`, with `e₁` in the vertical
 /// plane through `p` pointing up and `e₂ = p × e₁` horizontal, and
 /// `ρT = ∫∫ f |cos θo| sin θ dψ dθ` over the part of that sphere below the
