@@ -878,3 +878,30 @@ fn banks_about_its_fibre_matches_a_one_dimensional_reference() {
         }
     }
 }
+
+/// The catalogue's modified Phong about its mirror direction
+/// ([`Brdf::pole`]), against its closed form: with `r = R(wi)`, the mean
+/// `cos θo` on a cone of angle α about `r` is `cos α (r·n)`, so
+/// `(e+2)/(2π) ∫ cos^e α cos θo dω = cos θi` while the lobe is above the
+/// horizon: at normal incidence for every exponent (the clamp's cone is
+/// the horizon), and at e = 10⁴ up to θi = 80° (what lies past the horizon
+/// is under `cos^e 10° = e^{−152}`). With `kd`, `ρhd = kd + ks cos θi`.
+#[test]
+fn modified_phong_about_its_mirror_direction_matches_its_closed_form() {
+    let opts = QuadratureOptions::default();
+    let (kd, ks) = (0.1, 0.8);
+    let mut cases: Vec<(f64, f64)> = [1.0, 20.0, 300.0].iter().map(|&e| (e, 0.0)).collect();
+    cases.extend([0.0, 30.0, 60.0, 80.0].iter().map(|&d| (1e4, d)));
+    for (e, deg) in cases {
+        let b = build("modified-phong", &json!({"kd": kd, "ks": ks, "e": e}));
+        let q = quadrature::rho_hd(b.as_ref(), f64::to_radians(deg), 0.4, &opts);
+        let want = kd + ks * f64::to_radians(deg).cos();
+        let dev = (q.value.x - want).abs();
+        assert!(
+            dev <= 1e-5 && dev <= q.std_error.x + 1e-9,
+            "modified-phong e={e} θi={deg}: {} ± {:e} vs {want}",
+            q.value.x,
+            q.std_error.x
+        );
+    }
+}
