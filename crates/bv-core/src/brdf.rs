@@ -133,6 +133,24 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
         Vec::new()
     }
 
+    /// A unit direction on `wi`'s side of the surface or in its plane about
+    /// which `f(wi, ·)` is best integrated in polar coordinates: a point cusp
+    /// there, where `f` depends on the angle from it like `|wo − c|` rather
+    /// than smoothly (Hapke's opposition surge at `wo = wi`, Hapke 1981
+    /// eq. 30 with `tan(g/2)`), or an axis on whose rings `f` is constant
+    /// (Banks' fibre, where `f` depends on `wo` through `wo·t` alone). The
+    /// albedo quadrature then integrates the part on `wi`'s side about it
+    /// instead of over the half vector, where a cusp is a 2-D feature that
+    /// both axes must resolve and Banks' cone a ridge across the circles.
+    /// Name one only when the model has no narrow lobe about the half vector
+    /// (which the half vector serves better); [`Brdf::peaks`] on that side
+    /// still break the rings, and [`Brdf::kinks`] the rings and the polar
+    /// angle where they cross the great circle through the pole and `wi`.
+    /// Default: none.
+    fn pole(&self, _wi: DVec3) -> Option<DVec3> {
+        None
+    }
+
     /// The kinks of `f(wi, ·)` (see [`Kink`]) over the outgoing directions on
     /// `wi`'s side, so that the albedo quadrature breaks its panels where
     /// they cross a circle of integration instead of bisecting towards them:

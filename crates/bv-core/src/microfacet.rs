@@ -171,15 +171,18 @@ pub fn v_groove_section(wi: DVec3, wo: DVec3, u: DVec3) -> Option<VGrooveSection
 
 /// The kinks of [`v_groove_g`] for light from `wi` (see [`crate::Kink`]):
 /// where either shadowing term reaches 1 and where the two swap (`θo = θi`).
+///
+/// The first two are linear in `h`, so only its direction matters for
+/// their sign: they take the unnormalised `wi + wo`, which saves the
+/// quadrature a square root and a division per look at them.
 pub fn v_groove_kinks(wi: DVec3) -> Vec<crate::Kink<'static>> {
-    let half = move |wo: DVec3| (wi + wo).try_normalize().unwrap_or(DVec3::Z);
     vec![
         Box::new(move |wo: DVec3| {
-            let h = half(wo);
+            let h = wi + wo;
             2.0 * h.z * wo.z - wo.dot(h)
         }),
         Box::new(move |wo: DVec3| {
-            let h = half(wo);
+            let h = wi + wo;
             2.0 * h.z * wi.z - wo.dot(h)
         }),
         Box::new(move |wo: DVec3| wo.z - wi.z),

@@ -143,6 +143,12 @@ impl Brdf for Rotated {
             .collect()
     }
 
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        self.inner
+            .pole(self.to_inner(wi))
+            .map(|w| self.to_rotated(w))
+    }
+
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
         self.inner
             .kinks(self.to_inner(wi))

@@ -689,7 +689,8 @@ impl Brdf for Unkinked {
     }
 }
 
-/// The kinks a model names (Oren-Nayar's clamps, V-groove's `min`) save
+/// The kinks a model names (Oren-Nayar's clamps, V-groove's `min`,
+/// Ashikhmin-Shirley's `max(cos θi, cos θo)`) save
 /// evaluations, not accuracy: the same value within the stated errors, with
 /// under half the evaluations of the same function without them (a count,
 /// not a time), and the brute-force reference within the stated error.
@@ -702,6 +703,7 @@ fn named_kinks_save_work_not_accuracy() {
             "cook-torrance",
             json!({"distribution": "beckmann", "geometry": "v-groove", "alpha": 0.4}),
         ),
+        ("ashikhmin-shirley", json!({"nu": 100.0, "nv": 100.0})),
     ] {
         let (mut with, mut without) = (0usize, 0usize);
         for deg in [10.0f64, 40.0, 70.0] {
@@ -728,6 +730,178 @@ fn named_kinks_save_work_not_accuracy() {
         assert!(
             2 * with < without,
             "{id}: {with} evaluations with kinks, {without} without"
+        );
+    }
+}
+
+/// A diffuse base plus a cone-shaped lobe about the light, `0.3/π +
+/// a exp(−|wo − wi|/r)` (defined here): a point cusp at `wo = wi` like
+/// Hapke's opposition surge, named through [`Brdf::pole`] or not.
+#[derive(Debug)]
+struct Cone {
+    a: f64,
+    r: f64,
+    named: bool,
+}
+impl Brdf for Cone {
+    fn id(&self) -> &'static str {
+        "cone"
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return Rgb::ZERO;
+        }
+        Rgb::splat(0.3 / PI + self.a * (-(wo - wi).length() / self.r).exp())
+    }
+    fn claims(&self) -> Claims {
+        Claims {
+            reciprocal: true,
+            energy_conserving: true,
+            isotropic: true,
+        }
+    }
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        self.named.then_some(wi)
+    }
+}
+
+/// The polar rule about a named cusp, against a closed form and the brute
+/// force: about `wi`, a ring at angle θ has `|wo − wi| = t = 2 sin(θ/2)` and
+/// its mean `cos θo` is `cos θ cos θi`, so with `u = 1 − cos θ = t²/2` the
+/// cone's share is `2π a cos θi ∫ e^{−t/r} (1 − t²/2) t dt
+/// = 2π a cos θi (r² − 3 r⁴)` while the lobe lies above the horizon (at
+/// θi ≤ 30° and r = 0.05 what lies below or past t = 2 is under
+/// `e^{−20}`). Past that, the brute force judges it. The cusp named must
+/// also save work: under half the evaluations of the same function without
+/// it (a count, not a time).
+#[test]
+fn a_named_cusp_is_integrated_about_its_pole() {
+    let opts = QuadratureOptions::default();
+    let (a, r) = (1.0, 0.05);
+    let named = Cone { a, r, named: true };
+    let plain = Cone { a, r, named: false };
+    for deg in [0.0f64, 10.0, 30.0] {
+        let q = quadrature::rho_hd(&named, deg.to_radians(), 0.7, &opts);
+        let want = 0.3 + 2.0 * PI * a * deg.to_radians().cos() * (r * r - 3.0 * r.powi(4));
+        let dev = (q.value.x - want).abs();
+        assert!(
+            dev <= 1e-5 && dev <= q.std_error.x + 1e-8,
+            "cone θi={deg}: {} ± {:e} vs {want}",
+            q.value.x,
+            q.std_error.x
+        );
+    }
+    let (mut with, mut without) = (0usize, 0usize);
+    for deg in [20.0f64, 60.0, 80.0, 89.0] {
+        let wi = frame::from_spherical(deg.to_radians(), 0.7);
+        let q = quadrature::rho_hd_dir(&named, wi, &opts);
+        let (want, ref_err) = reference(&named, wi);
+        assert!(
+            ref_err <= 2e-6,
+            "θi={deg}: brute force unconverged ({ref_err:e})"
+        );
+        let dev = (q.value - want).abs().max_element();
+        assert!(
+            dev <= 1e-5 && dev <= q.std_error.max_element() + 2.0 * ref_err + 1e-8,
+            "cone θi={deg}: {} ± {:e} vs brute force {}",
+            q.value.x,
+            q.std_error.x,
+            want.x
+        );
+        with += q.samples;
+        without += quadrature::rho_hd_dir(&plain, wi, &opts).samples;
+    }
+    assert!(
+        2 * with < without,
+        "{with} evaluations with the cusp named, {without} without"
+    );
+}
+
+/// Banks' model about its fibre `t = +x`: with `wo = (cos α, sin α cos β,
+/// sin α sin β)`, above the surface for `β ∈ (0, π)`, `cos θo = sin α sin β`
+/// and `dω = sin α dα dβ`, and `f` depends on `α` alone, so
+/// `ρhd = 2 ∫₀^π f(α) sin² α dα` (the β integral of `sin β` is 2): a 1-D
+/// integral, here by composite Gauss–Legendre with breaks at the clamp's
+/// cone (`α + αi = π/2` or `3π/2`) and graded about the lobe's `α = π − αi`, its own
+/// error the difference of two resolutions. The polar rule about the fibre
+/// ([`Brdf::pole`]) must match it within its stated error, for a kinked
+/// (`e = 1`), a broad and a narrow lobe, off the axes.
+#[test]
+fn banks_about_its_fibre_matches_a_one_dimensional_reference() {
+    let opts = QuadratureOptions::default();
+    let (kd, ks) = (0.2, 0.5);
+    let one_d = |e: f64, wi: DVec3, split: usize| -> f64 {
+        let ci = wi.x;
+        let si = (1.0 - ci * ci).sqrt();
+        let ai = ci.acos();
+        let f = |a: f64| {
+            let base = (si * a.sin() - ci * a.cos()).max(0.0);
+            kd * si + ks * base.powf(e)
+        };
+        let mut b = breaks(0.0, PI, 64, &[PI - ai]);
+        // −cos(α + αi) = 0 at α + αi = π/2 or 3π/2.
+        b.extend([FRAC_PI_2 - ai, 3.0 * FRAC_PI_2 - ai]);
+        b.retain(|&x| (0.0..=PI).contains(&x));
+        b.sort_by(f64::total_cmp);
+        let gl = gauss_legendre(8);
+        let mut sum = 0.0;
+        for w in b.windows(2) {
+            for k in 0..split {
+                let lo = w[0] + (w[1] - w[0]) * k as f64 / split as f64;
+                let hi = w[0] + (w[1] - w[0]) * (k + 1) as f64 / split as f64;
+                for &(x, wt) in &gl {
+                    let a = lo + (hi - lo) * x;
+                    sum += (hi - lo) * wt * f(a) * a.sin().powi(2);
+                }
+            }
+        }
+        2.0 * sum
+    };
+    for e in [1.0, 20.0, 1000.0] {
+        let b = build("banks", &json!({"kd": kd, "ks": ks, "e": e}));
+        for (deg, phi) in [(0.0f64, 0.0), (40.0, 0.6), (70.0, 2.0), (89.0, 1.0)] {
+            let wi = frame::from_spherical(deg.to_radians(), phi);
+            let (coarse, fine) = (one_d(e, wi, 2), one_d(e, wi, 3));
+            let ref_err = (fine - coarse).abs();
+            assert!(
+                ref_err < 1e-9,
+                "e={e} θi={deg}: reference unconverged {ref_err:e}"
+            );
+            let q = quadrature::rho_hd_dir(b.as_ref(), wi, &opts);
+            let dev = (q.value.x - fine).abs();
+            assert!(
+                dev <= 1e-5 && dev <= q.std_error.x + ref_err + 1e-9,
+                "banks e={e} θi={deg}: {} ± {:e} vs {fine}",
+                q.value.x,
+                q.std_error.x
+            );
+        }
+    }
+}
+
+/// The catalogue's modified Phong about its mirror direction
+/// ([`Brdf::pole`]), against its closed form: with `r = R(wi)`, the mean
+/// `cos θo` on a cone of angle α about `r` is `cos α (r·n)`, so
+/// `(e+2)/(2π) ∫ cos^e α cos θo dω = cos θi` while the lobe is above the
+/// horizon: at normal incidence for every exponent (the clamp's cone is
+/// the horizon), and at e = 10⁴ up to θi = 80° (what lies past the horizon
+/// is under `cos^e 10° = e^{−152}`). With `kd`, `ρhd = kd + ks cos θi`.
+#[test]
+fn modified_phong_about_its_mirror_direction_matches_its_closed_form() {
+    let opts = QuadratureOptions::default();
+    let (kd, ks) = (0.1, 0.8);
+    let mut cases: Vec<(f64, f64)> = [1.0, 20.0, 300.0].iter().map(|&e| (e, 0.0)).collect();
+    cases.extend([0.0, 30.0, 60.0, 80.0].iter().map(|&d| (1e4, d)));
+    for (e, deg) in cases {
+        let b = build("modified-phong", &json!({"kd": kd, "ks": ks, "e": e}));
+        let q = quadrature::rho_hd(b.as_ref(), f64::to_radians(deg), 0.4, &opts);
+        let want = kd + ks * f64::to_radians(deg).cos();
+        let dev = (q.value.x - want).abs();
+        assert!(
+            dev <= 1e-5 && dev <= q.std_error.x + 1e-9,
+            "modified-phong e={e} θi={deg}: {} ± {:e} vs {want}",
+            q.value.x,
+            q.std_error.x
         );
     }
 }

@@ -41,6 +41,13 @@
 //! - The kinks a model names ([`Brdf::kinks`]: Oren-Nayar's clamps,
 //!   V-groove's `min`) are located on each inner circle by regula falsi and
 //!   become panel breaks, instead of a cloud of bisections about each.
+//! - A model that names a pole on the light's side ([`Brdf::pole`]: Hapke's
+//!   opposition surge, a cusp at `wo = wi`; Banks' fibre, on whose rings
+//!   `f` is constant) is integrated there in polar coordinates about it, by
+//!   the rule of the transmitted part (see [`transmitted`]) on the model's
+//!   mirror image: each ring about the pole is then smooth, where over the
+//!   half vector Hapke's cusp is a 2-D feature at `h = wi` that both axes
+//!   must bisect towards and Banks' cone a ridge across every circle.
 
 use super::directions::below;
 use super::estimate::{AlbedoParts, Estimate, Method};
@@ -180,9 +187,14 @@ fn mirror_symmetric(brdf: &dyn Brdf, wi: DVec3, phi_i: f64, below: bool) -> bool
 /// left to the verified bisection).
 const KINK_SCAN: usize = 8;
 
-/// Adds to `out` the azimuths in `(lo, hi)` where a kink of the model
+/// Points of the scan along the plane of incidence in θh for the outer
+/// breaks where a kink's roots appear on the circles (see [`reflected`]).
+const OUTER_KINK_SCAN: usize = 32;
+
+/// Adds to `out` the parameters in `(lo, hi)` (an azimuth on a circle, or
+/// θh along the plane of incidence) where a kink of the model
 /// ([`Brdf::kinks`]) changes sign along the directions `dir(φ)` (`None`
-/// where there is no direction), each to within 1e-12 rad by the Illinois
+/// where there is no direction), looked for at `scan` steps, each to within 1e-12 rad by the Illinois
 /// variant of regula falsi (superlinear, and it keeps the root bracketed):
 /// panel breaks, so that no Gauss–Kronrod panel straddles a kink.
 fn kink_roots(
@@ -190,16 +202,17 @@ fn kink_roots(
     dir: impl Fn(f64) -> Option<DVec3>,
     lo: f64,
     hi: f64,
+    scan: usize,
     out: &mut Vec<f64>,
 ) {
     if kinks.is_empty() || hi - lo <= 0.0 {
         return;
     }
-    let step = (hi - lo) / KINK_SCAN as f64;
-    let dirs: Vec<Option<DVec3>> = (0..=KINK_SCAN).map(|k| dir(lo + step * k as f64)).collect();
+    let step = (hi - lo) / scan as f64;
+    let dirs: Vec<Option<DVec3>> = (0..=scan).map(|k| dir(lo + step * k as f64)).collect();
     for kink in kinks {
         let value = |phi: f64| dir(phi).map(kink);
-        for k in 0..KINK_SCAN {
+        for k in 0..scan {
             let (Some(a), Some(b)) = (dirs[k], dirs[k + 1]) else {
                 continue;
             };
@@ -307,7 +320,18 @@ pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) ->
     let sin_ti = (1.0 - cos_ti * cos_ti).max(0.0).sqrt();
     let theta_i = cos_ti.acos();
     let phi_i = if sin_ti > 0.0 { wi.y.atan2(wi.x) } else { 0.0 };
-    let upper = reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts);
+    // A model that names a pole on wi's side (Hapke's cusp at wo = wi,
+    // Banks' fibre) is integrated in polar coordinates about it, by the rule
+    // of the transmitted part applied to the model's mirror image through
+    // the surface ([`AboutPole`]).
+    let pole = brdf
+        .pole(wi)
+        .filter(|c| c.is_finite() && c.z >= 0.0)
+        .and_then(DVec3::try_normalize);
+    let upper = match pole {
+        Some(pole) => transmitted(&AboutPole(brdf), wi, Some(below(pole)), opts),
+        None => reflected(brdf, wi, cos_ti, sin_ti, theta_i, phi_i, opts),
+    };
     let reflected = quad_estimate(
         upper.value + delta_r,
         upper.error,
@@ -315,7 +339,7 @@ pub fn rho_hd_parts_dir(brdf: &dyn Brdf, wi: DVec3, opts: &QuadratureOptions) ->
         upper.converged,
     );
     let transmitted = if transmits {
-        let lower = transmitted(brdf, wi, opts);
+        let lower = transmitted(brdf, wi, None, opts);
         quad_estimate(
             lower.value + delta_t,
             lower.error,
@@ -357,9 +381,46 @@ impl Brdf for Flipped<'_> {
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         self.0.peaks(below(wi)).into_iter().map(below).collect()
     }
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        self.0.pole(below(wi)).map(below)
+    }
     fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
         self.0
             .kinks(below(wi))
+            .into_iter()
+            .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
+            .collect()
+    }
+}
+
+/// A reflection model seen through the surface plane on the outgoing side
+/// only (`wo → −wo.z`): its reflected hemisphere becomes the lower one, which
+/// [`transmitted`] integrates in polar coordinates about the mirror image of
+/// the model's [`Brdf::pole`]. The peaks and the kinks on `wi`'s side are
+/// mirrored with it.
+#[derive(Debug)]
+struct AboutPole<'a>(&'a dyn Brdf);
+
+impl Brdf for AboutPole<'_> {
+    fn id(&self) -> &'static str {
+        self.0.id()
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+        self.0.eval(wi, below(wo))
+    }
+    fn claims(&self) -> crate::Claims {
+        self.0.claims()
+    }
+    fn transmits(&self) -> bool {
+        true
+    }
+    fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+        let up = self.0.peaks(wi).into_iter().filter(|p| p.z > 0.0);
+        up.map(below).collect()
+    }
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.0
+            .kinks(wi)
             .into_iter()
             .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
             .collect()
@@ -397,6 +458,12 @@ fn reflected(
             let h = (wi + p.normalize()).try_normalize()?;
             Some((h.z.clamp(-1.0, 1.0).acos(), h.y.atan2(h.x)))
         })
+        // A peak at the mirror direction (a Lafortune lobe `(−1, −1, 1)`)
+        // has its half vector at the normal, which the square-law grading of
+        // the first panel resolves already: geometric breaks there would be
+        // a dozen panels of inner integrals for nothing, and its azimuth
+        // (rounding's) a break on every circle.
+        .filter(|&(t, _)| t > FINEST)
         .collect();
     let mut breaks = vec![0.0, theta_end];
     if theta_full > 0.0 && theta_full < theta_end {
@@ -413,6 +480,29 @@ fn reflected(
     // inside any lobe the contract covers, so bisection finds it), at
     // θ_full from above and towards the end (square-root points of the arc
     // width).
+    // Where a kink's curve on the hemisphere crosses the plane of incidence,
+    // a pair of its roots appears on (or leaves) the circles of θh: there
+    // the inner integral has a kink of its own in θh, which bisection and
+    // verification would otherwise chase (V-groove's `2 (n·h)(n·wi) = wi·h`
+    // at θh = 90° − θi, its and Oren-Nayar's `θo = θi` at θh = θi). Those θh
+    // are found as the inner roots are, along the plane on both sides of the
+    // normal, and become outer breaks. A crossing elsewhere (a kink that is
+    // not symmetric about the plane) is left to bisection.
+    let kinks = brdf.kinks(wi);
+    if !kinks.is_empty() {
+        for side in [0.0, PI] {
+            let (sp, cp) = (phi_i + side).sin_cos();
+            let along = |theta_h: f64| {
+                let (sh, ch) = theta_h.sin_cos();
+                let h = DVec3::new(sh * cp, sh * sp, ch);
+                let wo = 2.0 * wi.dot(h) * h - wi;
+                (wo.z > 0.0).then(|| wo.normalize())
+            };
+            kink_roots(&kinks, along, 0.0, theta_end, OUTER_KINK_SCAN, &mut breaks);
+        }
+        breaks.sort_by(f64::total_cmp);
+        breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
+    }
     let segs = polar_segments(&breaks, theta_full, theta_end);
     let anisotropic = !brdf.claims().isotropic;
     let mut fixed_phis: Vec<f64> = Vec::new();
@@ -430,7 +520,6 @@ fn reflected(
     let half = !anisotropic
         && peaks.iter().all(|&(t, p)| t < 1e-9 || in_plane(p, phi_i))
         && mirror_symmetric(brdf, wi, phi_i, false);
-    let kinks = brdf.kinks(wi);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta_h: f64| -> (Rgb, Rgb) {
@@ -465,7 +554,7 @@ fn reflected(
             let wo = 2.0 * wi.dot(h) * h - wi;
             (wo.z > 0.0).then(|| wo.normalize())
         };
-        kink_roots(&kinks, dir, lo, hi, &mut br);
+        kink_roots(&kinks, dir, lo, hi, KINK_SCAN, &mut br);
         let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
         inner_evals += r.evaluations;
         (r.value, r.error)
@@ -482,9 +571,11 @@ fn reflected(
     r
 }
 
-/// The transmitted part, in polar coordinates `(θ, ψ)` about the model's
-/// first peak below the surface `p` ([`Brdf::peaks`]: a rough dielectric's
-/// refracted direction; the pole −z when it names none):
+/// The transmitted part, in polar coordinates `(θ, ψ)` about `pole` when
+/// given (a reflection model's [`Brdf::pole`], mirrored through the surface
+/// by [`AboutPole`]; it may lie in the surface's plane), else about the
+/// model's first peak below the surface `p` ([`Brdf::peaks`]: a rough
+/// dielectric's refracted direction; the pole −z when it names none):
 /// `wo = cos θ p − sin θ (cos ψ e₁ + sin ψ e₂)`, with `e₁` in the vertical
 /// plane through `p` pointing up and `e₂ = p × e₁` horizontal, and
 /// `ρT = ∫∫ f |cos θo| sin θ dψ dθ` over the part of that sphere below the
@@ -505,6 +596,7 @@ fn reflected(
 fn transmitted(
     brdf: &dyn Brdf,
     wi: DVec3,
+    pole: Option<DVec3>,
     opts: &QuadratureOptions,
 ) -> gauss_kronrod::Integral<Rgb> {
     let below_peaks: Vec<DVec3> = brdf
@@ -513,7 +605,9 @@ fn transmitted(
         .filter(|p| p.is_finite() && p.z < 0.0)
         .filter_map(|p| p.try_normalize())
         .collect();
-    let p = below_peaks.first().copied().unwrap_or(DVec3::NEG_Z);
+    let p = pole
+        .or_else(|| below_peaks.first().copied())
+        .unwrap_or(DVec3::NEG_Z);
     let phi_i = wi.y.atan2(wi.x);
     let up = DVec3::Z - p.z * p;
     let e1 = if up.length() > 1e-9 {
@@ -533,10 +627,11 @@ fn transmitted(
         let (sp, cp) = psi.sin_cos();
         ct * p - st * (cp * e1 + sp * e2)
     };
-    // The other peaks, as (θ, ψ) about p.
+    // The other peaks, as (θ, ψ) about p (the pole itself is graded
+    // already).
     let others: Vec<(f64, f64)> = below_peaks
         .iter()
-        .skip(1)
+        .filter(|q| q.dot(p) < 1.0 - 1e-12)
         .map(|q| {
             let t = q.dot(p).clamp(-1.0, 1.0).acos();
             (t, (-q.dot(e2)).atan2(-q.dot(e1)))
@@ -558,6 +653,17 @@ fn transmitted(
         let gamma = c.acos();
         breaks.extend([gamma + beta, gamma - beta, beta - gamma]);
     }
+    // The rings where a kink's roots appear, along the great circle through
+    // the pole and the vertical (ψ = 0 and ψ = π), as in [`reflected`]:
+    // Banks' cone `αi + αo = 90°`, a ring about its fibre.
+    let kinks = brdf.kinks(wi);
+    for side in [0.0, PI] {
+        let along = |theta: f64| {
+            let wo = at(theta, side);
+            (wo.z < 0.0).then_some(wo)
+        };
+        kink_roots(&kinks, along, 0.0, theta_end, OUTER_KINK_SCAN, &mut breaks);
+    }
     breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
@@ -569,7 +675,6 @@ fn transmitted(
         && (p.z <= -1.0 + 1e-12 || in_plane(p.y.atan2(p.x), phi_i))
         && others.iter().all(|&(t, a)| t < 1e-9 || in_plane(a, 0.0))
         && mirror_symmetric(brdf, wi, phi_i, true);
-    let kinks = brdf.kinks(wi);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
     let mut outer = |theta: f64| -> (Rgb, Rgb) {
@@ -623,6 +728,7 @@ fn transmitted(
             },
             lo,
             hi,
+            KINK_SCAN,
             &mut br,
         );
         let mut inner = |psi: f64| -> (Rgb, Rgb) {

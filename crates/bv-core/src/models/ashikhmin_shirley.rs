@@ -269,6 +269,13 @@ impl Brdf for AshikhminShirley {
         diffuse + schlick(self.rs, c) * spec
     }
 
+    /// The specular term's `max(cos θi, cos θo)` (Ashikhmin & Shirley 2000,
+    /// eq. 4) switches branch where `θo = θi`.
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        let cz = wi.z;
+        vec![Box::new(move |wo: DVec3| wo.z - cz)]
+    }
+
     fn claims(&self) -> Claims {
         // Energy. Proven here only for the specular term alone: with dωo = 4c dωh,
         // ρs(wi) = ∫ p(h) F(c) cosθo / max(cosθi, cosθo) dωh ≤ max F · ∫ p(h) dωh

@@ -188,6 +188,30 @@ impl Brdf for Banks {
         Some(&self.kernel)
     }
 
+    /// The fibre `t = +x`: both terms depend on `wo` through `wo·t = cos αo`
+    /// alone (Banks 1994, §4), so `f` is constant on every ring about it and
+    /// the albedo quadrature integrates in polar coordinates about it,
+    /// where over the half vector the cone `αo = π − αi` is a ridge across
+    /// every circle.
+    fn pole(&self, _wi: DVec3) -> Option<DVec3> {
+        Some(DVec3::X)
+    }
+
+    /// Where the albedo quadrature should break: the clamp
+    /// `max(0, −cos(αi + αo))` switches branch on the cone `αo = π/2 − αi`
+    /// (a kink for an exponent near 1 or below), and the specular lobe
+    /// peaks on the cone `αo = π − αi` of mirror directions about the fibre
+    /// (`wo·t = −wi·t`), which is no kink but a sign change that costs a
+    /// break and puts a panel's end on the ridge (about the fibre, a ring),
+    /// so that a narrow lobe (`e` up to 10⁴) is never stepped over.
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        let (ci, si) = (wi.x, sin_to_fibre(wi));
+        vec![
+            Box::new(move |wo: DVec3| si * sin_to_fibre(wo) - ci * wo.x),
+            Box::new(move |wo: DVec3| wo.x + ci),
+        ]
+    }
+
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return Rgb::ZERO;

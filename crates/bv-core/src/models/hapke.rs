@@ -249,6 +249,15 @@ impl Brdf for Hapke {
         vec![wi]
     }
 
+    /// The surge `B = b0 h |wi+wo| / (h |wi+wo| + |wi−wo|)` is a cone in
+    /// `wo` about `wi` (its slope along any great circle through `wi` jumps
+    /// sign there), while every other term is smooth: integrated in polar
+    /// coordinates about `wi`, it is a smooth function of the polar angle
+    /// alone (`|wi ± wo| = 2 cos, 2 sin` of half of it).
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        Some(wi)
+    }
+
     fn batch_kernel(&self) -> Option<&dyn Kernel> {
         Some(&self.kernel)
     }

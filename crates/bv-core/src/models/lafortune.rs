@@ -306,6 +306,34 @@ impl Brdf for Lafortune {
             .collect()
     }
 
+    /// With one lobe that contributes (`ks ≠ 0`), `f` depends on `wo`
+    /// through `C wi · wo` alone, so it is constant on every ring about
+    /// `C wi / |C wi|`: the albedo quadrature integrates in polar
+    /// coordinates about it when it lies above the horizon (a Phong lobe
+    /// `(−1, −1, 1)` about the mirror direction, a retro-reflective one
+    /// `(1, 1, 1)` about `wi`). Lobes about different axes have no common
+    /// pole.
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        let mut lit = self.lobes.iter().filter(|l| l.ks.max_element() != 0.0);
+        let (Some(l), None) = (lit.next(), lit.next()) else {
+            return None;
+        };
+        (l.c * wi).try_normalize().filter(|v| v.z > 0.0)
+    }
+
+    /// Each lobe's clamp `max(0, C wi · wo)` switches branch where the base
+    /// turns negative (a kink for exponents near 1 or below).
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        self.lobes
+            .iter()
+            .filter(|l| l.ks.max_element() != 0.0)
+            .map(|l| -> crate::Kink<'_> {
+                let v = l.c * wi;
+                Box::new(move |wo: DVec3| v.dot(wo))
+            })
+            .collect()
+    }
+
     /// Reciprocal: each lobe's base is symmetric in `wi` and `wo`.
     ///
     /// Isotropic when every lobe that contributes (`ks ≠ 0`) has `cx = cy`:

@@ -147,6 +147,22 @@ impl Brdf for Phong {
     /// still covers directions above the horizon) while `1/cosθi → ∞`: every
     /// `ks > 0` exceeds 1 near grazing. So it conserves energy iff `ks = 0`
     /// and `π kd ≤ 1`.
+    /// The lobe depends on `wo` through `R(wo)·wi = wo·R(wi)` alone, the
+    /// cosine of the angle from the mirror direction, so `f` is constant on
+    /// every ring about `R(wi)`: the albedo quadrature integrates in polar
+    /// coordinates about it, where over the half vector the lobe is an
+    /// ellipse that narrows towards grazing.
+    fn pole(&self, wi: DVec3) -> Option<DVec3> {
+        Some(frame::reflect(wi))
+    }
+
+    /// The clamp `max(0, R(wo)·wi)` switches branch 90° from the mirror
+    /// direction (a kink for exponents near 1 or below).
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        let r = frame::reflect(wi);
+        vec![Box::new(move |wo: DVec3| wo.dot(r))]
+    }
+
     fn batch_kernel(&self) -> Option<&dyn Kernel> {
         Some(&self.kernel)
     }
