@@ -281,7 +281,14 @@ impl PolarView {
                 })
                 .collect();
             Some((
-                format!("{} SH L = {}", b.label, r.lobe.order),
+                // The error in the legend too: presenting, the toolbar's
+                // error line is hidden.
+                format!(
+                    "{} SH L = {}: L2 error {}",
+                    b.label,
+                    r.lobe.order,
+                    sh_overlay::percent(r.lobe.rel_l2_error)
+                ),
                 b.color(),
                 pts,
             ))

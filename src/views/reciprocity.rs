@@ -301,7 +301,20 @@ impl View for ReciprocityView {
         } else {
             Pos2::new(area.left() + 6.0, disc.bottom() + 6.0)
         };
-        painter.text(text_at, Align2::LEFT_TOP, worst, font.clone(), text);
+        // Beside the disc the text gets its own lines and wraps at the
+        // view's edge (on one line it ran past it at 1920×1080).
+        let worst = if wide {
+            worst.replace("; ", "\n")
+        } else {
+            worst
+        };
+        let galley = painter.layout(
+            worst,
+            font.clone(),
+            text,
+            (area.right() - text_at.x - 6.0).max(80.0),
+        );
+        painter.galley(text_at, galley, text);
         if !scene.figure {
             let hover = response
                 .hover_pos()
