@@ -53,7 +53,9 @@ use crate::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, ma
 use crate::fresnel::{self, FresnelLanes};
 use crate::microfacet::{self, Distribution, Microfacet, ScaleLanes};
 use crate::model::{ALPHA_ALIAS, Build, GpuPort, GpuTables, ModelInfo};
-use crate::models::rough_dielectric::{Geometry, ReflectionLanes, RoughDielectric};
+use crate::models::rough_dielectric::{
+    Geometry, ReflectionLanes, RoughDielectric, fresnel_t_lanes,
+};
 use crate::params::decl::{ColorSpec, FloatSpec, ParamDecl, ParamKind};
 use crate::params::value::{ModelSpec, Params};
 use crate::{Brdf, BvError, Claims, FresnelTerm, Ndf, Result, Rgb, frame, quadrature, sampling};
@@ -666,17 +668,12 @@ impl CoatedKernel {
 }
 
 /// Fresnel transmittance `1 − F` of the coat's macro interface for light
-/// from above at `c = cos θ` (> 0), written out so that it does not cancel
-/// near grazing incidence: with `g = η cos θt = √(η² − 1 + c²)`,
-/// `T = ½ [4cg/(c + g)² + 4η²cg/(η²c + g)²]` (the complements of
-/// `((c − g)/(c + g))²` and `((η²c − g)/(η²c + g))²`, the s and p
-/// reflectances of [`fresnel::dielectric`]).
+/// from above at `c = cos θ` (> 0): rough-dielectric's lane form with
+/// `g = η cos θt = √(η² − 1 + c²)`.
 #[inline(always)]
 fn transmittance<V: Lanes>(c: V, eta2: f32) -> V {
     let g = (c * c + (eta2 - 1.0)).sqrt();
-    let (s1, s2) = (c + g, c * eta2 + g);
-    let cg4 = c * g * 4.0;
-    (cg4 / (s1 * s1) + cg4 * eta2 / (s2 * s2)) * 0.5
+    fresnel_t_lanes(c, g, V::splat(eta2))
 }
 
 /// One monomorphised combination of distribution and base

@@ -575,6 +575,18 @@ impl ReflectionLanes {
     }
 }
 
+/// The exact dielectric Fresnel transmittance `1 − F` at `c = |cos θ|`
+/// with `g = ηrel cos θt` and `n2 = η²rel`, written out so that it does not
+/// cancel near grazing incidence or total internal reflection:
+/// `½ [4cg/(c + g)² + 4 n² cg/(n² c + g)²]` (Walter et al. 2007, eq. 22's
+/// terms' complements). Shared with the `coated` kernel's macro interface.
+#[inline(always)]
+pub(crate) fn fresnel_t_lanes<V: Lanes>(c: V, g: V, n2: V) -> V {
+    let (s1, s2) = (c + g, n2 * c + g);
+    let cg4 = c * g * 4.0;
+    (cg4 / (s1 * s1) + cg4 * n2 / (s2 * s2)) * 0.5
+}
+
 /// `ln(1 + z)` for `z ≥ 0`, accurate relative to the result for small `z`.
 #[inline(always)]
 fn ln1p<V: Lanes>(z: V) -> V {
@@ -704,8 +716,7 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         let (s1, s2) = (c + gg, n2 * c + gg);
         let (rs, rp) = ((c - gg) / s1, (n2 * c - gg) / s2);
         let fr = tir.select(one, (rs * rs + rp * rp) * 0.5);
-        let cg4 = c * gg * 4.0;
-        let ft = tir.select(zero, (cg4 / (s1 * s1) + cg4 * n2 / (s2 * s2)) * 0.5);
+        let ft = tir.select(zero, fresnel_t_lanes(c, gg, n2));
         let zz = (zi * zo).abs();
         // Eq. 20, and eq. 21 with (ηi wi·h + ηo wo·h)² = |ηi wi + ηo wo|² = l2.
         let refl = fr * d * g / (zz * 4.0);
