@@ -1204,3 +1204,91 @@ fn where_reflectance_functions_come_from() {
     );
     assert!(widest(1, 2) >= 0.3, "the two fits: {}", widest(1, 2));
 }
+
+/// LECTURE.md scene 10 [cf]: the slice's display is the slide's own
+/// (`plots.slice`, N1), Lambert is one grey, and the microfacet band at
+/// θh = 0 brightens about 200× from θd 0° to 80° (F 9.7×, 1/cos²θd 33×,
+/// G2 0.66) without being clipped to white below 80°.
+#[test]
+fn the_parameterisation_slide_shows_the_band_unclipped() {
+    use bv::derive::slice::{compute, luminance};
+    use bv::views::image_slice::display_color;
+    let slides = slides();
+    let s = slide(&slides, "Parameterisations: θh, θd");
+    let set = s.state.plots.slice;
+    assert_eq!(set.phi_d_deg, 90.0);
+    let brdfs = scene_brdfs(s);
+    let n = 256;
+    let hatch = (eframe::egui::Color32::BLACK, eframe::egui::Color32::BLACK);
+    let shown = |d: &bv::derive::slice::SliceData, row: usize, col: usize| {
+        display_color(d.values[row * n + col], &set, hatch, false)
+    };
+    // Lambert: one grey over the whole image, neither black nor white.
+    let lambert = compute(
+        brdfs[0].as_ref(),
+        set.phi_d_deg.to_radians(),
+        set.sqrt_theta_h,
+        n,
+    );
+    let grey = shown(&lambert, 0, 0);
+    assert!((30..225).contains(&grey.r()), "{grey:?}");
+    for row in 0..n {
+        for col in 0..n {
+            assert_eq!(shown(&lambert, row, col), grey);
+        }
+    }
+    // The microfacet lobe at θh ≈ 0 (the first column), against its closed
+    // form D(0) F(θd) G2(θd, θd) / (4 cos²θd) with GGX and Smith's
+    // height-correlated G2 (Heitz 2014, eq. 99).
+    let ggx = compute(
+        brdfs[1].as_ref(),
+        set.phi_d_deg.to_radians(),
+        set.sqrt_theta_h,
+        n,
+    );
+    let alpha: f64 = 0.2;
+    let closed = |td: f64| {
+        let c = td.cos();
+        let lambda = (-1.0 + (1.0 + alpha * alpha * td.tan().powi(2)).sqrt()) / 2.0;
+        let g2 = 1.0 / (1.0 + 2.0 * lambda);
+        let d0 = 1.0 / (std::f64::consts::PI * alpha * alpha);
+        d0 * fresnel_dielectric(c, 1.0, 1.5) * g2 / (4.0 * c * c)
+    };
+    let row_of = |td_deg: f64| ((1.0 - td_deg / 90.0) * n as f64 - 0.5).round() as usize;
+    let td_of = |row: usize| (1.0 - (row as f64 + 0.5) / n as f64) * std::f64::consts::FRAC_PI_2;
+    let mut last_level = 0u8;
+    for td_deg in [0.2, 10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 75.0, 80.0] {
+        let row = row_of(td_deg);
+        let got = luminance(ggx.values[row * n].unwrap());
+        let want = closed(td_of(row));
+        assert!(
+            (got - want).abs() <= 2e-3 * want,
+            "θd {td_deg}: {got} vs {want}"
+        );
+        let level = shown(&ggx, row, 0).r();
+        assert!(
+            level >= last_level,
+            "θd {td_deg}: level {level} after {last_level}"
+        );
+        last_level = level;
+        if td_deg < 80.0 {
+            assert!(level < 255, "θd {td_deg}: clipped to white");
+        }
+        if td_deg < 1.0 {
+            assert!(level >= 30, "the band at θd 0 is black: {level}");
+        }
+    }
+    // A gradient up the band that reads from across the room.
+    assert!(
+        f64::from(last_level) > 4.0 * f64::from(shown(&ggx, row_of(0.2), 0).r()),
+        "{last_level}"
+    );
+    let ratio = closed(80f64.to_radians()) / closed(0.0);
+    assert!((150.0..260.0).contains(&ratio), "{ratio}");
+    // A band: at θd 30° the first column is brighter than θh = 30°.
+    let row = row_of(30.0);
+    let col30 =
+        (bv::derive::slice::u_of_theta_h(30f64.to_radians(), set.sqrt_theta_h) * n as f64) as usize;
+    let (at0, at30) = (shown(&ggx, row, 0).r(), shown(&ggx, row, col30).r());
+    assert!(f64::from(at0) > 1.5 * f64::from(at30), "{at0} vs {at30}");
+}

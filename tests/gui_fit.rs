@@ -189,10 +189,11 @@ fn headless_residual_tiles_show_both_signs() {
         "ward",
         serde_json::json!({"kd": 0.1061, "ks": 0.0213, "alpha": 0.2434}),
     ));
+    // Residual mode, as a scene saves it (`plots.slice`).
+    state.plots.slice.residual = true;
     let mut runtime = bv::session::runtime::Runtime::default();
     runtime.sync(&state);
-    let mut view = bv::views::image_slice::ImageSliceView::default();
-    view.settings.residual = true;
+    let view = bv::views::image_slice::ImageSliceView::default();
     let rs = egui_kittest::wgpu::create_render_state(
         egui_kittest::wgpu::default_wgpu_setup(),
         eframe::egui_wgpu::RendererOptions::PREDICTABLE,

@@ -248,6 +248,8 @@ fn the_image_slice_follows_phi_d() {
         .settings
         .phi_d_deg;
     assert_eq!(phi, 0.0);
+    // The edit is the scene's (saved with it, undone with it).
+    assert_eq!(h.state().state().plots.slice.phi_d_deg, 0.0);
     let b = slice(&h);
     assert_ne!(a.values, b.values);
     let below = b.values.iter().filter(|v| v.is_none()).count();

@@ -64,6 +64,10 @@ fn rich_state() -> AppState {
     s.display.wireframe = true;
     s.plots.axis = CartesianAxis::ThetaH;
     s.plots.fixed_theta_d_deg = 12.5;
+    s.plots.slice.phi_d_deg = 33.5;
+    s.plots.slice.exposure_ev = -4.5;
+    s.plots.slice.gamma = 3.25;
+    s.plots.slice.sqrt_theta_h = true;
     s.maximised = Some("polar".into());
     s.theme = Theme::Light;
     s.sanitised()
@@ -132,6 +136,14 @@ fn corrupt_files_are_refused_with_a_clear_error() {
     assert!(e.contains("brdfs[0]") && e.contains("lamberd"), "{e}");
     let e = err_of(&good.replace("alpha_x = 0.15", "alpha_x = -3.0"));
     assert!(e.contains("brdfs[1]") && e.contains("alpha_x"), "{e}");
+    // The image slice's display (saved since LECTURE.md N1).
+    let e = err_of(&good.replace("gamma = 3.25", "gamma = 0.0"));
+    assert!(
+        e.contains("plots.slice.gamma") && e.contains("1..=4"),
+        "{e}"
+    );
+    let e = err_of(&good.replace("phi_d_deg = 33.5", "phi_d_deg = nan"));
+    assert!(e.contains("plots.slice.phi_d_deg"), "{e}");
     // A colour byte out of range.
     let e = err_of(&good.replace("color = [1, 2, 3]", "color = [1, 2, 300]"));
     assert!(e.contains("300") || e.contains("u8"), "{e}");

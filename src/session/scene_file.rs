@@ -48,7 +48,8 @@
 use super::command::MAX_NAME_CHARS;
 use super::model_names::{portable_in, resolve_in};
 use super::state::{
-    AppState, BrdfEntry, Camera, Display, Incident, MAX_BRDFS, STATE_VERSION, SnellSettings,
+    AppState, BrdfEntry, Camera, Display, Incident, MAX_BRDFS, STATE_VERSION, SliceSettings,
+    SnellSettings,
 };
 use bv_core::error::quote;
 use bv_core::fsio;
@@ -546,6 +547,35 @@ fn validate(s: &AppState, warnings: &mut Vec<String>) -> Result<(), SceneError> 
         89.5,
         "°",
     )?;
+    let slice = &s.plots.slice;
+    for (key, v, (lo, hi), unit) in [
+        (
+            "plots.slice.phi_d_deg",
+            slice.phi_d_deg,
+            SliceSettings::PHI_D_RANGE,
+            "°",
+        ),
+        (
+            "plots.slice.exposure_ev",
+            slice.exposure_ev,
+            SliceSettings::EV_RANGE,
+            " EV",
+        ),
+        (
+            "plots.slice.gamma",
+            slice.gamma,
+            SliceSettings::GAMMA_RANGE,
+            "",
+        ),
+        (
+            "plots.slice.residual_range",
+            slice.residual_range,
+            SliceSettings::RESIDUAL_RANGE,
+            "",
+        ),
+    ] {
+        range(key, v, lo, hi, unit)?;
+    }
     if let Some(v) = &s.maximised
         && super::views::info(v).is_none()
     {

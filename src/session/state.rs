@@ -324,6 +324,63 @@ pub struct PlotSettings {
     /// in its own panel, on its own scale, instead of all of them overlaid
     /// on the largest one's.
     pub small_multiples: bool,
+    /// The image slice view's display (LECTURE.md N1: the slice's φd and
+    /// exposure kept in the scene, so that a slide shows the band it means
+    /// rather than one clipped to white).
+    pub slice: SliceSettings,
+}
+
+/// The image slice view's display settings: saved with the scene.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SliceSettings {
+    /// The fixed difference azimuth φd, degrees (0–180).
+    pub phi_d_deg: f64,
+    /// θh on a √θh axis (as the MERL table's cells) instead of linear.
+    pub sqrt_theta_h: bool,
+    /// Exposure: `f` is multiplied by `2^ev` before the gamma.
+    pub exposure_ev: f64,
+    /// Display gamma: the shown level is `(2^ev f)^(1/γ)`.
+    pub gamma: f64,
+    /// Colour (RGB) or luminance (grey).
+    pub chroma: bool,
+    /// Every drawn BRDF, or only the selected one.
+    pub all: bool,
+    /// Residual mode: the relative error against `reference`.
+    pub residual: bool,
+    /// The BRDF the residuals are taken against (an id of the list); the
+    /// first drawn BRDF when it is not set or not drawn.
+    pub reference: Option<u64>,
+    /// The relative error at either end of the colour map (1 = ±100 %).
+    pub residual_range: f64,
+}
+
+impl SliceSettings {
+    /// Accepted range of φd, degrees.
+    pub const PHI_D_RANGE: (f64, f64) = (0.0, 180.0);
+    /// Accepted range of the exposure, EV.
+    pub const EV_RANGE: (f64, f64) = (-20.0, 20.0);
+    /// Accepted range of the display gamma.
+    pub const GAMMA_RANGE: (f64, f64) = (1.0, 4.0);
+    /// Accepted range of the residual colour map's end (0.01 = ±1 %,
+    /// 10 = ±1000 %).
+    pub const RESIDUAL_RANGE: (f64, f64) = (0.01, 10.0);
+}
+
+impl Default for SliceSettings {
+    fn default() -> Self {
+        Self {
+            phi_d_deg: 90.0,
+            sqrt_theta_h: false,
+            exposure_ev: 0.0,
+            gamma: 2.2,
+            chroma: true,
+            all: true,
+            residual: false,
+            reference: None,
+            residual_range: 1.0,
+        }
+    }
 }
 
 /// The albedo view's options: saved with the scene, so that a deck's slide
@@ -354,6 +411,7 @@ impl Default for PlotSettings {
             gonio: false,
             gonio_surface: false,
             small_multiples: false,
+            slice: SliceSettings::default(),
         }
     }
 }

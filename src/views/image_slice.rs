@@ -41,45 +41,9 @@ pub const DRAG_RESOLUTION: usize = 128;
 /// Smallest image side (points) worth drawing with its axes.
 const MIN_TILE: f32 = 56.0;
 
-/// Display settings of the view.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SliceSettings {
-    /// The fixed difference azimuth φd, degrees (0–180).
-    pub phi_d_deg: f64,
-    /// θh on a √θh axis (as the MERL table's cells) instead of linear.
-    pub sqrt_theta_h: bool,
-    /// Exposure: `f` is multiplied by `2^ev` before the gamma.
-    pub exposure_ev: f64,
-    /// Display gamma: the shown level is `(2^ev f)^(1/γ)`.
-    pub gamma: f64,
-    /// Colour (RGB) or luminance (grey).
-    pub chroma: bool,
-    /// Every drawn BRDF, or only the selected one.
-    pub all: bool,
-    /// Residual mode: the relative error against `reference`.
-    pub residual: bool,
-    /// The BRDF the residuals are taken against (an id of the list); the
-    /// first drawn BRDF when it is not set or not drawn.
-    pub reference: Option<u64>,
-    /// The relative error at either end of the colour map (1 = ±100 %).
-    pub residual_range: f64,
-}
-
-impl Default for SliceSettings {
-    fn default() -> Self {
-        Self {
-            phi_d_deg: 90.0,
-            sqrt_theta_h: false,
-            exposure_ev: 0.0,
-            gamma: 2.2,
-            chroma: true,
-            all: true,
-            residual: false,
-            reference: None,
-            residual_range: 1.0,
-        }
-    }
-}
+/// Display settings of the view: the scene's (`plots.slice`), so that a
+/// slide keeps its φd and exposure.
+pub use crate::session::state::SliceSettings;
 
 /// The colour of one pixel under the display settings.
 pub fn display_color(
@@ -182,8 +146,13 @@ pub struct SliceReadout {
 /// The image slice view.
 #[derive(Default)]
 pub struct ImageSliceView {
-    /// Display settings.
+    /// Display settings: the scene's `plots.slice` as last seen, with the
+    /// toolbar's edits (sent back to the scene as a command).
     pub settings: SliceSettings,
+    /// The scene's `plots.slice` when `settings` was last taken from it:
+    /// a change of the scene (a slide, a loaded file, undo) replaces the
+    /// view's settings, and only then.
+    synced: Option<SliceSettings>,
     cache: HashMap<u64, Cached>,
     rebuilds: u64,
     /// The values under the pointer in the last frame.
@@ -242,9 +211,19 @@ impl ImageSliceView {
         Some(slice::relative_error(&a.data, &r.data))
     }
 
+    /// Takes the scene's slice settings when they changed since last seen.
+    fn sync(&mut self, scene: &Scene<'_>) {
+        let saved = scene.state.plots.slice;
+        if self.synced != Some(saved) {
+            self.settings = saved;
+            self.synced = Some(saved);
+        }
+    }
+
     /// Brings the cached slices up to date (at most one evaluation per BRDF)
     /// and drops those of BRDFs no longer shown.
     pub fn update(&mut self, scene: &Scene<'_>) {
+        self.sync(scene);
         let resolution = if scene.interacting {
             DRAG_RESOLUTION
         } else {
@@ -411,8 +390,9 @@ fn tiles(area: Rect, n: usize) -> Vec<Rect> {
         .collect()
 }
 
-impl View for ImageSliceView {
-    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+impl ImageSliceView {
+    /// The toolbar's widgets, editing `self.settings`.
+    fn toolbar_widgets(&mut self, ui: &mut Ui, scene: &Scene<'_>) {
         let s = &mut self.settings;
         ui.spacing_mut().slider_width = 90.0;
         let row = crate::widgets::params_ui::slider_row(
@@ -532,8 +512,23 @@ impl View for ImageSliceView {
             s.residual_range = pct / 100.0;
         }
     }
+}
+
+impl View for ImageSliceView {
+    fn toolbar(&mut self, ui: &mut Ui, scene: &Scene<'_>, out: &mut Vec<Command>) {
+        self.sync(scene);
+        let before = self.settings;
+        self.toolbar_widgets(ui, scene);
+        if self.settings != before {
+            out.push(Command::SetPlots(crate::session::state::PlotSettings {
+                slice: self.settings,
+                ..scene.state.plots
+            }));
+        }
+    }
 
     fn ui(&mut self, ui: &mut Ui, scene: &Scene<'_>, _out: &mut Vec<Command>) {
+        self.sync(scene);
         let readout_h = if scene.figure { 0.0 } else { 22.0 };
         let reference = self.reference(scene).cloned();
         self.reference_id = reference.as_ref().map(|r| r.id);
