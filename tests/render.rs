@@ -473,3 +473,60 @@ fn lobe_meshes_for_blender() {
     assert!(text.starts_with("ply\nformat ascii 1.0\n"));
     assert!(text.contains("property uchar red"));
 }
+
+/// The terms view's SVG carries the v-groove strip when the scene shows it
+/// (`plots.terms.vgroove`): three panels, each with the lit and seen parts
+/// and G of Torrance & Sparrow's groove, written here from their closed
+/// forms (the light at 80°: towards the normal the partner facet lets
+/// 2 cos 80° of each facet be lit; towards the light, 2 cos² 80°).
+#[test]
+fn terms_svg_draws_the_v_groove_strip() {
+    let dir = out_dir("svg-vgroove");
+    let scene = dir.join("grooves.toml");
+    std::fs::write(
+        &scene,
+        "format = \"bv-scene\"\nversion = 1\nselected = 1\nmaximised = \"terms\"\n\
+         incident = { theta_deg = 80.0, phi_deg = 0.0 }\n\
+         plots = { terms = { d = false, g1 = false, f = false, vgroove = true } }\n\
+         [[brdfs]]\nid = 1\ncolor = [200, 80, 80]\nvisible = true\nname = \"v-groove\"\n\
+         spec = { model = \"cook-torrance\", params = { geometry = \"v-groove\" } }\n",
+    )
+    .unwrap();
+    let p = dir.join("terms.svg");
+    run(&[
+        "render",
+        "--scene",
+        &scene.to_string_lossy(),
+        "--view",
+        "terms",
+        "--width",
+        "1200",
+        "--height",
+        "800",
+        "--out",
+        &p.to_string_lossy(),
+    ]);
+    let text = std::fs::read_to_string(&p).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let texts: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("text"))
+        .filter_map(|n| n.text())
+        .collect();
+    let c = 80f64.to_radians().cos();
+    for (title, lit, seen) in [
+        ("θo = +80° (ωr)", 1.0, 1.0),
+        ("θo = 0° (n)", 2.0 * c, 1.0),
+        ("θo = -80° (towards the light)", 2.0 * c * c, 2.0 * c * c),
+    ] {
+        assert!(texts.contains(&title), "{title} not in {texts:?}");
+        let foot = format!(
+            "lit {lit:.2} · seen {seen:.2} · G = {:.2}",
+            f64::min(lit, seen)
+        );
+        assert!(texts.contains(&foot.as_str()), "{foot} not in {texts:?}");
+    }
+    // The grooves are drawn clipped, and the G2 chart is still there.
+    assert!(doc.descendants().any(|n| n.has_tag_name("clipPath")));
+    assert!(texts.iter().any(|t| t.contains("G2")), "{texts:?}");
+}

@@ -332,6 +332,8 @@ impl Chart {
                 );
             }
         }
+        let mut note_w: f32 = 0.0;
+        let mut note_h = 0.0;
         if !self.note.is_empty() {
             for (k, line) in self.note.lines().enumerate() {
                 svg.text(
@@ -343,10 +345,38 @@ impl Chart {
                     Baseline::Top,
                     None,
                 );
+                note_w = note_w.max(text_width(line, font));
+                note_h = 8.0 + (k + 1) as f32 * (font + 4.0);
             }
         }
-        legend(svg, &self.series, [pmin[0] + psize[0], pmin[1]], pal);
+        // The legend sits in the top-right corner, or under the note where
+        // the two would overlap.
+        let top = if note_w + legend_width(&self.series) + 24.0 > psize[0] {
+            pmin[1] + note_h
+        } else {
+            pmin[1]
+        };
+        legend(svg, &self.series, [pmin[0] + psize[0], top], pal);
     }
+}
+
+/// An estimate of a line's width in points (no font metrics here): 0.58 em
+/// per character.
+fn text_width(text: &str, font: f32) -> f32 {
+    text.chars().count() as f32 * font * 0.58
+}
+
+/// The legend's font size.
+const LEGEND_FONT: f32 = 11.5;
+
+/// The width of [`legend`]'s box for `series` (0 without a labelled one).
+fn legend_width(series: &[Series]) -> f32 {
+    let text_w = series
+        .iter()
+        .filter(|s| !s.label.is_empty())
+        .map(|s| text_width(&s.label, LEGEND_FONT))
+        .fold(None, |m: Option<f32>, w| Some(m.map_or(w, |m| m.max(w))));
+    text_w.map_or(0.0, |w| w + 46.0)
 }
 
 /// The legend box in the top-right corner at `corner` (the plot's top right).
@@ -355,14 +385,9 @@ pub fn legend(svg: &mut Svg, series: &[Series], corner: [f32; 2], pal: Palette) 
     if items.is_empty() {
         return;
     }
-    let font = 11.5;
+    let font = LEGEND_FONT;
     let row = 16.0;
-    // An estimate of the text width (no font metrics here): 0.58 em per char.
-    let text_w = items
-        .iter()
-        .map(|s| s.label.chars().count() as f32 * font * 0.58)
-        .fold(0.0, f32::max);
-    let box_w = text_w + 40.0;
+    let box_w = legend_width(series) - 6.0;
     let box_h = items.len() as f32 * row + 8.0;
     let min = [corner[0] - box_w - 6.0, corner[1] + 6.0];
     let fill = pal

@@ -35,6 +35,7 @@ pub mod sh_overlay;
 pub mod snell;
 pub mod svg;
 pub mod terms;
+pub mod vgroove;
 
 use crate::session::command::Command;
 pub use crate::session::frame::{Scene, SceneBrdf};

@@ -28,19 +28,20 @@ use super::BrdfColor as _;
 use super::chart::{self, Chart, Marker, Palette, Series};
 use super::curves;
 use super::svg::Svg;
+use super::vgroove;
 use super::{Scene, View};
 use crate::derive::slices;
 use crate::session::command::Command;
 use crate::session::state::PlotSettings;
 use bv_core::frame;
-use bv_core::microfacet::{VGrooveSection, v_groove_section};
-use eframe::egui::{self, Color32, RichText, Ui};
+use eframe::egui::{self, RichText, Ui};
 use egui_plot::{Corner, Line, LineStyle, Plot, PlotPoints, VLine};
 use std::f64::consts::FRAC_PI_2;
 
 /// Samples over 0..90° (D, F); twice as many over −90..90° (G).
 const SAMPLES: usize = 360;
 
+pub use super::vgroove::{VGroovePanel, vgroove_sections};
 /// Which terms are drawn: the scene's (`plots.terms`), so that a slide can
 /// show D alone or G2 alone.
 pub use crate::session::state::TermToggles;
@@ -430,227 +431,17 @@ pub fn plot_chart(
     }
 }
 
-/// One panel of the v-groove strip: the outgoing direction's signed θo
-/// (the charts' convention: + on the mirror side), its name, and the
-/// section there.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VGroovePanel {
-    /// The light's θi, degrees.
-    pub theta_i_deg: f64,
-    /// Signed θo, degrees.
-    pub theta_o_deg: f64,
-    /// "ωr", "n" or "towards the light".
-    pub name: &'static str,
-    /// The grooves, or `None` where there is none (light at the horizon).
-    pub section: Option<VGrooveSection>,
-}
-
-/// The strip's panels for the scene's light: θo = +θi (the mirror
-/// direction), 0 and −θi (back towards the light); one panel at normal
-/// incidence.
-pub fn vgroove_sections(scene: &Scene<'_>) -> Vec<VGroovePanel> {
-    let theta_i = scene.incident.theta_deg;
-    let phi_i = scene.incident.phi_deg.to_radians();
-    let wi = scene.wi();
-    // The plane's horizontal direction towards the light.
-    let u = glam::DVec3::new(phi_i.cos(), phi_i.sin(), 0.0);
-    let mut out: Vec<VGroovePanel> = Vec::new();
-    for (t, name) in [(theta_i, "ωr"), (0.0, "n"), (-theta_i, "towards the light")] {
-        if out.iter().any(|p| (p.theta_o_deg - t).abs() < 1e-9) {
-            continue;
-        }
-        let wo = slices::plane_direction(t.to_radians(), phi_i);
-        out.push(VGroovePanel {
-            theta_i_deg: theta_i,
-            theta_o_deg: t,
-            name,
-            section: v_groove_section(wi, wo, u),
-        });
-    }
-    out
-}
-
-/// Draws the v-groove panels side by side in `rect`.
-fn paint_vgrooves(painter: &egui::Painter, rect: egui::Rect, panels: &[VGroovePanel], dark: bool) {
-    let text = super::strong_text_color(dark);
-    let n = panels.len().max(1) as f32;
-    let w = rect.width() / n;
-    for (k, p) in panels.iter().enumerate() {
-        let r = egui::Rect::from_min_size(
-            egui::pos2(rect.left() + k as f32 * w, rect.top()),
-            egui::vec2(w, rect.height()),
-        )
-        .shrink(6.0);
-        paint_vgroove(painter, r, p, dark, text);
-    }
-}
-
-/// The light's and the viewer's colours in the v-groove panels.
-const LIGHT: Color32 = Color32::from_rgb(250, 200, 60);
-const VIEW: Color32 = Color32::from_rgb(90, 170, 255);
-
-/// One v-groove panel in `r`. Screen x runs as the charts' θo: the light on
-/// the left (at −θi), the mirror direction on the right; a direction at
-/// signed angle θ is `(sin θ, cos θ)`, and the facets' normal, the half
-/// vector, is at `−tilt`.
-fn paint_vgroove(
-    painter: &egui::Painter,
-    r: egui::Rect,
-    p: &VGroovePanel,
-    dark: bool,
-    text: Color32,
-) {
-    let font = egui::FontId::proportional(13.0);
-    let sign = if p.theta_o_deg > 0.0 { "+" } else { "" };
-    let title = format!("θo = {sign}{:.0}° ({})", p.theta_o_deg, p.name);
-    let head = painter.text(
-        r.center_top(),
-        egui::Align2::CENTER_TOP,
-        title,
-        font.clone(),
-        text,
-    );
-    let Some(s) = p.section else {
-        painter.text(
-            r.center(),
-            egui::Align2::CENTER_CENTER,
-            "no groove",
-            font,
-            text,
-        );
-        return;
-    };
-    let foot_text = format!("lit {:.2} · seen {:.2} · G = {:.2}", s.lit, s.seen, s.g);
-    let foot = painter.text(
-        r.center_bottom(),
-        egui::Align2::CENTER_BOTTOM,
-        foot_text,
-        font,
-        text,
-    );
-    let fig = egui::Rect::from_x_y_ranges(r.x_range(), head.bottom() + 4.0..=foot.top() - 4.0);
-    if fig.height() < 20.0 || fig.width() < 40.0 {
-        return;
-    }
-    // Two grooves of half-width 1 and depth t = tan|tilt|, with room above
-    // for the rays. A deep groove (a low light) is cut below what matters,
-    // 2.5 times the deeper of the lit and seen parts, at least one unit: its
-    // rims, where the light and the view reach, stay large enough to read.
-    let t = s.tilt.abs().min(89f64.to_radians()).tan() as f32;
-    let reach = s.lit.max(s.seen) as f32 * t;
-    let depth = t.min((2.5 * reach).max(1.0));
-    let scale = (fig.width() / 4.8).min(fig.height() / (depth + 1.3));
-    let origin = egui::pos2(fig.center().x, fig.top() + 1.2 * scale);
-    let at = |(x, z): (f32, f32)| egui::pos2(origin.x + x * scale, origin.y - z * scale);
-    let cut = depth < t;
-    let unclipped = painter;
-    let painter = &painter.with_clip_rect(egui::Rect::from_x_y_ranges(
-        fig.x_range(),
-        fig.top()..=at((0.0, -depth - 0.12)).y,
-    ));
-    let profile = [(-2.0, 0.0), (-1.0, -t), (0.0, 0.0), (1.0, -t), (2.0, 0.0)];
-    let material = if dark {
-        Color32::from_gray(70)
+/// The height of the v-groove strip under `charts` charts in a view
+/// `height` high: all of it without a chart, otherwise a share (more beside
+/// one chart: the grooves towards a low light are deep).
+fn strip_height(on: bool, charts: usize, height: f32) -> f32 {
+    if !on {
+        0.0
+    } else if charts == 0 {
+        height
     } else {
-        Color32::from_gray(190)
-    };
-    // The material under the profile, one quad per facet.
-    let bottom = -t - 0.15;
-    // (The clip above cuts a deep groove's material and facets.)
-    for w2 in profile.windows(2) {
-        let (a, b) = (w2[0], w2[1]);
-        let quad = vec![at(a), at(b), at((b.0, bottom)), at((a.0, bottom))];
-        painter.add(egui::Shape::convex_polygon(
-            quad,
-            material,
-            egui::Stroke::NONE,
-        ));
-    }
-    painter.add(egui::Shape::line(
-        profile.iter().map(|&q| at(q)).collect(),
-        egui::Stroke::new(1.5, text.gamma_multiply(0.6)),
-    ));
-    if cut {
-        // The groove goes on below the cut, to depth t.
-        let y = at((0.0, -depth - 0.12)).y - 1.0;
-        painter.add(egui::Shape::dashed_line(
-            &[
-                egui::pos2(at((-2.0, 0.0)).x, y),
-                egui::pos2(at((2.0, 0.0)).x, y),
-            ],
-            egui::Stroke::new(1.5, text),
-            6.0,
-            5.0,
-        ));
-        unclipped.text(
-            egui::pos2(at((-2.0, 0.0)).x - 6.0, y),
-            egui::Align2::RIGHT_CENTER,
-            format!("{:.1}× deeper", t / depth),
-            egui::FontId::proportional(11.0),
-            text,
-        );
-    }
-    // The reflecting facets (rim, foot): with the light on the left, a
-    // tilt towards it (> 0) is the facets that rise to the right.
-    let facets: [((f32, f32), (f32, f32)); 2] = if s.tilt >= 0.0 {
-        [((0.0, 0.0), (-1.0, -t)), ((2.0, 0.0), (1.0, -t))]
-    } else {
-        [((-2.0, 0.0), (-1.0, -t)), ((0.0, 0.0), (1.0, -t))]
-    };
-    let lerp =
-        |a: (f32, f32), b: (f32, f32), f: f32| (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
-    let shadow = egui::Stroke::new(4.0, text.gamma_multiply(0.35));
-    for (rim, base) in facets {
-        let lit_end = lerp(rim, base, s.lit as f32);
-        let seen_end = lerp(rim, base, s.seen as f32);
-        painter.line_segment([at(lit_end), at(base)], shadow);
-        painter.line_segment([at(rim), at(lit_end)], egui::Stroke::new(4.0, LIGHT));
-        // The seen part: a blue band just above the facet.
-        let d = at(base) - at(rim);
-        let mut n = egui::vec2(-d.y, d.x).normalized();
-        if n.y > 0.0 {
-            n = -n;
-        }
-        let off = n * 5.0;
-        painter.line_segment(
-            [at(rim) + off, at(seen_end) + off],
-            egui::Stroke::new(2.5, VIEW),
-        );
-    }
-    // On the first groove: rays from the light onto the lit part and from
-    // the seen part to the viewer, and the limiting ray (dashed), which
-    // grazes the partner facet's rim.
-    let dir = |deg: f64| {
-        let a = deg.to_radians() as f32;
-        egui::vec2(a.sin(), -a.cos())
-    };
-    let (rim, base) = facets[0];
-    for (frac, ray, colour, incoming) in [
-        (s.lit as f32, dir(-p.theta_i_deg), LIGHT, true),
-        (s.seen as f32, dir(p.theta_o_deg), VIEW, false),
-    ] {
-        let len = 1.1 * scale;
-        for q in [0.3, 0.8] {
-            let on = at(lerp(rim, base, q * frac));
-            let away = on + ray * len;
-            if incoming {
-                painter.arrow(away, on - away, egui::Stroke::new(1.3, colour));
-            } else {
-                painter.arrow(on, away - on, egui::Stroke::new(1.3, colour));
-            }
-        }
-        if frac < 0.999 {
-            let edge = lerp(rim, base, frac);
-            // Up to the rims' height and a little beyond.
-            let reach = (-edge.1 / (-ray.y).max(0.05) + 0.5) * scale;
-            let e = at(edge);
-            painter.add(egui::Shape::dashed_line(
-                &[e, e + ray * reach],
-                egui::Stroke::new(1.2, colour),
-                5.0,
-                4.0,
-            ));
-        }
+        let share = if charts == 1 { 0.42 } else { 0.32 };
+        (share * height).max(80.0).min(height)
     }
 }
 
@@ -692,14 +483,11 @@ impl View for TermsView {
         let shown = charts.shown();
         // The v-groove strip takes the bottom of the view (half of it beside
         // one chart: the grooves towards a low light are deep).
-        let strip_h = if !scene.state.plots.terms.vgroove {
-            0.0
-        } else if shown.is_empty() {
-            ui.available_height()
-        } else {
-            let share = if shown.len() == 1 { 0.42 } else { 0.32 };
-            (share * ui.available_height()).max(80.0)
-        };
+        let strip_h = strip_height(
+            scene.state.plots.terms.vgroove,
+            shown.len(),
+            ui.available_height(),
+        );
         if shown.is_empty() && strip_h == 0.0 {
             ui.label(RichText::new("no term is switched on").weak());
         } else if !shown.is_empty() {
@@ -737,7 +525,12 @@ impl View for TermsView {
                 egui::vec2(ui.available_width(), strip_h.min(ui.available_height())),
                 egui::Sense::hover(),
             );
-            paint_vgrooves(&ui.painter_at(r), r, &vgroove_sections(scene), dark);
+            vgroove::paint_vgrooves(
+                &mut vgroove::PainterCanvas::new(ui.painter_at(r)),
+                r,
+                &vgroove_sections(scene),
+                dark,
+            );
         }
         self.last = Some(charts);
     }
@@ -755,11 +548,17 @@ impl View for TermsView {
             svg.rect([0.0, 0.0], [w, h], Some(bg), None);
         }
         let shown = charts.shown();
-        let panel_h = h / shown.len().max(1) as f32;
+        // The v-groove strip at the bottom, as in the window.
+        let strip_h = strip_height(scene.state.plots.terms.vgroove, shown.len(), h);
+        let panel_h = (h - strip_h) / shown.len().max(1) as f32;
         for (k, c) in shown.iter().enumerate() {
             svg.begin_translate([0.0, k as f32 * panel_h]);
             c.draw(&mut svg, [w, panel_h], pal);
             svg.end_group();
+        }
+        if strip_h > 0.0 {
+            let r = egui::Rect::from_min_size(egui::pos2(0.0, h - strip_h), egui::vec2(w, strip_h));
+            vgroove::paint_vgrooves(&mut svg, r, &vgroove_sections(scene), dark);
         }
         Some(svg.finish())
     }
