@@ -1292,3 +1292,43 @@ fn the_parameterisation_slide_shows_the_band_unclipped() {
     let (at0, at30) = (shown(&ggx, row, 0).r(), shown(&ggx, row, col30).r());
     assert!(f64::from(at0) > 1.5 * f64::from(at30), "{at0} vs {at30}");
 }
+
+/// LECTURE.md scene 58 (N7): lumber and cement are RGL files the lecturer
+/// supplies; without them (not shipped) models stand in, named as such,
+/// and the caption says so. The lumber's stand-in is anisotropic: the
+/// same pair of directions turned 90° about the normal reflects ≥ 3× less
+/// near its highlight (Ward's αx 0.05 against αy 0.3).
+#[test]
+fn lumber_and_cement_are_measured_or_named_stand_ins() {
+    let slides = slides();
+    let s = slide(&slides, "BRDF illustrations: lumber and cement");
+    let dir = manifest().join("assets/decks");
+    let names: Vec<&str> = s
+        .state
+        .brdfs
+        .iter()
+        .filter_map(|b| b.name.as_deref())
+        .collect();
+    for (k, file) in ["lumber.bsdf", "cement.bsdf"].into_iter().enumerate() {
+        let shipped = dir.join(file).exists();
+        let want = if shipped { "measured" } else { "stand-in" };
+        assert!(names[k].starts_with(want), "{names:?}");
+        assert_eq!(!shipped, s.caption.contains(file), "{}", s.caption);
+    }
+    if dir.join("lumber.bsdf").exists() {
+        return;
+    }
+    let brdfs = scene_brdfs(s);
+    let wood = brdfs[0].as_ref();
+    // Directions 8° either side of the normal's highlight, along x then y.
+    let (a, b) = (8f64.to_radians(), 45f64.to_radians());
+    let wi = glam::DVec3::new(b.sin(), 0.0, b.cos());
+    let along = |u: glam::DVec3| {
+        let h = (glam::DVec3::new(0.0, 0.0, 1.0) * a.cos() + u * a.sin()).normalize();
+        let wo = 2.0 * wi.dot(h) * h - wi;
+        mean_rgb(wood.eval(wi, wo))
+    };
+    let tilt_x = along(glam::DVec3::X);
+    let tilt_y = along(glam::DVec3::Y);
+    assert!(tilt_y > 3.0 * tilt_x, "{tilt_x} vs {tilt_y}");
+}
