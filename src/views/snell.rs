@@ -245,13 +245,16 @@ fn fmt_eta(x: f64) -> String {
 }
 
 /// Where the label of an angle `a` from the upward normal goes, on the side
-/// `side` (−1 left, +1 right): on the bisector of a wide wedge, else beside
-/// the ray's end of the arc (a narrow wedge has no room inside).
+/// `side` (−1 left, +1 right): inside a wide wedge, centred between the ray
+/// and the normal at the height of the bisector 0.45 out, else beside the
+/// ray's end of the arc. A label is about 0.55 units wide at full size, so a
+/// wedge below 55° has no room for it inside: centred on the bisector there
+/// (as before), the ray ran through the label's first letters.
 fn angle_label_place(a: f64, side: f64) -> (DVec2, Align2) {
-    if a > 40f64.to_radians() {
-        let b = 0.5 * a;
+    if a > 55f64.to_radians() {
+        let y = 0.45 * (0.5 * a).cos();
         (
-            DVec2::new(side * 0.45 * b.sin(), 0.45 * b.cos()),
+            DVec2::new(side * 0.5 * y * a.tan().min(4.0), y),
             Align2::CENTER_CENTER,
         )
     } else {
@@ -261,7 +264,7 @@ fn angle_label_place(a: f64, side: f64) -> (DVec2, Align2) {
             Align2::LEFT_CENTER
         };
         (
-            DVec2::new(side * (0.3 * a.sin() + 0.06), 0.3 * a.cos()),
+            DVec2::new(side * (0.3 * a.sin() + 0.1), 0.3 * a.cos()),
             align,
         )
     }
@@ -351,8 +354,10 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
             points: cone,
             color: c.window,
         });
+        // The label below the rays' ends (radius 1) and Brewster's mark,
+        // not across them.
         p.push(label(
-            DVec2::new(0.0, s * 0.78),
+            DVec2::new(0.0, s * 1.04),
             format!(
                 "Snell's window 2 × {:.1}° = {:.1}°",
                 lo.to_degrees(),
@@ -372,8 +377,8 @@ pub fn snell_figure(theta_i: f64, interface: &Interface, dark: bool) -> Option<S
     // The normal; on the light's side it stops short of Snell's window's
     // label when there is one.
     let (n_lo, n_hi) = match (d.tir_range.is_some(), s > 0.0) {
-        (true, true) => (y0, 0.74),
-        (true, false) => (-0.74, y1),
+        (true, true) => (y0, 1.02),
+        (true, false) => (-1.02, y1),
         (false, _) => (y0, y1),
     };
     p.push(Prim::Line {
@@ -846,13 +851,21 @@ impl View for SnellView {
             // column to its right; a little of the width left over goes to
             // its left, where its full-size labels reach past its edge.
             let s = rect.height() / (2.0 * EXTENT[1] as f32);
-            let w = (2.0 * EXTENT[0] as f32 * s).min(0.7 * rect.width());
+            let w = (2.0 * EXTENT[0] as f32 * s).min(0.66 * rect.width());
             let left = rect.left() + ((rect.width() - w) / 5.0).clamp(0.0, 60.0);
             let diagram = egui::Rect::from_x_y_ranges(left..=left + w, rect.y_range());
             let column = rect
                 .with_min_x(diagram.right() + 12.0)
                 .shrink2(Vec2::new(0.0, 12.0));
             paint(&painter, diagram, &fig, 1.0, true);
+            // The column is a panel of its own: the interface line and the
+            // medium's tint, which run to the view's edge, stop at it
+            // rather than strike through its text.
+            painter.rect_filled(
+                column.expand2(Vec2::new(6.0, 12.0)),
+                0.0,
+                super::figure_fill(ui, scene),
+            );
             paint_details(&painter, column, &fig);
             diagram
         } else {
