@@ -463,7 +463,7 @@ impl PolarView {
                         .width(scene.stroke(1.0))
                         .allow_hover(false),
                 );
-                if deg % 30 == 0 {
+                if deg % 30 == 0 && tick_label_clear(deg, theta_i, &marks) {
                     // ±90° sit just above the surface line, clear of the ring values.
                     let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
                     let p = PlotPoint::new(outer * 1.09 * a.sin(), outer * 1.09 * a.cos() + lift);
@@ -1286,6 +1286,7 @@ fn polar_svg_panel(
             None,
         );
     }
+    let marks = interface_marks(scene, outer, dark);
     for deg in (-span..=span).step_by(15) {
         let a = f64::from(deg).to_radians();
         svg.line(
@@ -1295,7 +1296,7 @@ fn polar_svg_panel(
             1.0,
             None,
         );
-        if deg % 30 == 0 {
+        if deg % 30 == 0 && tick_label_clear(deg, theta_i, &marks) {
             let lift = if deg.abs() == 90 { outer * 0.05 } else { 0.0 };
             svg.text(
                 at([outer * 1.09 * a.sin(), outer * 1.09 * a.cos() + lift]),
@@ -1315,7 +1316,7 @@ fn polar_svg_panel(
         1.5,
         None,
     );
-    for m in interface_marks(scene, outer, dark) {
+    for m in marks {
         match m {
             Mark::Fill { points, color } => {
                 let p: Vec<[f32; 2]> = points.iter().map(|p| at(*p)).collect();
@@ -1465,9 +1466,57 @@ fn polar_svg_panel(
     legend(svg, &series, [w - 4.0, 4.0], pal);
 }
 
+/// Whether the angle label of spoke `deg` (signed, from the normal) is
+/// drawn: not where the light's line or the mirror direction's runs
+/// through it (within 8°), where the ωi and ωr labels say the angle, nor
+/// under one of the interface's labels outside the rings (`marks`: ωt's,
+/// Snell's window's; within 16°).
+fn tick_label_clear(deg: i32, theta_i: f64, marks: &[Mark]) -> bool {
+    let d = f64::from(deg);
+    let light = slices::incident_signed_angle(theta_i).to_degrees();
+    // (The medium's name beside the surface line leaves ±90° alone: those
+    // labels are lifted above the line.)
+    let taken = marks
+        .iter()
+        .filter_map(|m| match m {
+            Mark::Text { at, .. } if at[0].hypot(at[1]) > 0.0 => {
+                Some(at[0].atan2(at[1]).to_degrees())
+            }
+            _ => None,
+        })
+        .filter(|a| (a.abs() - 90.0).abs() > 12.0);
+    // The interface's labels are wider than ωi and ωr: 16° either side.
+    [light, theta_i.to_degrees()]
+        .into_iter()
+        .all(|a| (d - a).abs() >= 8.0)
+        && taken.into_iter().all(|a| (d - a).abs() >= 16.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spoke_labels_give_way_to_the_light_and_the_mirror() {
+        let t = 60f64.to_radians();
+        // The light on the left (−60°), the mirror direction at +60°.
+        assert!(!tick_label_clear(-60, t, &[]) && !tick_label_clear(60, t, &[]));
+        assert!(tick_label_clear(-30, t, &[]) && tick_label_clear(30, t, &[]));
+        assert!(tick_label_clear(0, t, &[]));
+        // Light from below (θi 120°): it comes from −120°, the mirror is at +120°.
+        let b = 120f64.to_radians();
+        assert!(!tick_label_clear(-120, b, &[]) && !tick_label_clear(120, b, &[]));
+        assert!(tick_label_clear(-90, b, &[]) && tick_label_clear(150, b, &[]));
+        // A label outside the rings at 153° (ωt's) takes the 150° spoke's.
+        let a = 153f64.to_radians();
+        let wt = Mark::Text {
+            at: [1.2 * a.sin(), 1.2 * a.cos()],
+            text: "ωt".into(),
+            color: Color32::WHITE,
+        };
+        assert!(!tick_label_clear(150, t, std::slice::from_ref(&wt)));
+        assert!(tick_label_clear(-150, t, &[wt]));
+    }
 
     #[test]
     fn small_multiples_fill_the_area() {

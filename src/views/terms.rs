@@ -205,7 +205,7 @@ pub fn term_charts(scene: &Scene<'_>, show: TermToggles, dark: bool) -> TermChar
         let mut c = Chart {
             x_label: "θo (°) in the plane of incidence, negative on the light's side".into(),
             y_label: match (show.g1, show.g2) {
-                (true, true) => "G1 (dashed), G2",
+                (true, true) => "G1, G2",
                 (true, false) => "G1",
                 _ => "G2",
             }
