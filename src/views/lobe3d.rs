@@ -802,23 +802,10 @@ impl Lobe3dView {
         let font = FontId::proportional(15.0);
         let at = |p: Vec3| cam.project(p).map(|s| rect.min + Vec2::new(s[0], s[1]));
         let (n_col, t_col, b_col) = axis_colors(dark);
-        for (p, label, c) in [
-            (Vec3::Z * 1.42, "n", n_col),
-            (Vec3::X * 1.42, "t", t_col),
-            (Vec3::Y * 1.42, "b", b_col),
-        ] {
-            if let Some(s) = at(p) {
-                outlined_text(
-                    &painter,
-                    s,
-                    Align2::CENTER_CENTER,
-                    label,
-                    font.clone(),
-                    c,
-                    dark,
-                );
-            }
-        }
+        // The light's and the mirror direction's labels first: the axes'
+        // labels then step aside where they would fall on one (seen along
+        // ωr, ωi's label sat on n's).
+        let mut taken: Vec<Rect> = Vec::new();
         let wi = scene.wi().as_vec3();
         if let Some(s) = at(wi * (INCIDENT_LENGTH + 0.04)) {
             let label = format!(
@@ -826,7 +813,7 @@ impl Lobe3dView {
                 scene.incident.theta_deg, scene.incident.phi_deg
             );
             let align = away_from(at(Vec3::ZERO), s);
-            outlined_text(
+            taken.push(outlined_text(
                 &painter,
                 s,
                 align,
@@ -834,12 +821,12 @@ impl Lobe3dView {
                 font.clone(),
                 super::light_color(dark),
                 dark,
-            );
+            ));
         }
         let r = bv_core::frame::reflect(scene.wi()).as_vec3();
         if let Some(s) = at(r * (MIRROR_LENGTH + 0.04)) {
             let align = away_from(at(Vec3::ZERO), s);
-            outlined_text(
+            taken.push(outlined_text(
                 &painter,
                 s,
                 align,
@@ -847,7 +834,28 @@ impl Lobe3dView {
                 font.clone(),
                 super::mirror_color(dark),
                 dark,
-            );
+            ));
+        }
+        for (p, label, c) in [
+            (Vec3::Z * 1.42, "n", n_col),
+            (Vec3::X * 1.42, "t", t_col),
+            (Vec3::Y * 1.42, "b", b_col),
+        ] {
+            if let Some(s) = at(p) {
+                let size = painter
+                    .layout_no_wrap(label.to_string(), font.clone(), c)
+                    .size();
+                let (pos, align) = clear_of(s, size, &taken, painter.clip_rect().shrink(3.0));
+                taken.push(outlined_text(
+                    &painter,
+                    pos,
+                    align,
+                    label,
+                    font.clone(),
+                    c,
+                    dark,
+                ));
+            }
         }
 
         let d = scene.state.display;
@@ -1060,18 +1068,17 @@ fn outlined_text(
     font: FontId,
     color: Color32,
     dark: bool,
-) {
+) -> Rect {
     let halo = if dark {
         Color32::from_rgba_unmultiplied(0, 0, 0, 160)
     } else {
         Color32::from_rgba_unmultiplied(255, 255, 255, 200)
     };
     let galley = painter.layout_no_wrap(text.to_string(), font.clone(), color);
-    let mut r = align.anchor_size(pos, galley.size());
-    let bounds = painter.clip_rect().shrink(3.0);
-    let dx = (bounds.min.x - r.min.x).max(0.0) + (bounds.max.x - r.max.x).min(0.0);
-    let dy = (bounds.min.y - r.min.y).max(0.0) + (bounds.max.y - r.max.y).min(0.0);
-    r = r.translate(Vec2::new(dx, dy));
+    let r = inside(
+        align.anchor_size(pos, galley.size()),
+        painter.clip_rect().shrink(3.0),
+    );
     for o in [
         Vec2::new(-1.0, 0.0),
         Vec2::new(1.0, 0.0),
@@ -1081,6 +1088,49 @@ fn outlined_text(
         painter.text(r.min + o, Align2::LEFT_TOP, text, font.clone(), halo);
     }
     painter.galley(r.min, galley, color);
+    r
+}
+
+/// `r` moved the least that puts it inside `bounds` (a label near the
+/// view's edge stays whole).
+fn inside(r: Rect, bounds: Rect) -> Rect {
+    let dx = (bounds.min.x - r.min.x).max(0.0) + (bounds.max.x - r.max.x).min(0.0);
+    let dy = (bounds.min.y - r.min.y).max(0.0) + (bounds.max.y - r.max.y).min(0.0);
+    r.translate(Vec2::new(dx, dy))
+}
+
+/// Where a label of `size` centred on `p` goes so that it covers none of
+/// the labels already drawn (`taken`) once [`outlined_text`] has moved it
+/// inside `bounds`: centred on `p` when that is clear, else the nearest
+/// clear place beside it (right, left, below, above, a step further out
+/// each round), else centred on `p` after all.
+fn clear_of(p: Pos2, size: Vec2, taken: &[Rect], bounds: Rect) -> (Pos2, Align2) {
+    let gap = 6.0;
+    let clear = |at: Pos2, align: Align2| {
+        let r = inside(align.anchor_size(at, size), bounds).expand(1.0);
+        !taken.iter().any(|t| t.intersects(r))
+    };
+    if clear(p, Align2::CENTER_CENTER) {
+        return (p, Align2::CENTER_CENTER);
+    }
+    for k in 0..6 {
+        let k = k as f32;
+        let (dx, dy) = (
+            size.x * 0.5 + gap + k * size.x,
+            size.y * 0.5 + gap + k * size.y,
+        );
+        for (at, align) in [
+            (p + Vec2::new(dx, 0.0), Align2::LEFT_CENTER),
+            (p - Vec2::new(dx, 0.0), Align2::RIGHT_CENTER),
+            (p + Vec2::new(0.0, dy), Align2::CENTER_TOP),
+            (p - Vec2::new(0.0, dy), Align2::CENTER_BOTTOM),
+        ] {
+            if clear(at, align) {
+                return (at, align);
+            }
+        }
+    }
+    (p, Align2::CENTER_CENTER)
 }
 
 /// Anchors a label on the side of `p` away from `origin`, so it does not
@@ -1096,6 +1146,30 @@ fn away_from(origin: Option<Pos2>, p: Pos2) -> Align2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn axis_labels_step_aside_from_drawn_labels() {
+        let size = Vec2::new(10.0, 16.0);
+        let p = Pos2::new(100.0, 100.0);
+        // Clear: centred on its point.
+        let view = Rect::from_min_size(Pos2::ZERO, Vec2::splat(1000.0));
+        assert_eq!(clear_of(p, size, &[], view), (p, Align2::CENTER_CENTER));
+        // On ωi's label: beside it, not covering it.
+        let wi = Rect::from_center_size(p, Vec2::new(120.0, 18.0));
+        let (at, align) = clear_of(p, size, &[wi], view);
+        let r = align.anchor_size(at, size);
+        assert!(!r.intersects(wi), "{r:?}");
+        // Off the top, where the label is moved down inside the view onto
+        // ωi's label (at the view's top edge): placed clear of it there.
+        let top = Pos2::new(100.0, -30.0);
+        let wi = Rect::from_min_size(Pos2::new(40.0, 0.0), Vec2::new(120.0, 18.0));
+        let (at, align) = clear_of(top, size, &[wi], view);
+        let r = inside(align.anchor_size(at, size), view);
+        assert!(!r.intersects(wi), "{r:?}");
+        // Boxed in on every side: centred (drawn where it belongs).
+        let wall = Rect::from_center_size(p, Vec2::splat(400.0));
+        assert_eq!(clear_of(p, size, &[wall], view), (p, Align2::CENTER_CENTER));
+    }
 
     #[test]
     fn ground_disc_is_a_fan() {
