@@ -73,16 +73,58 @@ fn write_synthetic_table() -> String {
     path.to_string_lossy().into_owned()
 }
 
+/// An RGL material of a real file's size (8 θi, 128-node NDF, 32² value
+/// squares as the database's isotropic RGB files): a GGX Cook-Torrance
+/// written by `bv tabulate --format rgl`'s writer.
+fn synthetic_rgl() -> String {
+    static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    PATH.get_or_init(|| {
+        use bv_core::measured::rgl_write::{RglWriteOptions, tabulate_rgl};
+        let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
+        let path = dir.join("bv-bench-ggx.bsdf");
+        let tmp = dir.join(format!("bv-bench-ggx.bsdf.{}", std::process::id()));
+        let opts = RglWriteOptions {
+            theta_i: 8,
+            values: 32,
+            ..RglWriteOptions::default()
+        };
+        let written = ModelSpec::from_json(
+            "cook-torrance",
+            &serde_json::json!({"distribution": "ggx", "alpha": 0.3}),
+        )
+        .and_then(|s| s.build())
+        .and_then(|b| tabulate_rgl(b.as_ref(), &opts));
+        match written {
+            Ok(bytes) => {
+                if let Err(e) =
+                    std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path))
+                {
+                    eprintln!("cannot write {}: {e}", path.display());
+                }
+            }
+            Err(e) => eprintln!("cannot tabulate the RGL bench file: {e}"),
+        }
+        path.to_string_lossy().into_owned()
+    })
+    .clone()
+}
+
 /// Every model of the catalogue with its defaults (a measured model whose
-/// defaults name no file reads a synthetic table), plus Cook-Torrance with GGX.
+/// defaults name no file reads a synthetic file of its format: a MERL
+/// table, an RGL material), plus Cook-Torrance with GGX.
 fn models() -> Vec<(String, &'static ModelInfo, Box<dyn Brdf>)> {
     let mut out = Vec::new();
     for &m in catalogue().iter() {
         let built = ModelSpec::new(m.id).and_then(|mut s| {
             if !analytic(m) {
                 for d in m.params {
-                    if matches!(d.kind, ParamKind::Path { .. }) {
-                        s.set_json(d.id, &serde_json::Value::String(synthetic_table()))?;
+                    if let ParamKind::Path { format, .. } = d.kind {
+                        let file = if format.extensions().contains(&"bsdf") {
+                            synthetic_rgl()
+                        } else {
+                            synthetic_table()
+                        };
+                        s.set_json(d.id, &serde_json::Value::String(file))?;
                     }
                 }
             }
