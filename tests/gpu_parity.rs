@@ -26,6 +26,9 @@
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+#[path = "support/rgl_files.rs"]
+mod rgl_files;
+
 use bv::gpu::{GpuEvaluator, gpu_for_test, shaders::ShaderLibrary};
 use bv_core::measured::merl;
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
@@ -694,53 +697,6 @@ const RGL_ABS_TOL: f64 = 1e-4;
 /// left 8 of them over (worst 1.8 tolerances), 1e-3 none (worst 0.97).
 const RGL_ANGLE_SLACK: f64 = 1e-3;
 
-/// A hand-built RGL file of random positive tables (the construction of
-/// `random_file` in `crates/bv-core/tests/rgl.rs`): `nphi` incident azimuths
-/// from −π spanning `span` (anisotropic above 2: folded by a half turn for
-/// span π, a quarter turn for π/2), 4 θi, NDF and σ varying with φ, the VNDF
-/// zero where the normal faces away from the slice's wi, the Jacobian on.
-fn random_rgl_file(seed: u64, nphi: usize, span: f64) -> Vec<u8> {
-    use bv_core::measured::tensor::TensorWriter;
-    let mut g = rng(seed);
-    let mut r = |n: usize, lo: f32, hi: f32| -> Vec<f32> {
-        (0..n)
-            .map(|_| lo + (hi - lo) * uniform2(&mut g).x as f32)
-            .collect()
-    };
-    let phi: Vec<f32> = if nphi == 1 {
-        vec![0.0]
-    } else {
-        (0..nphi)
-            .map(|k| (-PI + span * k as f64 / (nphi - 1) as f64) as f32)
-            .collect()
-    };
-    let theta: Vec<f32> = (0..4).map(|k| 1.4 * k as f32 / 3.0).collect();
-    let sph = |t: f64, p: f64| DVec3::new(t.sin() * p.cos(), t.sin() * p.sin(), t.cos());
-    let mut vndf = r(nphi * 4 * 192, 0.1, 2.0);
-    for (k, v) in vndf.iter_mut().enumerate() {
-        let (x, y) = (k % 16, (k / 16) % 12);
-        let (t, pi) = ((k / 192) % 4, k / 768);
-        let phi_i = if nphi <= 2 { 0.0 } else { f64::from(phi[pi]) };
-        let wi = sph(f64::from(theta[t]), phi_i);
-        let u = x as f64 / 15.0;
-        let tm = u * u * PI / 2.0;
-        let m = sph(tm, (2.0 * y as f64 / 11.0 - 1.0) * PI);
-        *v *= (wi.dot(m).max(0.0) * u * tm.sin()) as f32;
-    }
-    let p = nphi as u64;
-    let mut w = TensorWriter::new();
-    w.u8("description", &[6], b"random")
-        .f32("theta_i", &[4], &theta)
-        .f32("phi_i", &[p], &phi)
-        .f32("ndf", &[8, 16], &r(128, 0.2, 2.0))
-        .f32("sigma", &[8, 16], &r(128, 0.5, 1.5))
-        .f32("vndf", &[p, 4, 12, 16], &vndf)
-        .f32("luminance", &[p, 4, 8, 8], &r(nphi * 4 * 64, 0.1, 2.0))
-        .f32("rgb", &[p, 4, 3, 8, 8], &r(nphi * 4 * 192, 0.0, 1.0))
-        .u8("jacobian", &[1], &[1]);
-    w.to_bytes()
-}
-
 /// The RGL files the port is held to: analytic models tabulated by
 /// `tabulate_rgl` (isotropic, one φi), and hand-built random files with 9 φi
 /// over a full turn, 5 over a half and a quarter turn (folded), and 2 φi
@@ -786,7 +742,7 @@ fn rgl_parity_files() -> Vec<(String, Vec<u8>)> {
     for (seed, nphi, span) in [(3, 9, 2.0 * PI), (1, 5, PI / 2.0), (2, 5, PI), (4, 2, PI)] {
         out.push((
             format!("random, {nphi} φi over {:.0}°", span.to_degrees()),
-            random_rgl_file(seed, nphi, span),
+            rgl_files::random_rgl_file(seed, nphi, span),
         ));
     }
     out
