@@ -129,11 +129,20 @@ fn every_model_converges_to_its_reflected_radiance() {
     let rgl_dir = std::env::temp_dir().join(format!("bv-env-rgl-{}", std::process::id()));
     for (name, bytes) in [
         ("rgl ggx α 0.08", rgl_files::tabulated_ggx(0.08)),
-        ("rgl random 9 φi", rgl_files::random_rgl_file(3, 9, 2.0 * PI)),
-        ("rgl random 5 φi ¼ turn", rgl_files::random_rgl_file(1, 5, PI / 2.0)),
+        (
+            "rgl random 9 φi",
+            rgl_files::random_rgl_file(3, 9, 2.0 * PI),
+        ),
+        (
+            "rgl random 5 φi ¼ turn",
+            rgl_files::random_rgl_file(1, 5, PI / 2.0),
+        ),
     ] {
         let file = format!("{}.bsdf", specs.len());
-        specs.push((name.to_string(), rgl_files::rgl_spec(&rgl_dir, &file, &bytes)));
+        specs.push((
+            name.to_string(),
+            rgl_files::rgl_spec(&rgl_dir, &file, &bytes),
+        ));
     }
     let mut failures = Vec::new();
     for (name, spec) in &specs {

@@ -1,5 +1,8 @@
 //! RGL test files shared by the GPU tests (`gpu_parity`, `gpu_env`).
 
+// Each test crate that includes this module uses part of it.
+#![allow(dead_code)]
+
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -49,7 +52,6 @@ pub fn random_rgl_file(seed: u64, nphi: usize, span: f64) -> Vec<u8> {
         .u8("jacobian", &[1], &[1]);
     w.to_bytes()
 }
-
 
 /// A sharp conductor-like GGX lobe (Cook-Torrance, no diffuse part, GGX of
 /// roughness `alpha`) tabulated as an isotropic RGL file by bv-core's writer.

@@ -845,8 +845,8 @@ fn the_sampling_proxy_matches_the_tabulated_lobe() {
             "cook-torrance",
             serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx", "alpha": alpha}),
         );
-        let m = RglMaterial::parse(written(b.as_ref(), &RglWriteOptions::default()), "t.bsdf")
-            .unwrap();
+        let m =
+            RglMaterial::parse(written(b.as_ref(), &RglWriteOptions::default()), "t.bsdf").unwrap();
         let p = m.sampling_proxy();
         println!("GGX α {alpha}: proxy {p:?}");
         assert!(

@@ -913,8 +913,16 @@ impl RglMaterial {
             albedo += a / (k * k) as f64 / 4.0;
             diffuse += PI * fs[fs.len() / 10] / 4.0;
         }
-        let albedo = if albedo.is_finite() { albedo.max(0.0) } else { 0.0 };
-        let diffuse = if diffuse.is_finite() { diffuse.clamp(0.0, albedo) } else { 0.0 };
+        let albedo = if albedo.is_finite() {
+            albedo.max(0.0)
+        } else {
+            0.0
+        };
+        let diffuse = if diffuse.is_finite() {
+            diffuse.clamp(0.0, albedo)
+        } else {
+            0.0
+        };
         SamplingProxy {
             alpha,
             diffuse,
