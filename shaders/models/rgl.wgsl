@@ -12,7 +12,7 @@
 #import bv::params::{pf, pu}
 #import bv::models::merl::merl_data
 #import bv::sampling_lobe::{Lobe, p_cos_of, ggx_lobe}
-#import bv::layout::{RGL_TABLE, RGL_N_THETA, RGL_VNDF_X, RGL_VNDF_Y, RGL_VALUES, RGL_NDF_X, RGL_NDF_Y, RGL_SIGMA_X, RGL_SIGMA_Y, RGL_JACOBIAN, RGL_AT_THETA, RGL_AT_VNDF, RGL_AT_MARGINAL, RGL_AT_CONDITIONAL, RGL_AT_RGB, RGL_AT_NDF, RGL_N_PHI, RGL_AT_PHI, RGL_ISOTROPIC, RGL_REDUCTION, RGL_LOBE_ALPHA, RGL_LOBE_DIFFUSE, RGL_LOBE_GLOSSY}
+#import bv::layout::{RGL_TABLE, RGL_N_THETA, RGL_VNDF_X, RGL_VNDF_Y, RGL_VALUES, RGL_NDF_X, RGL_NDF_Y, RGL_SIGMA_X, RGL_SIGMA_Y, RGL_JACOBIAN, RGL_AT_THETA, RGL_AT_VNDF, RGL_AT_MARGINAL, RGL_AT_CONDITIONAL, RGL_AT_RGB, RGL_AT_NDF, RGL_N_PHI, RGL_AT_PHI, RGL_ISOTROPIC, RGL_REDUCTION, RGL_LOBE_ALPHA_X, RGL_LOBE_ALPHA_Y, RGL_LOBE_DIFFUSE, RGL_LOBE_GLOSSY}
 
 const RGL_PI: f32 = 3.14159265358979323846;
 
@@ -263,9 +263,10 @@ fn rgl_eval_cos(o: u32, wi_in: vec3<f32>, wo_in: vec3<f32>) -> vec3<f32> {
 
 // The proxy lobe the environment renderer samples (bv::sampling_lobe): GGX
 // visible normals at the roughness whose D at the normal equals the file's
-// normalised NDF there, and a cosine part in proportion to the material's
+// normalised NDF there (αx : αy from its half-maximum widths for an
+// anisotropic file), and a cosine part in proportion to the material's
 // diffuse weight (bv_core's RglMaterial::sampling_proxy, computed once).
 fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
-    let a = pf(o + RGL_LOBE_ALPHA);
-    return ggx_lobe(p_cos_of(pf(o + RGL_LOBE_DIFFUSE), pf(o + RGL_LOBE_GLOSSY)), a, a);
+    let p = p_cos_of(pf(o + RGL_LOBE_DIFFUSE), pf(o + RGL_LOBE_GLOSSY));
+    return ggx_lobe(p, pf(o + RGL_LOBE_ALPHA_X), pf(o + RGL_LOBE_ALPHA_Y));
 }

@@ -461,7 +461,8 @@ impl RglMaterial {
             gpu,
             gpu_slots,
             proxy: SamplingProxy {
-                alpha: 1.0,
+                alpha_x: 1.0,
+                alpha_y: 1.0,
                 diffuse: 1.0,
                 glossy: 0.0,
             },
@@ -790,9 +791,12 @@ fn gpu_blob(
 /// RGL material (see [`RglMaterial::sampling_proxy`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SamplingProxy {
-    /// GGX roughness with the file's normalised `D` at the normal:
-    /// `D(ẑ) = 1/(π α²)`.
-    pub alpha: f64,
+    /// GGX roughness along x: with `alpha_y`, `αx αy = 1/(π D(ẑ))` for the
+    /// file's normalised `D`, in the ratio of its half-maximum widths along
+    /// x and y.
+    pub alpha_x: f64,
+    /// GGX roughness along y.
+    pub alpha_y: f64,
     /// Diffuse weight: π × the 10th percentile of `f` over
     /// cosine-distributed outgoing directions (a glossy lobe covers few of
     /// those, a diffuse floor all of them), at most the albedo.
@@ -847,12 +851,16 @@ impl RglMaterial {
     /// `∫ D(m) cos θm dωm = 1` (the projected-area normalisation of Dupuy &
     /// Jakob 2018, eq. 4, σ(ẑ) = 1; integrated here by the midpoint rule on
     /// the square, whatever scale the file stores `D` at), GGX has
-    /// `D(ẑ) = 1/(π α²)` (Walter et al. 2007, eq. 33), so `α = (π D(ẑ))^−½`.
-    /// The peak height is used rather than a second slope moment because
-    /// GGX's slope variance is infinite (its tail falls as tan⁻⁴θ), and the
-    /// peak is what a sharp highlight's samples must find. An anisotropic
-    /// NDF gets the geometric mean `√(αx αy)` this way. The pdf of the lobe
-    /// is what the shader draws, so a poor match costs noise, never bias.
+    /// `D(ẑ) = 1/(π αx αy)` (Walter et al. 2007, eq. 33; Heitz 2014, eq. 85
+    /// for αx ≠ αy). The peak height is used rather than a second slope
+    /// moment because GGX's slope variance is infinite (its tail falls as
+    /// tan⁻⁴θ), and the peak is what a sharp highlight's samples must find.
+    /// An anisotropic file (more than two φi, whose NDF is over the absolute
+    /// azimuth) splits the product in the ratio of the NDF's half-maximum
+    /// angles along x (φ = 0, π) and y (φ = ±π/2), each turned into a GGX α
+    /// by `D(θ½)/D(0) = ½ ⇔ α² = tan²θ½ / (√2/cos²θ½ − 1)`. The pdf of the
+    /// lobe is what the shader draws, so a poor match costs noise, never
+    /// bias.
     pub fn sampling_proxy(&self) -> SamplingProxy {
         self.proxy
     }
@@ -875,11 +883,22 @@ impl RglMaterial {
             .map(|j| self.ndf.eval([0.0, (j as f64 + 0.5) / nv as f64], &[]))
             .sum::<f64>()
             / nv as f64;
-        let alpha = if norm > 0.0 && d0 > 0.0 {
-            (norm / (PI * d0)).sqrt().clamp(1e-3, 1.0)
+        // αx αy from the peak; the ratio from the half-maximum widths.
+        let product = if norm > 0.0 && d0 > 0.0 {
+            norm / (PI * d0)
         } else {
             1.0
         };
+        let ratio = if self.isotropic {
+            1.0
+        } else {
+            let ax = 0.5 * (self.ndf_half_max_alpha(0.0) + self.ndf_half_max_alpha(PI));
+            let ay =
+                0.5 * (self.ndf_half_max_alpha(FRAC_PI_2) + self.ndf_half_max_alpha(-FRAC_PI_2));
+            if ax > 0.0 && ay > 0.0 { ax / ay } else { 1.0 }
+        };
+        let alpha_x = (product * ratio).sqrt().clamp(1e-3, 1.0);
+        let alpha_y = (product / ratio).sqrt().clamp(1e-3, 1.0);
         // Diffuse and glossy weights from light at 30° over four azimuths:
         // the albedo by the file's own sampler (stratified), the diffuse part
         // as π × the 10th percentile of f (mean luminance) over
@@ -924,10 +943,36 @@ impl RglMaterial {
             0.0
         };
         SamplingProxy {
-            alpha,
+            alpha_x,
+            alpha_y,
             diffuse,
             glossy: albedo - diffuse,
         }
+    }
+
+    /// The GGX α whose `D` falls to half its peak at the same angle as the
+    /// file's NDF along azimuth `phi` (0 when it never does).
+    fn ndf_half_max_alpha(&self, phi: f64) -> f64 {
+        let v = phi2u(phi).clamp(0.0, 1.0);
+        let d0 = self.ndf.eval([0.0, v], &[]);
+        let steps = 2048;
+        let (mut t0, mut v0) = (0.0, d0);
+        for k in 1..=steps {
+            let u = k as f64 / steps as f64;
+            let (t1, v1) = (u2theta(u), self.ndf.eval([u, v], &[]));
+            if v1 <= 0.5 * d0 {
+                let th = if v0 > v1 {
+                    t0 + (t1 - t0) * (v0 - 0.5 * d0) / (v0 - v1)
+                } else {
+                    t1
+                };
+                let (c2, t2) = (th.cos().powi(2), th.tan().powi(2));
+                let den = std::f64::consts::SQRT_2 / c2 - 1.0;
+                return if den > 0.0 { (t2 / den).sqrt() } else { 0.0 };
+            }
+            (t0, v0) = (t1, v1);
+        }
+        0.0
     }
 }
 

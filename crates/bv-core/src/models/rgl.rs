@@ -53,7 +53,7 @@ pub static INFO: ModelInfo = ModelInfo {
 /// Derived GPU slots of `rgl` (read by `shaders/models/rgl.wgsl`): the
 /// blob's offset in the frame's table buffer (units of [`TABLE_ALIGN`]
 /// floats), then [`RglMaterial::gpu_slots`], then the sampling proxy's
-/// GGX α, diffuse and glossy weights ([`RglMaterial::sampling_proxy`]).
+/// GGX αx and αy, diffuse and glossy weights ([`RglMaterial::sampling_proxy`]).
 const DERIVED_SLOTS: &[&str] = &[
     "table",
     "n_theta",
@@ -75,7 +75,8 @@ const DERIVED_SLOTS: &[&str] = &[
     "at_phi",
     "isotropic",
     "reduction",
-    "lobe_alpha",
+    "lobe_alpha_x",
+    "lobe_alpha_y",
     "lobe_diffuse",
     "lobe_glossy",
 ];
@@ -99,7 +100,8 @@ fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>
     let mut out = vec![offset as f32];
     out.extend_from_slice(&slots);
     out.extend([
-        proxy.alpha as f32,
+        proxy.alpha_x as f32,
+        proxy.alpha_y as f32,
         proxy.diffuse as f32,
         proxy.glossy as f32,
     ]);
