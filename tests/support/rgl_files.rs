@@ -78,3 +78,27 @@ pub fn rgl_spec(dir: &std::path::Path, name: &str, bytes: &[u8]) -> bv_core::Mod
     )
     .unwrap()
 }
+
+/// A `merl` model spec over the same sharp lobe as [`tabulated_ggx`],
+/// tabulated at the public 90 × 90 × 180 resolution into `dir`.
+pub fn merl_ggx_spec(dir: &std::path::Path, alpha: f64) -> bv_core::ModelSpec {
+    use bv_core::measured::merl::{MerlDims, tabulate};
+    let b = bv_core::ModelSpec::from_json(
+        "cook-torrance",
+        &serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx", "alpha": alpha, "fresnel": "schlick", "f0": 0.9}),
+    )
+    .unwrap()
+    .build()
+    .unwrap();
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(format!("ggx-{alpha}.binary"));
+    tabulate(b.as_ref(), MerlDims::new(90, 90, 180).unwrap())
+        .unwrap()
+        .write(&path)
+        .unwrap();
+    bv_core::ModelSpec::from_json(
+        "merl",
+        &serde_json::json!({"path": path.display().to_string()}),
+    )
+    .unwrap()
+}
