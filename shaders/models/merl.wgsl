@@ -7,9 +7,10 @@
 // units of 4 floats (so that every offset stays an exactly representable f32).
 #define_import_path bv::models::merl
 
-#import bv::params::pu
+#import bv::params::{pf, pu}
 #import bv::frame::{PI, half_unnormalised}
-#import bv::layout::{MERL_INTERPOLATION, MERL_INTERPOLATION_NEAREST, MERL_THETA_H_COUNT, MERL_THETA_D_COUNT, MERL_PHI_D_COUNT, MERL_TABLE}
+#import bv::sampling_lobe::{Lobe, p_cos_of, ggx_lobe}
+#import bv::layout::{MERL_INTERPOLATION, MERL_INTERPOLATION_NEAREST, MERL_THETA_H_COUNT, MERL_THETA_D_COUNT, MERL_PHI_D_COUNT, MERL_TABLE, MERL_LOBE_ALPHA, MERL_LOBE_DIFFUSE, MERL_LOBE_GLOSSY}
 
 @group(0) @binding(8) var<storage, read> merl_data: array<f32>;
 
@@ -159,4 +160,13 @@ fn eval(o: u32, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         }
     }
     return out;
+}
+
+// The proxy lobe the environment renderer samples (bv::sampling_lobe): GGX
+// visible normals at the roughness whose D halves where the table's θh
+// profile does, and a cosine part in proportion to its floor (bv_core's
+// MerlTable::sampling_proxy, computed once per table).
+fn sampling_lobe(o: u32, wo: vec3<f32>) -> Lobe {
+    let a = pf(o + MERL_LOBE_ALPHA);
+    return ggx_lobe(p_cos_of(pf(o + MERL_LOBE_DIFFUSE), pf(o + MERL_LOBE_GLOSSY)), a, a);
 }

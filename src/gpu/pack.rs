@@ -130,8 +130,8 @@ impl TableBuffer {
             let limit = gpu.device.limits().max_storage_buffer_binding_size;
             if bytes > limit {
                 bail!(
-                    "the MERL tables drawn together need {:.1} MB, over this GPU's storage \
-                     buffer limit of {:.1} MB: show fewer measured BRDFs at once",
+                    "the measured tables (MERL, RGL) drawn together need {:.1} MB, over this \
+                     GPU's storage buffer limit of {:.1} MB: show fewer measured BRDFs at once",
                     bytes as f64 / 1e6,
                     limit as f64 / 1e6
                 );

@@ -385,12 +385,38 @@ pub struct ChannelRange {
 }
 
 /// A MERL table in memory: `f32` values of `f` (scales applied), channel-major.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct MerlTable {
     dims: MerlDims,
     data: Vec<f32>,
     warnings: MerlWarnings,
     ranges: [ChannelRange; 3],
+    /// [`MerlTable::sampling_proxy`], computed on first use.
+    proxy: std::sync::OnceLock<MerlProxy>,
+}
+
+impl PartialEq for MerlTable {
+    /// The same values (the cached sampling proxy follows from them).
+    fn eq(&self, other: &Self) -> bool {
+        self.dims == other.dims
+            && self.data == other.data
+            && self.warnings == other.warnings
+            && self.ranges == other.ranges
+    }
+}
+
+/// The GGX proxy lobe the environment renderer importance-samples for a
+/// MERL table (see [`MerlTable::sampling_proxy`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MerlProxy {
+    /// GGX roughness whose `D` falls to half its peak at the θh where the
+    /// table's glossy profile does.
+    pub alpha: f64,
+    /// Diffuse weight: π × the floor of the θh profile.
+    pub diffuse: f64,
+    /// Glossy weight: the profile above its floor, reflected at normal
+    /// incidence and integrated, `∫ g(θh) cos 2θh 4 cos θh dωh`.
+    pub glossy: f64,
 }
 
 fn file_err(path: &str, reason: impl Into<String>) -> BvError {
@@ -489,6 +515,7 @@ impl MerlTable {
             data,
             warnings,
             ranges,
+            proxy: std::sync::OnceLock::new(),
         })
     }
 
@@ -631,6 +658,7 @@ impl MerlTable {
             data,
             warnings,
             ranges,
+            proxy: std::sync::OnceLock::new(),
         })
     }
 
@@ -675,6 +703,93 @@ impl MerlTable {
     /// Range of the valid samples per channel (red, green, blue).
     pub fn ranges(&self) -> &[ChannelRange; 3] {
         &self.ranges
+    }
+
+    /// The GGX proxy lobe of the environment renderer's importance sampling
+    /// (computed on first use, then kept). The table's θh profile `p(θh)`
+    /// (the mean of its positive values over θd < 45°, every φd and the
+    /// channels: near the
+    /// mirror configuration, where `f ≈ D(θh) F G / (4 cos θi cos θo)`
+    /// varies with θh mostly through `D`) less its floor is the glossy part
+    /// `g`; the GGX α whose `D(θh)/D(0)` halves where `g` does
+    /// (`α² = tan²θ½ / (√2/cos²θ½ − 1)`, from Walter et al. 2007, eq. 33)
+    /// shapes the lobe, and π × the floor against the reflected integral of
+    /// `g` weighs the cosine part. MERL has no NDF to match the peak height
+    /// of, as the RGL proxy does; the half-maximum width needs none. The
+    /// shader's pdf is what it draws, so a poor match costs noise, not bias.
+    pub fn sampling_proxy(&self) -> MerlProxy {
+        *self.proxy.get_or_init(|| self.compute_proxy())
+    }
+
+    fn compute_proxy(&self) -> MerlProxy {
+        let d = self.dims;
+        let n = d.cells();
+        let nd = (0..d.theta_d)
+            .take_while(|&id| theta_d_centre(id, d.theta_d) < std::f64::consts::FRAC_PI_4)
+            .count()
+            .max(1);
+        let profile: Vec<f64> = (0..d.theta_h)
+            .map(|ih| {
+                let (mut sum, mut count) = (0.0, 0usize);
+                for id in 0..nd {
+                    for ip in 0..d.phi_d {
+                        let k = d.cell(ih, id, ip);
+                        for c in 0..3 {
+                            let v = f64::from(self.data[k + c * n]);
+                            // Cells below the horizon hold 0 (or a negative
+                            // mark): only measured values count.
+                            if v.is_finite() && v > 0.0 {
+                                sum += v;
+                                count += 1;
+                            }
+                        }
+                    }
+                }
+                if count > 0 { sum / count as f64 } else { 0.0 }
+            })
+            .collect();
+        let floor = profile.iter().copied().fold(f64::INFINITY, f64::min);
+        let floor = if floor.is_finite() {
+            floor.max(0.0)
+        } else {
+            0.0
+        };
+        let g: Vec<f64> = profile.iter().map(|p| (p - floor).max(0.0)).collect();
+        let (peak_i, peak) = g
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |a, (i, v)| if v > a.1 { (i, v) } else { a });
+        let mut alpha = 1.0;
+        if peak > 0.0 {
+            for i in peak_i + 1..d.theta_h {
+                if g[i] <= 0.5 * peak {
+                    let (t0, t1) = (
+                        theta_h_centre(i - 1, d.theta_h),
+                        theta_h_centre(i, d.theta_h),
+                    );
+                    let th = t0 + (t1 - t0) * (g[i - 1] - 0.5 * peak) / (g[i - 1] - g[i]);
+                    let den = std::f64::consts::SQRT_2 / th.cos().powi(2) - 1.0;
+                    if den > 0.0 {
+                        alpha = (th.tan().powi(2) / den).sqrt();
+                    }
+                    break;
+                }
+            }
+        }
+        let mut glossy = 0.0;
+        for (i, gi) in g.iter().enumerate() {
+            let ta = FRAC_PI_2 * (i as f64 / d.theta_h as f64).powi(2);
+            let tb = FRAC_PI_2 * ((i + 1) as f64 / d.theta_h as f64).powi(2);
+            let th = theta_h_centre(i, d.theta_h);
+            let omega = 2.0 * std::f64::consts::PI * (ta.cos() - tb.cos());
+            glossy += gi * (2.0 * th).cos().max(0.0) * 4.0 * th.cos() * omega;
+        }
+        MerlProxy {
+            alpha: alpha.clamp(1e-3, 1.0),
+            diffuse: std::f64::consts::PI * floor,
+            glossy,
+        }
     }
 
     /// The value of cell `(ih, id, ip)`, per channel.
@@ -1361,6 +1476,35 @@ mod tests {
             tri < 0.005 && near < 0.03,
             "trilinear {tri}, nearest {near}"
         );
+    }
+
+    #[test]
+    fn sampling_proxy_follows_the_tabulated_lobe() {
+        // GGX lobes tabulated at the public resolution: the proxy's α (by
+        // the θh profile's half maximum, against the closed-form D of the
+        // model's α) and its weights; a Lambertian table is all floor.
+        for alpha in [0.08, 0.3] {
+            let spec = ModelSpec::from_json(
+                "cook-torrance",
+                &serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx", "alpha": alpha,
+                    "fresnel": "schlick", "f0": 0.9}),
+            )
+            .unwrap();
+            let b = spec.build().unwrap();
+            let p = tabulate(b.as_ref(), dims(90, 90, 180))
+                .unwrap()
+                .sampling_proxy();
+            println!("GGX α {alpha}: {p:?}");
+            assert!((p.alpha / alpha - 1.0).abs() < 0.2, "α {alpha}: {p:?}");
+            assert!(p.diffuse < 0.2 * (p.diffuse + p.glossy), "{p:?}");
+        }
+        let spec = ModelSpec::from_json("lambert", &serde_json::json!({"albedo": 0.7})).unwrap();
+        let b = spec.build().unwrap();
+        let p = tabulate(b.as_ref(), dims(45, 45, 90))
+            .unwrap()
+            .sampling_proxy();
+        println!("lambert 0.7: {p:?}");
+        assert!((p.diffuse - 0.7).abs() < 1e-3 && p.glossy < 1e-3, "{p:?}");
     }
 
     // --- bad files -----------------------------------------------------------

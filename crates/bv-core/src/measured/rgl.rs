@@ -84,10 +84,11 @@ pub struct RglMaterial {
     bytes: usize,
     gpu: Vec<f32>,
     gpu_slots: [f32; GPU_SLOTS],
+    proxy: SamplingProxy,
 }
 
 /// Number of values [`RglMaterial::gpu_slots`] returns.
-pub const GPU_SLOTS: usize = 15;
+pub const GPU_SLOTS: usize = 19;
 
 fn file_err(name: &str, reason: impl Into<String>) -> BvError {
     BvError::File {
@@ -435,8 +436,10 @@ impl RglMaterial {
             (2.0 * PI / span).round() as i64
         };
         let _ = name;
-        let (gpu, gpu_slots) = gpu_blob(nphi, &theta_i, &vndf, &rgb, &ndf, &sigma, jacobian);
-        Ok(Self {
+        let (gpu, gpu_slots) = gpu_blob(
+            &phi_i, &theta_i, &vndf, &rgb, &ndf, &sigma, jacobian, reduction,
+        );
+        let mut m = Self {
             name: tf.name().to_string(),
             description,
             version,
@@ -457,7 +460,15 @@ impl RglMaterial {
             bytes: 0,
             gpu,
             gpu_slots,
-        })
+            proxy: SamplingProxy {
+                alpha_x: 1.0,
+                alpha_y: 1.0,
+                diffuse: 1.0,
+                glossy: 0.0,
+            },
+        };
+        m.proxy = m.compute_proxy();
+        Ok(m)
     }
 
     /// The file's name as given.
@@ -691,34 +702,53 @@ impl RglMaterial {
     }
 }
 
+/// The largest GPU blob, in floats: the port's offsets within the blob travel
+/// as `f32` slots, which hold integers exactly up to 2²⁴ (and the blob's own
+/// offset, in units of [`crate::model::TABLE_ALIGN`], up to 4 · 2²⁴). A real
+/// anisotropic file is a few million floats; beyond this the port refuses it
+/// by name ([`RglMaterial::gpu_blob_error`]).
+pub const GPU_MAX_FLOATS: usize = 1 << 24;
+
 /// The tables a GPU port reads, in one `f32` vector, and where each starts
-/// (see [`RglMaterial::gpu_slots`]). Files with one `phi_i` only (the
-/// isotropic ones of the database); others get an empty blob, which the port
-/// draws as 0.
+/// (see [`RglMaterial::gpu_slots`]): every φi and θi slice, as the CPU
+/// evaluation interpolates them. Empty (with zero slots) when the blob would
+/// exceed [`GPU_MAX_FLOATS`].
+#[allow(clippy::too_many_arguments)]
 fn gpu_blob(
-    nphi: usize,
+    phi_i: &[f64],
     theta_i: &[f64],
     vndf: &Marginal2D,
     rgb: &Marginal2D,
     ndf: &Marginal2D,
     sigma: &Marginal2D,
     jacobian: bool,
+    reduction: i64,
 ) -> (Vec<f32>, [f32; GPU_SLOTS]) {
     let mut slots = [0.0f32; GPU_SLOTS];
-    if nphi != 1 {
+    let (vx, vy) = vndf.size();
+    let (n, _) = rgb.size();
+    let (nx, ny) = ndf.size();
+    let (sx, sy) = sigma.size();
+    // Each section is padded to TABLE_ALIGN: at most 3 floats each.
+    let need = phi_i.len()
+        + theta_i.len()
+        + vndf.data().len()
+        + vndf.marginal().len()
+        + vndf.conditional().len()
+        + rgb.data().len()
+        + ndf.data().len()
+        + sigma.data().len()
+        + 7 * (crate::model::TABLE_ALIGN - 1);
+    if need > GPU_MAX_FLOATS {
         return (Vec::new(), slots);
     }
-    let mut out: Vec<f32> = Vec::new();
+    let mut out: Vec<f32> = Vec::with_capacity(need);
     let section = |v: &[f64], out: &mut Vec<f32>| -> f32 {
         out.resize(out.len().next_multiple_of(crate::model::TABLE_ALIGN), 0.0);
         let at = out.len();
         out.extend(v.iter().map(|x| *x as f32));
         at as f32
     };
-    let (vx, vy) = vndf.size();
-    let (n, _) = rgb.size();
-    let (nx, ny) = ndf.size();
-    let (sx, sy) = sigma.size();
     slots[0] = theta_i.len() as f32;
     slots[1] = vx as f32;
     slots[2] = vy as f32;
@@ -748,23 +778,201 @@ fn gpu_blob(
         sigma_at as usize,
         (ndf_at as usize + nx * ny).next_multiple_of(crate::model::TABLE_ALIGN)
     );
+    slots[15] = phi_i.len() as f32;
+    slots[16] = section(phi_i, &mut out);
+    // Isotropic layout (half-vector azimuth relative to φi) for nφ ≤ 2, as
+    // in `from_tensor`.
+    slots[17] = f32::from(u8::from(phi_i.len() <= 2));
+    slots[18] = reduction as f32;
     (out, slots)
+}
+
+/// The GGX proxy lobe the environment renderer importance-samples for an
+/// RGL material (see [`RglMaterial::sampling_proxy`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SamplingProxy {
+    /// GGX roughness along x: with `alpha_y`, `αx αy = 1/(π D(ẑ))` for the
+    /// file's normalised `D`, in the ratio of its half-maximum widths along
+    /// x and y.
+    pub alpha_x: f64,
+    /// GGX roughness along y.
+    pub alpha_y: f64,
+    /// Diffuse weight: π × the 10th percentile of `f` over
+    /// cosine-distributed outgoing directions (a glossy lobe covers few of
+    /// those, a diffuse floor all of them), at most the albedo.
+    pub diffuse: f64,
+    /// Glossy weight: the directional albedo less the diffuse weight.
+    pub glossy: f64,
 }
 
 impl RglMaterial {
     /// What the GPU port reads besides the blob (`shaders/models/rgl.wgsl`,
     /// in this order): nθ, VNDF nx and ny, value nodes n, NDF nx and ny, σ
-    /// nx and ny, the Jacobian flag, and the offsets in the blob of θi, the
+    /// nx and ny, the Jacobian flag, the offsets in the blob of θi, the
     /// VNDF's values, marginal and conditional CDFs, the RGB values and the
-    /// NDF (σ follows it at the next multiple of 4). All zero for a file the
-    /// port cannot draw (more than one `phi_i`).
+    /// NDF (σ follows it at the next multiple of 4), then nφ, the offset of
+    /// φi, the isotropic-layout flag (nφ ≤ 2) and the fold (Mitsuba's
+    /// `m_reduction`: 2 a half turn, 4 a quarter turn, below 2 none). All
+    /// zero for a file whose tables exceed [`GPU_MAX_FLOATS`].
     pub fn gpu_slots(&self) -> [f32; GPU_SLOTS] {
         self.gpu_slots
     }
 
-    /// Floats in the GPU blob (0 when the port cannot draw the file).
+    /// Floats in the GPU blob (0 when the tables are too large for the
+    /// port: see [`Self::gpu_blob_error`]).
     pub fn gpu_data_len(&self) -> usize {
         self.gpu.len()
+    }
+
+    /// Why the GPU port cannot draw this file, if it cannot: its tables
+    /// exceed [`GPU_MAX_FLOATS`] floats.
+    pub fn gpu_blob_error(&self) -> Option<String> {
+        if !self.gpu.is_empty() {
+            return None;
+        }
+        let floats = self.vndf.data().len()
+            + self.vndf.conditional().len()
+            + self.rgb.data().len()
+            + self.ndf.data().len()
+            + self.sigma.data().len();
+        Some(format!(
+            "its tables ({} φi × {} θi) need {:.1} MB as f32, over the GPU port's limit of \
+             {:.1} MB (offsets are f32 slots, exact to 2^24 floats)",
+            self.phi_i.len(),
+            self.theta_i.len(),
+            (floats * 4) as f64 / 1e6,
+            (GPU_MAX_FLOATS * 4) as f64 / 1e6
+        ))
+    }
+
+    /// The GGX proxy lobe of the environment renderer's importance sampling
+    /// (computed once, at load). Its roughness matches the file's own
+    /// microfacet distribution at the normal: with `D` normalised so that
+    /// `∫ D(m) cos θm dωm = 1` (the projected-area normalisation of Dupuy &
+    /// Jakob 2018, eq. 4, σ(ẑ) = 1; integrated here by the midpoint rule on
+    /// the square, whatever scale the file stores `D` at), GGX has
+    /// `D(ẑ) = 1/(π αx αy)` (Walter et al. 2007, eq. 33; Heitz 2014, eq. 85
+    /// for αx ≠ αy). The peak height is used rather than a second slope
+    /// moment because GGX's slope variance is infinite (its tail falls as
+    /// tan⁻⁴θ), and the peak is what a sharp highlight's samples must find.
+    /// An anisotropic file (more than two φi, whose NDF is over the absolute
+    /// azimuth) splits the product in the ratio of the NDF's half-maximum
+    /// angles along x (φ = 0, π) and y (φ = ±π/2), each turned into a GGX α
+    /// by `D(θ½)/D(0) = ½ ⇔ α² = tan²θ½ / (√2/cos²θ½ − 1)`. The pdf of the
+    /// lobe is what the shader draws, so a poor match costs noise, never
+    /// bias.
+    pub fn sampling_proxy(&self) -> SamplingProxy {
+        self.proxy
+    }
+
+    fn compute_proxy(&self) -> SamplingProxy {
+        // ∫ D cos θm dω over the square: dω = 2π² u sin θ du dv.
+        let (nu, nv) = (256usize, 128usize);
+        let mut norm = 0.0;
+        for i in 0..nu {
+            let u = (i as f64 + 0.5) / nu as f64;
+            let th = u2theta(u);
+            let w = 2.0 * PI * PI * u * th.sin() * th.cos();
+            for j in 0..nv {
+                let v = (j as f64 + 0.5) / nv as f64;
+                norm += w * self.ndf.eval([u, v], &[]);
+            }
+        }
+        norm /= (nu * nv) as f64;
+        let d0 = (0..nv)
+            .map(|j| self.ndf.eval([0.0, (j as f64 + 0.5) / nv as f64], &[]))
+            .sum::<f64>()
+            / nv as f64;
+        // αx αy from the peak; the ratio from the half-maximum widths.
+        let product = if norm > 0.0 && d0 > 0.0 {
+            norm / (PI * d0)
+        } else {
+            1.0
+        };
+        let ratio = if self.isotropic {
+            1.0
+        } else {
+            let ax = 0.5 * (self.ndf_half_max_alpha(0.0) + self.ndf_half_max_alpha(PI));
+            let ay =
+                0.5 * (self.ndf_half_max_alpha(FRAC_PI_2) + self.ndf_half_max_alpha(-FRAC_PI_2));
+            if ax > 0.0 && ay > 0.0 { ax / ay } else { 1.0 }
+        };
+        let alpha_x = (product * ratio).sqrt().clamp(1e-3, 1.0);
+        let alpha_y = (product / ratio).sqrt().clamp(1e-3, 1.0);
+        // Diffuse and glossy weights from light at 30° over four azimuths:
+        // the albedo by the file's own sampler (stratified), the diffuse part
+        // as π × the 10th percentile of f (mean luminance) over
+        // cosine-distributed outgoing directions: the floor that a Lambertian
+        // part puts under every direction (the median would count much of
+        // a GGX α 0.3 lobe as diffuse).
+        let lum = |c: Rgb| (c.x + c.y + c.z) / 3.0;
+        let k = 16usize;
+        let (mut albedo, mut diffuse) = (0.0, 0.0);
+        for q in 0..4 {
+            let phi = 0.25 + q as f64 * FRAC_PI_2;
+            let th = 30f64.to_radians();
+            let wi = DVec3::new(th.sin() * phi.cos(), th.sin() * phi.sin(), th.cos());
+            let (mut a, mut fs) = (0.0, Vec::with_capacity(k * k));
+            for i in 0..k {
+                for j in 0..k {
+                    let u = DVec2::new((i as f64 + 0.5) / k as f64, (j as f64 + 0.5) / k as f64);
+                    if let Some(wo) = self.sample(wi, u) {
+                        let p = self.pdf(wi, wo);
+                        if p > 0.0 {
+                            a += lum(self.eval_cos(wi, wo)) / p;
+                        }
+                    }
+                    let r = u.x.sqrt();
+                    let ph = 2.0 * PI * u.y;
+                    let wo = DVec3::new(r * ph.cos(), r * ph.sin(), (1.0 - u.x).max(0.0).sqrt());
+                    fs.push(lum(self.eval(wi, wo)));
+                }
+            }
+            fs.sort_by(f64::total_cmp);
+            albedo += a / (k * k) as f64 / 4.0;
+            diffuse += PI * fs[fs.len() / 10] / 4.0;
+        }
+        let albedo = if albedo.is_finite() {
+            albedo.max(0.0)
+        } else {
+            0.0
+        };
+        let diffuse = if diffuse.is_finite() {
+            diffuse.clamp(0.0, albedo)
+        } else {
+            0.0
+        };
+        SamplingProxy {
+            alpha_x,
+            alpha_y,
+            diffuse,
+            glossy: albedo - diffuse,
+        }
+    }
+
+    /// The GGX α whose `D` falls to half its peak at the same angle as the
+    /// file's NDF along azimuth `phi` (0 when it never does).
+    fn ndf_half_max_alpha(&self, phi: f64) -> f64 {
+        let v = phi2u(phi).clamp(0.0, 1.0);
+        let d0 = self.ndf.eval([0.0, v], &[]);
+        let steps = 2048;
+        let (mut t0, mut v0) = (0.0, d0);
+        for k in 1..=steps {
+            let u = k as f64 / steps as f64;
+            let (t1, v1) = (u2theta(u), self.ndf.eval([u, v], &[]));
+            if v1 <= 0.5 * d0 {
+                let th = if v0 > v1 {
+                    t0 + (t1 - t0) * (v0 - 0.5 * d0) / (v0 - v1)
+                } else {
+                    t1
+                };
+                let (c2, t2) = (th.cos().powi(2), th.tan().powi(2));
+                let den = std::f64::consts::SQRT_2 / c2 - 1.0;
+                return if den > 0.0 { (t2 / den).sqrt() } else { 0.0 };
+            }
+            (t0, v0) = (t1, v1);
+        }
+        0.0
     }
 }
 

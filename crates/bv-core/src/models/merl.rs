@@ -52,7 +52,8 @@ pub static INFO: ModelInfo = ModelInfo {
             "shaders/models/merl.wgsl",
             include_str!("../../../../shaders/models/merl.wgsl"),
         )
-        .with_derived(DERIVED_SLOTS, derive_slots),
+        .with_derived(DERIVED_SLOTS, derive_slots)
+        .with_sampling_lobe(),
     ),
 };
 
@@ -89,20 +90,33 @@ impl FileFormat for MerlFiles {
 
 /// Derived GPU slots of `merl` (read by `shaders/models/merl.wgsl`): the
 /// table's dimensions and its offset in the frame's table buffer, in units
-/// of [`TABLE_ALIGN`] floats.
-const DERIVED_SLOTS: &[&str] = &["theta_h_count", "theta_d_count", "phi_d_count", "table"];
+/// of [`TABLE_ALIGN`] floats, then the environment renderer's sampling
+/// proxy (GGX α, diffuse and glossy weights: [`MerlTable::sampling_proxy`]).
+const DERIVED_SLOTS: &[&str] = &[
+    "theta_h_count",
+    "theta_d_count",
+    "phi_d_count",
+    "table",
+    "lobe_alpha",
+    "lobe_diffuse",
+    "lobe_glossy",
+];
 
 fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
     // Through the cache: the same table (and so the same upload) as the
     // built model's.
     let t = table::read_cached(spec.params().text("path")?)?;
     let d = t.dims();
+    let proxy = t.sampling_proxy();
     let offset = tables.offset_of(t) / TABLE_ALIGN;
     Ok(vec![
         d.theta_h as f32,
         d.theta_d as f32,
         d.phi_d as f32,
         offset as f32,
+        proxy.alpha as f32,
+        proxy.diffuse as f32,
+        proxy.glossy as f32,
     ])
 }
 

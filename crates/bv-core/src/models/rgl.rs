@@ -26,9 +26,11 @@ pub const PARAMS: &[ParamDecl] = &[ParamDecl {
     applies: Applies::Always,
 }];
 
-/// Catalogue entry. The GPU port draws files with one `phi_i` (the
-/// isotropic ones); others draw as 0 on the GPU (the CPU views and every
-/// analysis draw them).
+/// Catalogue entry. The GPU port draws every file the CPU evaluates
+/// (isotropic and anisotropic, every φi and θi slice interpolated as
+/// [`RglMaterial::eval`] does), up to [`material::GPU_MAX_FLOATS`] floats of
+/// tables; it importance-samples a GGX proxy lobe fitted to the file's NDF
+/// ([`RglMaterial::sampling_proxy`]).
 pub static INFO: ModelInfo = ModelInfo {
     id: "rgl",
     name: "RGL measured",
@@ -43,13 +45,15 @@ pub static INFO: ModelInfo = ModelInfo {
             "shaders/models/rgl.wgsl",
             include_str!("../../../../shaders/models/rgl.wgsl"),
         )
-        .with_derived(DERIVED_SLOTS, derive_slots),
+        .with_derived(DERIVED_SLOTS, derive_slots)
+        .with_sampling_lobe(),
     ),
 };
 
 /// Derived GPU slots of `rgl` (read by `shaders/models/rgl.wgsl`): the
 /// blob's offset in the frame's table buffer (units of [`TABLE_ALIGN`]
-/// floats), then [`RglMaterial::gpu_slots`].
+/// floats), then [`RglMaterial::gpu_slots`], then the sampling proxy's
+/// GGX αx and αy, diffuse and glossy weights ([`RglMaterial::sampling_proxy`]).
 const DERIVED_SLOTS: &[&str] = &[
     "table",
     "n_theta",
@@ -67,25 +71,40 @@ const DERIVED_SLOTS: &[&str] = &[
     "at_conditional",
     "at_rgb",
     "at_ndf",
+    "n_phi",
+    "at_phi",
+    "isotropic",
+    "reduction",
+    "lobe_alpha_x",
+    "lobe_alpha_y",
+    "lobe_diffuse",
+    "lobe_glossy",
 ];
 
 fn derive_slots(spec: &ModelSpec, tables: &mut dyn GpuTables) -> Result<Vec<f32>> {
     // Through the cache: the same material as the built model's.
     let path = spec.params().text("path")?;
     let m = material::read_cached(path, &mut |_, _| {})?;
-    // A file the port cannot draw is refused here rather than packed as
-    // zeros: the GPU views then say why instead of drawing it black.
-    if m.gpu_data_len() == 0 {
+    // A file the port cannot draw (tables too large) is refused here rather
+    // than packed as zeros: the GPU views then say why instead of drawing
+    // it black.
+    if let Some(why) = m.gpu_blob_error() {
         return Err(BvError::Invalid(format!(
-            "{path}: the GPU port draws RGL files with one φi (isotropic); this one has {} \
-             (anisotropic): the CPU views (lobe, polar, slices, albedo) draw it",
-            m.phi_i().len()
+            "{path}: the GPU views cannot draw this RGL file: {why}; the CPU views \
+             (lobe, polar, slices, albedo) draw it"
         )));
     }
     let slots = m.gpu_slots();
+    let proxy = m.sampling_proxy();
     let offset = tables.offset_of(m) / TABLE_ALIGN;
     let mut out = vec![offset as f32];
     out.extend_from_slice(&slots);
+    out.extend([
+        proxy.alpha_x as f32,
+        proxy.alpha_y as f32,
+        proxy.diffuse as f32,
+        proxy.glossy as f32,
+    ]);
     Ok(out)
 }
 
