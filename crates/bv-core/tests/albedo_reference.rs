@@ -713,9 +713,11 @@ fn named_kinks_save_work_not_accuracy() {
             let d = (a.value - b.value).abs().max_element();
             assert!(
                 d <= a.std_error.max_element() + b.std_error.max_element(),
-                "{id} at {deg}°: {} vs {}",
+                "{id} at {deg}°: {} ± {} vs {} ± {}",
                 a.value.x,
-                b.value.x
+                a.std_error.x,
+                b.value.x,
+                b.std_error.x
             );
             let (truth, err) = reference(build(id, &p).as_ref(), wi);
             assert!(
