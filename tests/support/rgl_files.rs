@@ -1,4 +1,5 @@
-//! RGL test files shared by the GPU tests (`gpu_parity`, `gpu_env`).
+//! RGL test files shared by the GPU tests (`gpu_parity`, `gpu_env`) and
+//! bv-core's `tests/rgl.rs` (which includes this file by path).
 
 // Each test crate that includes this module uses part of it.
 #![allow(dead_code)]
@@ -6,8 +7,7 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// A hand-built RGL file of random positive tables (the construction of
-/// `random_file` in `crates/bv-core/tests/rgl.rs`): `nphi` incident azimuths
+/// A hand-built RGL file of random positive tables: `nphi` incident azimuths
 /// from −π spanning `span` (anisotropic above 2: folded by a half turn for
 /// span π, a quarter turn for π/2), 4 θi, NDF and σ varying with φ, the VNDF
 /// zero where the normal faces away from the slice's wi, the Jacobian on.

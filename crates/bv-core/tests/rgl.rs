@@ -18,6 +18,9 @@ use rand::Rng;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+#[path = "../../../tests/support/rgl_files.rs"]
+mod rgl_files;
+
 // ---------------------------------------------------------------------------
 // The container.
 
@@ -698,51 +701,11 @@ fn eval_is_zero_below_the_horizon_and_finite_everywhere() {
     }
 }
 
-/// A hand-built file of random positive tables: `nphi` incident azimuths
-/// spanning `span` (anisotropic above 2), 4 θi, NDF and σ varying with φ.
+/// A hand-built file of random positive tables (`nphi` incident azimuths
+/// spanning `span`, anisotropic above 2; 4 θi; NDF and σ varying with φ):
+/// the one the GPU tests of the `bv` package draw too.
 fn random_file(seed: u64, nphi: usize, span: f64) -> Vec<u8> {
-    let mut rng = sampling::rng(seed);
-    let mut r = |n: usize, lo: f32, hi: f32| -> Vec<f32> {
-        (0..n).map(|_| rng.random_range(lo..hi)).collect()
-    };
-    let phi: Vec<f32> = if nphi == 1 {
-        vec![0.0]
-    } else {
-        // From −π: a folded wi has y ≤ 0 (and x ≤ 0 for a quarter turn).
-        (0..nphi)
-            .map(|k| (-PI + span * k as f64 / (nphi - 1) as f64) as f32)
-            .collect()
-    };
-    let theta: Vec<f32> = (0..4).map(|k| 1.4 * k as f32 / 3.0).collect();
-    // Random, but zero where the normal faces away from the slice's wi (as
-    // any VNDF):
-    // a sampled normal there would reflect wi into a direction whose own
-    // half vector is another normal, which no pdf accounts for.
-    let mut vndf = r(nphi * 4 * 192, 0.1, 2.0);
-    for (k, v) in vndf.iter_mut().enumerate() {
-        let (x, y) = (k % 16, (k / 16) % 12);
-        let (t, pi) = ((k / 192) % 4, k / 768);
-        let phi_i = if nphi <= 2 { 0.0 } else { f64::from(phi[pi]) };
-        let wi = dir(f64::from(theta[t]), phi_i);
-        let u = x as f64 / 15.0;
-        let tm = u * u * PI / 2.0;
-        let m = dir(tm, (2.0 * y as f64 / 11.0 - 1.0) * PI);
-        // … and carrying the square's area element u sin θm, as a VNDF in
-        // solid angle written on the square does.
-        *v *= (wi.dot(m).max(0.0) * u * tm.sin()) as f32;
-    }
-    let p = nphi as u64;
-    let mut w = TensorWriter::new();
-    w.u8("description", &[6], b"random")
-        .f32("theta_i", &[4], &theta)
-        .f32("phi_i", &[p], &phi)
-        .f32("ndf", &[8, 16], &r(128, 0.2, 2.0))
-        .f32("sigma", &[8, 16], &r(128, 0.5, 1.5))
-        .f32("vndf", &[p, 4, 12, 16], &vndf)
-        .f32("luminance", &[p, 4, 8, 8], &r(nphi * 4 * 64, 0.1, 2.0))
-        .f32("rgb", &[p, 4, 3, 8, 8], &r(nphi * 4 * 192, 0.0, 1.0))
-        .u8("jacobian", &[1], &[1]);
-    w.to_bytes()
+    rgl_files::random_rgl_file(seed, nphi, span)
 }
 
 #[test]
