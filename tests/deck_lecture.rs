@@ -1332,3 +1332,48 @@ fn lumber_and_cement_are_measured_or_named_stand_ins() {
     let tilt_y = along(glam::DVec3::Y);
     assert!(tilt_y > 3.0 * tilt_x, "{tilt_x} vs {tilt_y}");
 }
+
+/// LECTURE.md scene 59 [cf]: seen along ωr, the anisotropic lobe's
+/// cross-section is an ellipse whose long axis is along b, with axis ratio
+/// ≥ 3: turning ωo off ωr by δ tilts the half vector by δ/2 in the plane of
+/// incidence (along t, Ward's αx) and by about δ/(2 cos θi) across it (along
+/// b, αy), so the plan's small-angle ratio is cos θi · αy/αx = 4.2. Read
+/// here as the half-maximum widths of f(ωi, ·) about ωr in the two
+/// directions, against the same widths of Ward's formula (Ward 1992, eq. 5)
+/// written in this test: at the half maximum across, 0.36 rad out, the half
+/// vector also tilts along t, which the small-angle ratio leaves out.
+#[test]
+fn the_anisotropic_lobe_seen_along_the_mirror_direction_is_an_ellipse() {
+    let slides = slides();
+    let s = slide(&slides, "bv = BRDF viewer: an anisotropic lobe in 3-D");
+    let b = &scene_brdfs(s)[0];
+    let ti = s.state.incident.theta_deg.to_radians();
+    let wi = glam::DVec3::new(ti.sin(), 0.0, ti.cos());
+    let wr = glam::DVec3::new(-wi.x, -wi.y, wi.z);
+    let (kd, ks, ax, ay) = (0.1, 0.5, 0.05, 0.3);
+    let ward = |wo: glam::DVec3| {
+        let h = (wi + wo).normalize();
+        let t2 = (h.x * h.x / (ax * ax) + h.y * h.y / (ay * ay)) / (h.z * h.z);
+        kd / std::f64::consts::PI
+            + ks * (-t2).exp() / (4.0 * std::f64::consts::PI * ax * ay * (wi.z * wo.z).sqrt())
+    };
+    let model = |wo: glam::DVec3| mean_rgb(b.eval(wi, wo));
+    // In-plane (towards t) and across (along b), both perpendicular to ωr.
+    let in_plane = wr.cross(glam::DVec3::Y).normalize();
+    let half_width = |f: &dyn Fn(glam::DVec3) -> f64, axis: glam::DVec3| {
+        let peak = f(wr);
+        let mut d = 0.0f64;
+        while d < 1.0 {
+            d += 1e-4;
+            if f(wr * d.cos() + axis * d.sin()) < 0.5 * peak {
+                return d;
+            }
+        }
+        d
+    };
+    let ratio =
+        |f: &dyn Fn(glam::DVec3) -> f64| half_width(f, glam::DVec3::Y) / half_width(f, in_plane);
+    let (got, want) = (ratio(&model), ratio(&ward));
+    assert!(got >= 3.0, "axis ratio {got}");
+    assert!((got / want - 1.0).abs() < 0.02, "{got} vs {want}");
+}
