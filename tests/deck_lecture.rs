@@ -1164,6 +1164,15 @@ fn ashikhmin_shirleys_body_darkens_at_grazing() {
     );
 }
 
+/// The legend names of a slide's BRDFs, in list order.
+fn brdf_names(s: &Slide) -> Vec<&str> {
+    s.state
+        .brdfs
+        .iter()
+        .filter_map(|b| b.name.as_deref())
+        .collect()
+}
+
 /// LECTURE.md scene 01 (N7): measured, phenomenological and microfacet,
 /// named by class; without MERL's file (not shipped) its stand-in is drawn,
 /// named as one, and the caption says so. The plan's "≥ 1 decade apart
@@ -1175,12 +1184,7 @@ fn ashikhmin_shirleys_body_darkens_at_grazing() {
 fn where_reflectance_functions_come_from() {
     let slides = slides();
     let s = slide(&slides, "Where reflectance functions come from");
-    let names: Vec<&str> = s
-        .state
-        .brdfs
-        .iter()
-        .filter_map(|b| b.name.as_deref())
-        .collect();
+    let names = brdf_names(s);
     let shipped = manifest().join("assets/decks/blue-acrylic.binary").exists();
     let measured = if shipped { "measured" } else { "stand-in" };
     assert!(names[0].starts_with(measured), "{names:?}");
@@ -1303,12 +1307,7 @@ fn lumber_and_cement_are_measured_or_named_stand_ins() {
     let slides = slides();
     let s = slide(&slides, "BRDF illustrations: lumber and cement");
     let dir = manifest().join("assets/decks");
-    let names: Vec<&str> = s
-        .state
-        .brdfs
-        .iter()
-        .filter_map(|b| b.name.as_deref())
-        .collect();
+    let names = brdf_names(s);
     for (k, file) in ["lumber.bsdf", "cement.bsdf"].into_iter().enumerate() {
         let shipped = dir.join(file).exists();
         let want = if shipped { "measured" } else { "stand-in" };

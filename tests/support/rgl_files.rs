@@ -57,14 +57,27 @@ pub fn random_rgl_file(seed: u64, nphi: usize, span: f64) -> Vec<u8> {
 /// roughness `alpha`) tabulated as an isotropic RGL file by bv-core's writer.
 pub fn tabulated_ggx(alpha: f64) -> Vec<u8> {
     use bv_core::measured::rgl_write::{RglWriteOptions, tabulate_rgl};
-    let b = bv_core::ModelSpec::from_json(
+    tabulate_rgl(sharp_ggx(alpha).as_ref(), &RglWriteOptions::default()).unwrap()
+}
+
+/// The sharp lobe [`tabulated_ggx`] and [`merl_ggx_spec`] tabulate.
+fn sharp_ggx(alpha: f64) -> Box<dyn bv_core::Brdf> {
+    bv_core::ModelSpec::from_json(
         "cook-torrance",
         &serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx", "alpha": alpha, "fresnel": "schlick", "f0": 0.9}),
     )
     .unwrap()
     .build()
-    .unwrap();
-    tabulate_rgl(b.as_ref(), &RglWriteOptions::default()).unwrap()
+    .unwrap()
+}
+
+/// A spec of the measured `model` reading the file at `path`.
+fn file_spec(model: &str, path: &std::path::Path) -> bv_core::ModelSpec {
+    bv_core::ModelSpec::from_json(
+        model,
+        &serde_json::json!({"path": path.display().to_string()}),
+    )
+    .unwrap()
 }
 
 /// An `rgl` model spec over `bytes`, written as `name` in `dir`.
@@ -72,33 +85,21 @@ pub fn rgl_spec(dir: &std::path::Path, name: &str, bytes: &[u8]) -> bv_core::Mod
     std::fs::create_dir_all(dir).unwrap();
     let path = dir.join(name);
     std::fs::write(&path, bytes).unwrap();
-    bv_core::ModelSpec::from_json(
-        "rgl",
-        &serde_json::json!({"path": path.display().to_string()}),
-    )
-    .unwrap()
+    file_spec("rgl", &path)
 }
 
 /// A `merl` model spec over the same sharp lobe as [`tabulated_ggx`],
 /// tabulated at the public 90 × 90 × 180 resolution into `dir`.
 pub fn merl_ggx_spec(dir: &std::path::Path, alpha: f64) -> bv_core::ModelSpec {
     use bv_core::measured::merl::{MerlDims, tabulate};
-    let b = bv_core::ModelSpec::from_json(
-        "cook-torrance",
-        &serde_json::json!({"kd": 0.0, "ks": 1.0, "distribution": "ggx", "alpha": alpha, "fresnel": "schlick", "f0": 0.9}),
-    )
-    .unwrap()
-    .build()
-    .unwrap();
     std::fs::create_dir_all(dir).unwrap();
     let path = dir.join(format!("ggx-{alpha}.binary"));
-    tabulate(b.as_ref(), MerlDims::new(90, 90, 180).unwrap())
-        .unwrap()
-        .write(&path)
-        .unwrap();
-    bv_core::ModelSpec::from_json(
-        "merl",
-        &serde_json::json!({"path": path.display().to_string()}),
+    tabulate(
+        sharp_ggx(alpha).as_ref(),
+        MerlDims::new(90, 90, 180).unwrap(),
     )
     .unwrap()
+    .write(&path)
+    .unwrap();
+    file_spec("merl", &path)
 }

@@ -50,10 +50,17 @@ fn synthetic_table() -> String {
     PATH.get_or_init(write_synthetic_table).clone()
 }
 
+/// Writes `bytes` as `name` in the bench's temporary folder, atomically (a
+/// concurrent run never reads half a file), and returns its path.
+fn bench_file(name: &str, bytes: &[u8]) -> String {
+    let path = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    if let Err(e) = bv_core::fsio::write_atomic(&path, |w| w.write_all(bytes)) {
+        eprintln!("cannot write {}: {e}", path.display());
+    }
+    path.to_string_lossy().into_owned()
+}
+
 fn write_synthetic_table() -> String {
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-    let path = dir.join("bv-bench-90x90x180.binary");
-    let tmp = dir.join(format!("bv-bench-90x90x180.binary.{}", std::process::id()));
     let dims = [90i32, 90, 180];
     let n = (dims[0] * dims[1] * dims[2]) as usize;
     let mut bytes = Vec::with_capacity(12 + 24 * n);
@@ -66,11 +73,7 @@ fn write_synthetic_table() -> String {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    // A private name, then a rename: a concurrent run never reads half a file.
-    if let Err(e) = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path)) {
-        eprintln!("cannot write {}: {e}", path.display());
-    }
-    path.to_string_lossy().into_owned()
+    bench_file("bv-bench-90x90x180.binary", &bytes)
 }
 
 /// An RGL material of a real file's size (8 θi, 128-node NDF, 32² value
@@ -80,9 +83,6 @@ fn synthetic_rgl() -> String {
     static PATH: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     PATH.get_or_init(|| {
         use bv_core::measured::rgl_write::{RglWriteOptions, tabulate_rgl};
-        let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"));
-        let path = dir.join("bv-bench-ggx.bsdf");
-        let tmp = dir.join(format!("bv-bench-ggx.bsdf.{}", std::process::id()));
         let opts = RglWriteOptions {
             theta_i: 8,
             values: 32,
@@ -94,17 +94,11 @@ fn synthetic_rgl() -> String {
         )
         .and_then(|s| s.build())
         .and_then(|b| tabulate_rgl(b.as_ref(), &opts));
-        match written {
-            Ok(bytes) => {
-                if let Err(e) =
-                    std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, &path))
-                {
-                    eprintln!("cannot write {}: {e}", path.display());
-                }
-            }
-            Err(e) => eprintln!("cannot tabulate the RGL bench file: {e}"),
-        }
-        path.to_string_lossy().into_owned()
+        let bytes = written.unwrap_or_else(|e| {
+            eprintln!("cannot tabulate the RGL bench file: {e}");
+            Vec::new()
+        });
+        bench_file("bv-bench-ggx.bsdf", &bytes)
     })
     .clone()
 }
