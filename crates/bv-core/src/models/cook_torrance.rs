@@ -637,20 +637,26 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
         let k = self.0;
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let above = wi[2].gt(zero) & wo[2].gt(zero);
-        // frame::half_vector: one square root and one division.
+        // The unnormalised half vector wi + wo and its squared length.
         let hu = math::add3(wi, wo);
         let l2 = math::dot(hu, hu);
-        let inv = one / l2.sqrt();
-        let h = math::scale3(hu, inv);
         let finite_h = l2.gt(V::splat(1e-24)) & l2.lt(V::splat(f32::INFINITY));
-        let scalar = if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
-            // The common GGX-Smith case with one division for D G/(4 cos cos).
-            if G == CORRELATED {
+        let (scalar, cos_d) = if D == ScaleLanes::GGX && !MIX && G != VGROOVE {
+            // The common GGX-Smith case with one division for D G/(4 cos cos),
+            // which needs only wi + wo, not the unit half vector. Fresnel's
+            // cos θd = wi·h = (1 + wi·wo)/|wi + wo| is |wi + wo|/2 for unit
+            // wi and wo (|wi + wo|² = 2 + 2 wi·wo): one square root and no
+            // division, where normalising h took a square root, a division
+            // and a dot product.
+            let dg = if G == CORRELATED {
                 k.first.ggx_dg::<true, V>(wi, wo, hu, l2)
             } else {
                 k.first.ggx_dg::<false, V>(wi, wo, hu, l2)
-            }
+            };
+            (dg, l2.sqrt() * 0.5)
         } else {
+            // frame::half_vector: one square root and one division.
+            let h = math::scale3(hu, one / l2.sqrt());
             let w1 = 1.0 - k.w2;
             let d = if MIX {
                 k.first.d::<D, V>(h) * w1 + k.second.d::<D, V>(h) * k.w2
@@ -667,11 +673,11 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
                 SMITH => one / (self.one_plus_lambda(wi) * self.one_plus_lambda(wo)),
                 _ => one / (self.one_plus_lambda(wi) + self.one_plus_lambda(wo) - 1.0),
             };
-            d * g / (wi[2] * wo[2] * 4.0)
+            (d * g / (wi[2] * wo[2] * 4.0), math::dot(wi, h))
         };
         let ok = above & finite_h & scalar.is_finite();
         let scalar = ok.select(scalar * k.ks, zero);
-        let fr = k.fresnel.eval::<F, V>(math::dot(wi, h));
+        let fr = k.fresnel.eval::<F, V>(cos_d);
         match &k.multiscatter {
             // Kulla–Conty's lobe (see `crate::multiscatter`): a branch on the
             // model's choice, the same for every lane.
