@@ -265,9 +265,23 @@ fn kink_roots(
     // integral).
     let scan = scan.min(MAX_SCAN);
     let step = (hi - lo) / scan as f64;
+    let mut xs = [0.0; MAX_SCAN + 1];
     let mut dirs = [None; MAX_SCAN + 1];
-    for (k, d) in dirs.iter_mut().enumerate().take(scan + 1) {
-        *d = dir(lo + step * k as f64);
+    for (k, (x, d)) in xs.iter_mut().zip(&mut dirs).enumerate().take(scan + 1) {
+        *x = lo + step * k as f64;
+        *d = dir(*x);
+    }
+    // An arc's ends lie on the horizon, where rounding can put the
+    // direction just below it (`None`): the scan's first or last step would
+    // then be skipped, and with it a kink that crosses the arc there (V-groove's
+    // `2 (n·h)(n·wo) = wo·h`, near the horizon at every grazing θi), which
+    // bisection then chased at 5 to 15 times the work. Such an end is moved
+    // inside by a millionth of a step.
+    for (k, inward) in [(0, 1e-6 * step), (scan, -1e-6 * step)] {
+        if dirs[k].is_none() {
+            xs[k] += inward;
+            dirs[k] = dir(xs[k]);
+        }
     }
     for kink in kinks {
         let value = |phi: f64| dir(phi).map(kink);
@@ -279,7 +293,7 @@ fn kink_roots(
             if !(fa.is_finite() && fb.is_finite()) || (fa > 0.0) == (fb > 0.0) {
                 continue;
             }
-            let (mut x0, mut x1) = (lo + step * k as f64, lo + step * (k + 1) as f64);
+            let (mut x0, mut x1) = (xs[k], xs[k + 1]);
             // Which end was kept last time (Illinois halves its value).
             let mut kept = 0i8;
             for _ in 0..100 {
@@ -886,6 +900,31 @@ pub fn rho_hh(brdf: &dyn Brdf, opts: &QuadratureOptions) -> Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_kink_in_a_scan_step_that_ends_below_the_horizon_is_found() {
+        // An arc whose end (φ = 1) lies on the horizon, where the direction
+        // is `None` as rounding may make it; a kink at φ = 0.95, inside the
+        // scan's last step [0.875, 1].
+        let dir = |phi: f64| {
+            let z = 1.0 - phi;
+            (z > 0.0).then(|| DVec3::new((1.0 - z * z).sqrt(), 0.0, z))
+        };
+        let kinks: Vec<crate::Kink<'_>> = vec![Box::new(|wo: DVec3| wo.z - 0.05)];
+        let mut out = Vec::new();
+        kink_roots(&kinks, dir, 0.0, 1.0, KINK_SCAN, &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!((out[0] - 0.95).abs() < 1e-10, "{out:?}");
+        // And at the arc's start.
+        let dir = |phi: f64| {
+            let z = phi;
+            (z > 0.0).then(|| DVec3::new((1.0 - z * z).sqrt(), 0.0, z))
+        };
+        let mut out = Vec::new();
+        kink_roots(&kinks, dir, 0.0, 1.0, KINK_SCAN, &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!((out[0] - 0.05).abs() < 1e-10, "{out:?}");
+    }
 
     #[test]
     fn sin_cos_matches_std() {
