@@ -771,6 +771,14 @@ fn transmitted(
         }
         let full = psi_max >= PI;
         let (lo, hi) = (if half { 0.0 } else { -psi_max }, psi_max);
+        // `at(theta, ·)` with the ring's sine and cosine computed once (the
+        // same values: `at` takes them from `sin_cos` too).
+        let (st_r, ct_r) = sin_cos(theta);
+        let u = ct_r * p;
+        let on_ring = |psi: f64| {
+            let (sp, cp) = sin_cos(psi);
+            u - st_r * (cp * e1 + sp * e2)
+        };
         let mut br = vec![lo, 0.0, hi];
         for &(_, a) in &others {
             let a = wrap_near(a, 0.0);
@@ -796,7 +804,7 @@ fn transmitted(
         kink_roots(
             &kinks,
             |psi| {
-                let wo = at(theta, psi);
+                let wo = on_ring(psi);
                 (wo.z < 0.0).then_some(wo)
             },
             lo,
@@ -805,7 +813,7 @@ fn transmitted(
             &mut br,
         );
         let mut inner = |psi: f64| -> (Rgb, Rgb) {
-            let wo = at(theta, psi);
+            let wo = on_ring(psi);
             if wo.z >= 0.0 {
                 return (Rgb::ZERO, Rgb::ZERO);
             }
