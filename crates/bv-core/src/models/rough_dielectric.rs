@@ -450,6 +450,42 @@ impl Brdf for RoughDielectric {
         if p.is_finite() { p.max(0.0) } else { 0.0 }
     }
 
+    fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+        // Transmission: the facet that refracts wi into wo has the normal
+        // h ∝ ηi wi + ηo wo (eq. 16), which must face both (χ⁺, eq. 21):
+        // wi·(ηi wi + ηo wo) = ηi + ηo wi·wo and wo·(ηi wi + ηo wo) =
+        // ηi wi·wo + ηo change sign on the cones wi·wo = −ηi/ηo and
+        // −ηo/ηi about −wi, of which the one with the ratio below 1 exists.
+        // f falls to 0 there (with |wi·h| and 1 − F, or with |wo·h|) and is
+        // 0 beyond: a kink across every ring of the transmitted part that
+        // the cone cuts (it is a ring itself only at normal incidence).
+        let r = self.eta.min(1.0 / self.eta);
+        let side = wi.z;
+        let mut k: Vec<crate::Kink<'_>> = vec![Box::new(move |wo: DVec3| {
+            if wo.z * side > 0.0 {
+                1.0
+            } else {
+                wi.dot(wo) + r
+            }
+        })];
+        // Reflection from the denser side: F's total internal reflection
+        // starts at the facet angle sin θc = ηo/ηi, where F (eq. 22) has a
+        // square-root kink; with wi·h = √((1 + wi·wo)/2) that is the cone
+        // wi·wo = 1 − 2 (ηo/ηi)² about wi.
+        let (ei, eo) = (self.eta_of(wi), self.eta_of(-wi));
+        if ei > eo {
+            let c = 1.0 - 2.0 * (eo / ei) * (eo / ei);
+            k.push(Box::new(move |wo: DVec3| {
+                if wo.z * side > 0.0 {
+                    wi.dot(wo) - c
+                } else {
+                    1.0
+                }
+            }));
+        }
+        k
+    }
+
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         // The refracted direction through the macro surface (the transmitted
         // lobe's centre), when Snell's law has a solution.
