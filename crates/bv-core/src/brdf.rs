@@ -153,12 +153,13 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
 
     /// The kinks of `f(wi, ·)` (see [`Kink`]) over the outgoing directions on
     /// `wi`'s side (and, for a transmitting model, on the other side too),
-    /// so that the albedo quadrature breaks its panels where
-    /// they cross a circle of integration instead of bisecting towards them:
-    /// Oren-Nayar's `max(0, cos Δφ)` and `max(cos θi, cos θo)`, V-groove's
-    /// `min`, the rough dielectric's cone past which no facet refracts. A kink left out costs evaluations, not accuracy (the
-    /// quadrature verifies its panels); a function whose sign changes where
-    /// `f` is smooth costs a break. Default: none.
+    /// so that the albedo quadrature breaks its panels where they cross a
+    /// circle of integration instead of bisecting towards them: Oren-Nayar's
+    /// `max(0, cos Δφ)` and `max(cos θi, cos θo)`, V-groove's `min`, the
+    /// rough dielectric's cone past which no facet refracts. A kink left out
+    /// costs evaluations, not accuracy (the quadrature verifies its panels);
+    /// a function whose sign changes where `f` is smooth costs a break.
+    /// Default: none.
     fn kinks(&self, _wi: DVec3) -> Vec<Kink<'_>> {
         Vec::new()
     }
