@@ -371,6 +371,26 @@ fn cos_secant(phi_i: f64) -> impl Fn(f64, f64, f64, f64) -> f64 {
     }
 }
 
+/// The kinks' roots along the outer axis `0..theta_end` (a curve through
+/// the pole, `along`), as outer panel breaks: [`kink_roots`] with no first
+/// guess (plain regula falsi) and the outer scan.
+fn outer_kink_roots(
+    kinks: &[crate::Kink<'_>],
+    along: impl Fn(f64) -> Option<DVec3>,
+    theta_end: f64,
+    breaks: &mut Vec<f64>,
+) {
+    kink_roots(
+        kinks,
+        along,
+        no_guess,
+        0.0,
+        theta_end,
+        OUTER_KINK_SCAN,
+        breaks,
+    );
+}
+
 /// No first guess for [`kink_roots`]: plain regula falsi.
 fn no_guess(_: f64, _: f64, _: f64, _: f64) -> f64 {
     f64::NAN
@@ -611,15 +631,7 @@ fn reflected(
                 let wo = 2.0 * wi.dot(h) * h - wi;
                 (wo.z > 0.0).then(|| wo.normalize())
             };
-            kink_roots(
-                &kinks,
-                along,
-                no_guess,
-                0.0,
-                theta_end,
-                OUTER_KINK_SCAN,
-                &mut breaks,
-            );
+            outer_kink_roots(&kinks, along, theta_end, &mut breaks);
         }
         breaks.sort_by(f64::total_cmp);
         breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
@@ -783,15 +795,7 @@ fn transmitted(
             let wo = at(theta, side);
             (wo.z < 0.0).then_some(wo)
         };
-        kink_roots(
-            &kinks,
-            along,
-            no_guess,
-            0.0,
-            theta_end,
-            OUTER_KINK_SCAN,
-            &mut breaks,
-        );
+        outer_kink_roots(&kinks, along, theta_end, &mut breaks);
     }
     breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
