@@ -3,7 +3,7 @@
 //! `f · cos θo`, on a linear or logarithmic scale. The 3D view and the headless
 //! export draw this mesh; it carries a per-vertex value for colouring.
 
-use crate::batch::{self, Out};
+use crate::batch::{self, Isa, LaneTask, Lanes, Out};
 use crate::{Brdf, DeltaLobe, frame};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -62,6 +62,10 @@ impl Default for LobeOptions {
 pub struct LobeMesh {
     /// Vertex positions `r · wo` (local frame, +z the normal).
     pub positions: Vec<[f32; 3]>,
+    /// Per-vertex radius `r` (scaled): `positions[k]` is `radii[k]` times
+    /// the vertex's grid direction ([`LobeMesh::direction`]). Empty for a
+    /// mesh not built on the lobe grid.
+    pub radii: Vec<f32>,
     /// Smooth vertex normals (area-weighted face normals).
     pub normals: Vec<[f32; 3]>,
     /// Per-vertex value before scaling: `f` or `f cos θo`, per channel.
@@ -175,6 +179,12 @@ pub fn build(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions) -> LobeMesh {
 /// not rewritten (it is taken as the one an earlier call wrote), so only the
 /// values, positions and normals are computed.
 pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMesh) {
+    build_with(brdf, wi, opts, mesh, batch::isa());
+}
+
+/// [`build_into`] with the instruction set `isa` for the evaluation and the
+/// per-vertex passes (tests hold every path to the same mesh).
+fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMesh, isa: Isa) {
     let n_theta = opts.n_theta.max(2);
     let n_phi = opts.n_phi.max(3);
     let full = brdf.transmits();
@@ -190,10 +200,12 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
         && mesh.indices.len() == grid.indices.len();
     let mut values = std::mem::take(&mut mesh.values);
     let mut positions = std::mem::take(&mut mesh.positions);
+    let mut radii = std::mem::take(&mut mesh.radii);
     let mut normals = std::mem::take(&mut mesh.normals);
     let mut indices = std::mem::take(&mut mesh.indices);
     values.resize(count, [0.0; 3]);
     positions.resize(count, [0.0; 3]);
+    radii.resize(count, 0.0);
     normals.resize(count, [0.0; 3]);
     // The triangle list depends on the resolution only; a mesh of the same
     // resolution already holds it (callers do not edit it).
@@ -203,7 +215,7 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
     }
     // Rows per task: enough lanes per batch call to fill the vectors.
     let band = (2048 / n_phi).max(1);
-    let fill = |first_row: usize, (vals, pos): (&mut [[f32; 3]], &mut [[f32; 3]])| {
+    let fill = |first_row: usize, ((vals, pos), rad): BandOut<'_>| {
         let start = first_row * n_phi;
         let n = vals.len();
         let wo = [
@@ -219,8 +231,9 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
             wx.fill(wi32[0]);
             wy.fill(wi32[1]);
             wz.fill(wi32[2]);
-            batch::eval(
+            batch::eval_with(
                 brdf,
+                isa,
                 &batch::Dirs {
                     wi: [&wx[..], &wy[..], &wz[..]],
                     wo,
@@ -229,7 +242,7 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
                     rgb: [&mut r[..], &mut g[..], &mut b[..]],
                 },
             );
-            post_band([&r[..], &g[..], &b[..]], wo, vals, pos, opts)
+            post_band([&r[..], &g[..], &b[..]], wo, vals, pos, rad, opts, isa)
         })
     };
     let both_max = |a: (f32, f32), b: (f32, f32)| (a.0.max(b.0), a.1.max(b.1));
@@ -237,26 +250,31 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
         values
             .par_chunks_mut(band * n_phi)
             .zip(positions.par_chunks_mut(band * n_phi))
+            .zip(radii.par_chunks_mut(band * n_phi))
             .enumerate()
             .map(|(b, rows)| fill(b * band, rows))
             .reduce(|| (0.0, 0.0), both_max)
     } else {
-        fill(0, (&mut values[..], &mut positions[..]))
+        fill(0, ((&mut values[..], &mut positions[..]), &mut radii[..]))
     };
 
     grid_normals(
         &positions,
+        &radii,
         &mut normals,
         n_theta,
         n_phi,
+        band,
         parallel,
         &grid.dirs,
+        isa,
     );
     let max_value = max_mean as f64;
     let max_radius = max_r2.sqrt() as f64;
 
     *mesh = LobeMesh {
         positions,
+        radii,
         normals,
         values,
         indices,
@@ -268,6 +286,9 @@ pub fn build_into(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
         deltas: brdf.deltas(wi),
     };
 }
+
+/// One band's values, positions and radii, as the parallel iterator zips them.
+type BandOut<'a> = ((&'a mut [[f32; 3]], &'a mut [[f32; 3]]), &'a mut [f32]);
 
 /// Two triangles per grid cell; the φ seam wraps. θ grows away from the pole
 /// and φ counter-clockwise about +z, so `(a, c, d)` faces outwards.
@@ -300,14 +321,19 @@ fn grid_indices(n_theta: usize, n_phi: usize, parallel: bool) -> Vec<u32> {
 /// along θ and along φ (`∂P/∂θ × ∂P/∂φ` points outwards, as `sinθ e_r` does on a
 /// sphere). On a pole ring, where `∂P/∂φ` vanishes, the normal is the sum of the
 /// fan of triangles around it. A vertex with no area around it (a collapsed
-/// lobe) gets its grid direction, so shading never sees a NaN.
+/// lobe) gets its grid direction, so shading never sees a NaN. Rows are
+/// handed out `band` at a time when `parallel`.
+#[allow(clippy::too_many_arguments)]
 fn grid_normals(
     positions: &[[f32; 3]],
+    radii: &[f32],
     normals: &mut [[f32; 3]],
     n_theta: usize,
     n_phi: usize,
+    band: usize,
     parallel: bool,
-    fallback: &[Vec<f32>; 3],
+    dirs: &[Vec<f32>; 3],
+    isa: Isa,
 ) {
     let p = |i: usize, j: usize| Vec3::from_array(positions[i * n_phi + j]);
     let fan = |i: usize, next: usize| {
@@ -337,7 +363,7 @@ fn grid_normals(
         };
         let fb = |j: usize| {
             let k = i * n_phi + j;
-            [fallback[0][k], fallback[1][k], fallback[2][k]]
+            [dirs[0][k], dirs[1][k], dirs[2][k]]
         };
         // A vertex with no area around it gets its grid direction.
         let unit = |n: [f32; 3], j: usize| {
@@ -356,42 +382,43 @@ fn grid_normals(
             }
             return;
         }
-        // Central differences along θ (rows; one-sided at the last row) and
-        // φ (columns; the seam wraps): (down − up) × (right − left).
-        let up = row(if i == 0 { 0 } else { i - 1 });
-        let down = row(if i == n_theta { i } else { i + 1 });
-        let cur = row(i);
+        // Central differences along θ (rows; one-sided at the first and last
+        // rows) and φ (columns; the seam wraps): (down − up) × (right − left).
+        let i_up = if i == 0 { 0 } else { i - 1 };
+        let i_down = if i == n_theta { i } else { i + 1 };
+        let (up, down, cur) = (row(i_up), row(i_down), row(i));
         let normal = |j: usize, left: usize, right: usize| {
             let a = sub(down[j], up[j]);
             let b = sub(cur[right], cur[left]);
             unit(cross(a, b), j)
         };
         out[0] = normal(0, n_phi - 1, 1 % n_phi);
-        // The interior columns as one straight loop over slices, compiled
-        // for the CPU's vector width (see `InteriorNormals`).
-        let k0 = i * n_phi;
-        pulp::Arch::new().dispatch(InteriorNormals {
-            up,
-            cur,
-            down,
-            fallback: [
-                &fallback[0][k0..k0 + n_phi],
-                &fallback[1][k0..k0 + n_phi],
-                &fallback[2][k0..k0 + n_phi],
-            ],
-            out,
-        });
+        // The interior columns in vectors (see `InteriorNormals`).
+        batch::run_task(
+            isa,
+            InteriorNormals {
+                radii,
+                dirs: [&dirs[0][..], &dirs[1][..], &dirs[2][..]],
+                up: i_up * n_phi,
+                cur: i * n_phi,
+                down: i_down * n_phi,
+                out: &mut *out,
+            },
+        );
         out[n_phi - 1] = normal(n_phi - 1, n_phi - 2, 0);
+    };
+    let rows_of = |first: usize, out: &mut [[f32; 3]]| {
+        for (r, o) in out.chunks_mut(n_phi).enumerate() {
+            normal_row(first + r, o);
+        }
     };
     if parallel {
         normals
-            .par_chunks_mut(n_phi)
+            .par_chunks_mut(band * n_phi)
             .enumerate()
-            .for_each(|(i, out)| normal_row(i, out));
+            .for_each(|(b, out)| rows_of(b * band, out));
     } else {
-        for (i, out) in normals.chunks_mut(n_phi).enumerate() {
-            normal_row(i, out);
-        }
+        rows_of(0, normals);
     }
 }
 
@@ -401,23 +428,29 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<[Vec<f32>; 6]> = Default::default();
 }
 
-/// Values, positions and the band's largest mean and squared radius from
-/// the evaluated `rgb` of directions `wo` (see [`PostRows`]; the log scale
-/// is applied after it, per vertex in f64).
+/// Values, positions, radii and the band's largest mean and squared radius
+/// from the evaluated `rgb` of directions `wo` (see [`PostBand`]; the log
+/// scale is applied after it, per vertex in f64).
 fn post_band(
     rgb: [&[f32]; 3],
     wo: [&[f32]; 3],
     vals: &mut [[f32; 3]],
     pos: &mut [[f32; 3]],
+    radii: &mut [f32],
     opts: &LobeOptions,
+    isa: Isa,
 ) -> (f32, f32) {
-    let (max_mean, mut max_r2) = pulp::Arch::new().dispatch(PostRows {
-        rgb,
-        wo,
-        vals: &mut *vals,
-        pos: &mut *pos,
-        cosine: opts.cosine,
-    });
+    let (max_mean, mut max_r2) = batch::run_task(
+        isa,
+        PostBand {
+            rgb,
+            wo,
+            vals: &mut *vals,
+            pos: &mut *pos,
+            radii: &mut *radii,
+            cosine: opts.cosine,
+        },
+    );
     // The log scale's ln(1 + f) is f64 in `RadiusScale::apply`: its radii
     // replace the linear ones (the channel means) here.
     if let RadiusScale::Log = opts.scale {
@@ -426,6 +459,7 @@ fn post_band(
             let mean = (vals[k][0] + vals[k][1] + vals[k][2]) * (1.0 / 3.0);
             let rad = opts.scale.apply(mean.max(0.0) as f64) as f32;
             *p = [wo[0][k] * rad, wo[1][k] * rad, wo[2][k] * rad];
+            radii[k] = rad;
             max_r2 = max_r2.max(rad * rad);
         }
     }
@@ -434,105 +468,191 @@ fn post_band(
 
 /// The per-vertex pass after evaluation, over one band of rows: the cosine
 /// factor if asked, non-finite values shown as 0, the channel mean as the
-/// (linear) radius, and the band's largest mean and squared radius. A
-/// `pulp::WithSimd` operation, so that its loop is compiled for AVX-512 or
-/// AVX2 where the CPU has them; the maxima are kept in 16 independent lanes
-/// so that the reduction vectorises too.
-struct PostRows<'a> {
+/// (linear) radius, and the band's largest mean and squared radius.
+/// Written against [`Lanes`] (a [`LaneTask`]): LLVM left the same pass as a
+/// scalar loop scalar on AVX2 (a third of a Lambert lobe's time there).
+struct PostBand<'a> {
     rgb: [&'a [f32]; 3],
     wo: [&'a [f32]; 3],
     vals: &'a mut [[f32; 3]],
     pos: &'a mut [[f32; 3]],
+    radii: &'a mut [f32],
     cosine: bool,
 }
 
-/// Lanes of the running maxima in [`PostRows`].
-const MAX_LANES: usize = 16;
-
-impl pulp::WithSimd for PostRows<'_> {
+impl LaneTask for PostBand<'_> {
     type Output = (f32, f32);
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) -> (f32, f32) {
-        let n = self.vals.len().min(self.pos.len());
-        let [r, g, b] = self.rgb.map(|a| &a[..n]);
-        let [x, y, z] = self.wo.map(|a| &a[..n]);
-        let (vals, pos) = (&mut self.vals[..n], &mut self.pos[..n]);
-        let (mut mm, mut mr) = ([0f32; MAX_LANES], [0f32; MAX_LANES]);
-        for k in 0..n {
-            let c = if self.cosine { z[k].abs() } else { 1.0 };
-            let f = [r[k] * c, g[k] * c, b[k] * c];
-            // A model bug must not poison the whole mesh: show it as 0 here;
-            // the property analysis reports non-finite values loudly.
-            let finite = f[0].abs() < f32::INFINITY
-                && f[1].abs() < f32::INFINITY
-                && f[2].abs() < f32::INFINITY;
-            let f = if finite { f } else { [0.0; 3] };
-            let mean = (f[0] + f[1] + f[2]) * (1.0 / 3.0);
-            let mean = if mean > 0.0 { mean } else { 0.0 };
-            let p = [x[k] * mean, y[k] * mean, z[k] * mean];
-            vals[k] = f;
-            pos[k] = p;
-            // Running maxima in MAX_LANES independent slots, one per lane
-            // of a vector.
-            let l = k % MAX_LANES;
-            let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
-            mm[l] = if mean > mm[l] { mean } else { mm[l] };
-            mr[l] = if r2 > mr[l] { r2 } else { mr[l] };
+    fn run<V: Lanes>(mut self) -> (f32, f32) {
+        let n = self.vals.len().min(self.pos.len()).min(self.radii.len());
+        let whole = n - n % V::LANES;
+        let (mut mm, mut mr) = (V::splat(0.0), V::splat(0.0));
+        let mut k = 0;
+        while k < whole {
+            self.lanes::<V>(k, &mut mm, &mut mr);
+            k += V::LANES;
         }
-        let max = |a: [f32; MAX_LANES]| a.into_iter().fold(0f32, f32::max);
-        (max(mm), max(mr))
+        // The remainder one lane at a time.
+        let (mut m1, mut r1) = (0f32, 0f32);
+        while k < n {
+            self.lanes::<f32>(k, &mut m1, &mut r1);
+            k += 1;
+        }
+        let mut a = [[0f32; 16]; 2];
+        mm.store(&mut a[0]);
+        mr.store(&mut a[1]);
+        let lanes = V::LANES;
+        (
+            a[0][..lanes].iter().fold(m1, |x, &y| x.max(y)),
+            a[1][..lanes].iter().fold(r1, |x, &y| x.max(y)),
+        )
+    }
+}
+
+impl PostBand<'_> {
+    /// Vertices `k .. k + V::LANES`; the running maxima per lane in `mm`
+    /// (means) and `mr` (squared radii).
+    #[inline(always)]
+    fn lanes<V: Lanes>(&mut self, k: usize, mm: &mut V, mr: &mut V) {
+        // No closures here: a closure is not compiled with the instruction
+        // set of the function it is in, and LLVM left the vector intrinsics
+        // inside them as calls (3× slower than the scalar loop).
+        let zero = V::splat(0.0);
+        let wo = [
+            load_at::<V>(self.wo[0], k),
+            load_at::<V>(self.wo[1], k),
+            load_at::<V>(self.wo[2], k),
+        ];
+        let c = if self.cosine {
+            wo[2].abs()
+        } else {
+            V::splat(1.0)
+        };
+        let f = [
+            load_at::<V>(self.rgb[0], k) * c,
+            load_at::<V>(self.rgb[1], k) * c,
+            load_at::<V>(self.rgb[2], k) * c,
+        ];
+        // A model bug must not poison the whole mesh: show it as 0 here;
+        // the property analysis reports non-finite values loudly.
+        let finite = f[0].is_finite() & f[1].is_finite() & f[2].is_finite();
+        let f = [
+            V::select(finite, f[0], zero),
+            V::select(finite, f[1], zero),
+            V::select(finite, f[2], zero),
+        ];
+        let mean = (f[0] + f[1] + f[2]) * (1.0 / 3.0);
+        let mean = V::select(mean.gt(zero), mean, zero);
+        let p = [wo[0] * mean, wo[1] * mean, wo[2] * mean];
+        let r2 = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+        *mm = V::select(mean.gt(*mm), mean, *mm);
+        *mr = V::select(r2.gt(*mr), r2, *mr);
+        mean.store(&mut self.radii[k..]);
+        // The mesh's arrays are [x, y, z] per vertex: through lane buffers.
+        let mut t = [[0f32; 16]; 6];
+        f[0].store(&mut t[0]);
+        f[1].store(&mut t[1]);
+        f[2].store(&mut t[2]);
+        p[0].store(&mut t[3]);
+        p[1].store(&mut t[4]);
+        p[2].store(&mut t[5]);
+        let vals = &mut self.vals[k..k + V::LANES];
+        let pos = &mut self.pos[k..k + V::LANES];
+        for (l, (v, p)) in vals.iter_mut().zip(pos).enumerate() {
+            *v = [t[0][l], t[1][l], t[2][l]];
+            *p = [t[3][l], t[4][l], t[5][l]];
+        }
     }
 }
 
 /// Normals of one row's interior columns `1..n_phi − 1` from the rows above
 /// and below (`(down − up) × (right − left)`, normalised; the grid direction
-/// where that vanishes), as a `pulp::WithSimd` operation like [`PostRows`].
+/// where that vanishes). The positions are rebuilt as radius × direction
+/// from the structure-of-arrays `radii` and `dirs` (the same f32 products
+/// that made the mesh's positions), so neighbours are whole vector loads.
 struct InteriorNormals<'a> {
-    up: &'a [[f32; 3]],
-    cur: &'a [[f32; 3]],
-    down: &'a [[f32; 3]],
-    fallback: [&'a [f32]; 3],
+    radii: &'a [f32],
+    dirs: [&'a [f32]; 3],
+    /// First vertex of the row above, of this row, and of the row below.
+    up: usize,
+    cur: usize,
+    down: usize,
+    /// This row's normals.
     out: &'a mut [[f32; 3]],
 }
 
-impl pulp::WithSimd for InteriorNormals<'_> {
+impl LaneTask for InteriorNormals<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _simd: S) {
+    fn run<V: Lanes>(mut self) {
         let n = self.out.len();
         if n < 3 {
             return;
         }
-        let m = n - 2;
-        let (up, down) = (&self.up[1..n - 1], &self.down[1..n - 1]);
-        let (left, right) = (&self.cur[..m], &self.cur[2..]);
-        let [fx, fy, fz] = self.fallback.map(|a| &a[1..n - 1]);
-        let out = &mut self.out[1..n - 1];
-        for j in 0..m {
-            let a = sub(down[j], up[j]);
-            let b = sub(right[j], left[j]);
-            let c = cross(a, b);
-            let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-            let inv = 1.0 / l;
-            let ok = l > 1e-20 && l < f32::INFINITY;
-            out[j] = if ok {
-                [c[0] * inv, c[1] * inv, c[2] * inv]
-            } else {
-                [fx[j], fy[j], fz[j]]
-            };
+        let mut j = 1;
+        while j + V::LANES < n {
+            self.lanes::<V>(j);
+            j += V::LANES;
+        }
+        while j + 1 < n {
+            self.lanes::<f32>(j);
+            j += 1;
         }
     }
 }
 
+impl InteriorNormals<'_> {
+    /// Columns `j .. j + V::LANES` (all of them in `1..n_phi − 1`).
+    #[inline(always)]
+    fn lanes<V: Lanes>(&mut self, j: usize) {
+        // No closures here (see `PostBand::lanes`).
+        let (r, d) = (self.radii, self.dirs);
+        let k = self.cur + j;
+        let a = sub(
+            position::<V>(r, d, self.down + j),
+            position::<V>(r, d, self.up + j),
+        );
+        let b = sub(position::<V>(r, d, k + 1), position::<V>(r, d, k - 1));
+        let c = cross(a, b);
+        let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+        let inv = V::splat(1.0) / l;
+        let ok = l.gt(V::splat(1e-20)) & l.lt(V::splat(f32::INFINITY));
+        let mut t = [[0f32; 16]; 3];
+        V::select(ok, c[0] * inv, load_at::<V>(d[0], k)).store(&mut t[0]);
+        V::select(ok, c[1] * inv, load_at::<V>(d[1], k)).store(&mut t[1]);
+        V::select(ok, c[2] * inv, load_at::<V>(d[2], k)).store(&mut t[2]);
+        for (l, o) in self.out[j..j + V::LANES].iter_mut().enumerate() {
+            *o = [t[0][l], t[1][l], t[2][l]];
+        }
+    }
+}
+
+/// The lanes `a[k..k + V::LANES]`.
 #[inline(always)]
-fn sub(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+fn load_at<V: Lanes>(a: &[f32], k: usize) -> V {
+    V::load(&a[k..])
+}
+
+/// The positions `radius · direction` of vertices `k..k + V::LANES`.
+#[inline(always)]
+fn position<V: Lanes>(radii: &[f32], dirs: [&[f32]; 3], k: usize) -> [V; 3] {
+    let r = load_at::<V>(radii, k);
+    [
+        load_at::<V>(dirs[0], k) * r,
+        load_at::<V>(dirs[1], k) * r,
+        load_at::<V>(dirs[2], k) * r,
+    ]
+}
+
+#[inline(always)]
+fn sub<V: Lanes>(a: [V; 3], b: [V; 3]) -> [V; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 #[inline(always)]
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+fn cross<V: Lanes>(a: [V; 3], b: [V; 3]) -> [V; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -663,6 +783,153 @@ mod tests {
                         "{id} {k}: {v:?} vs {want}"
                     );
                 }
+            }
+        }
+    }
+
+    /// `f` with non-finite values in places (NaN for x > 0.5, +∞ in green
+    /// for y > 0.6) and a smooth lobe elsewhere.
+    #[derive(Debug)]
+    struct Poisoned;
+
+    impl Brdf for Poisoned {
+        fn id(&self) -> &'static str {
+            "poisoned"
+        }
+        fn eval(&self, _wi: DVec3, wo: DVec3) -> crate::Rgb {
+            if wo.x > 0.5 {
+                return crate::Rgb::splat(f64::NAN);
+            }
+            let v = (1.0 + wo.x) * (1.0 + wo.z * wo.z);
+            crate::Rgb::new(v, if wo.y > 0.6 { f64::INFINITY } else { 2.0 * v }, -v)
+        }
+        fn claims(&self) -> crate::Claims {
+            crate::Claims {
+                reciprocal: false,
+                energy_conserving: false,
+                isotropic: false,
+            }
+        }
+    }
+
+    #[test]
+    fn every_instruction_set_builds_the_mesh_of_the_formulas() {
+        // Every path's vector passes (values to radii and positions, then the
+        // normals) against the per-vertex formulas written out here in f64:
+        // value f·|cos θo| or f, 0 where any channel is not finite, radius the
+        // clamped channel mean (or ln(1 + mean)), position radius · direction,
+        // normal the normalised (down − up) × (right − left) of the positions.
+        // Sizes cover remainders of every vector width, the one-task and the
+        // parallel builds.
+        let wi = frame::from_spherical(0.6, 0.3);
+        let ct = crate::ModelSpec::new("cook-torrance")
+            .unwrap()
+            .build()
+            .unwrap();
+        let dielectric = crate::ModelSpec::new("rough-dielectric")
+            .unwrap()
+            .build()
+            .unwrap();
+        let models: [(&str, &dyn Brdf); 3] = [
+            ("cook-torrance", ct.as_ref()),
+            ("rough-dielectric", dielectric.as_ref()),
+            ("poisoned", &Poisoned),
+        ];
+        // `available` ends with the scalar path.
+        for isa in Isa::available() {
+            for (name, b) in models {
+                for (n_theta, n_phi, cosine, scale) in [
+                    (2, 3, false, RadiusScale::Linear),
+                    (7, 21, true, RadiusScale::Linear),
+                    (9, 37, false, RadiusScale::Log),
+                    (40, 133, true, RadiusScale::Linear),
+                    (33, 256, false, RadiusScale::Log),
+                ] {
+                    let opts = LobeOptions {
+                        n_theta,
+                        n_phi,
+                        cosine,
+                        scale,
+                    };
+                    let mut m = LobeMesh::default();
+                    build_with(b, wi, &opts, &mut m, isa);
+                    let at = format!("{name} {n_theta}×{n_phi} {isa:?} cosine {cosine} {scale:?}");
+                    check_against_formulas(b, wi, &opts, &m, &at);
+                }
+            }
+        }
+    }
+
+    fn check_against_formulas(b: &dyn Brdf, wi: DVec3, opts: &LobeOptions, m: &LobeMesh, at: &str) {
+        let (n_theta, n_phi) = (opts.n_theta, opts.n_phi);
+        let wi32 = wi.as_vec3().as_dvec3();
+        let close =
+            |got: f64, want: f64, rel: f64| (got - want).abs() <= (rel * want.abs()).max(1e-6);
+        let mut max_mean = 0f64;
+        for i in 0..=n_theta {
+            for j in 0..n_phi {
+                let k = i * n_phi + j;
+                let d = m.direction(i, j).as_vec3().as_dvec3();
+                let mut f = b.eval(wi32, d);
+                if opts.cosine {
+                    f *= d.z.abs();
+                }
+                if !(0..3).all(|c| f[c].is_finite()) {
+                    f = crate::Rgb::splat(0.0);
+                }
+                let v = m.values[k];
+                for c in 0..3 {
+                    assert!(
+                        close(v[c] as f64, f[c], 1e-4),
+                        "{at}: value {k} {v:?} vs {f}"
+                    );
+                }
+                let mean = ((f[0] + f[1] + f[2]) / 3.0).max(0.0);
+                max_mean = max_mean.max(mean);
+                let r = match opts.scale {
+                    RadiusScale::Linear => mean,
+                    RadiusScale::Log => mean.ln_1p(),
+                };
+                assert!(
+                    close(m.radii[k] as f64, r, 1e-4),
+                    "{at}: radius {k}: {} vs {r}",
+                    m.radii[k]
+                );
+                let p = m.positions[k];
+                for c in 0..3 {
+                    let want = d[c] * r;
+                    assert!(
+                        (p[c] as f64 - want).abs() <= 1e-4 * r.abs() + 1e-6,
+                        "{at}: position {k} {p:?} vs {}",
+                        d * r
+                    );
+                }
+            }
+        }
+        assert!(
+            close(m.max_value, max_mean, 1e-4),
+            "{at}: max {} vs {max_mean}",
+            m.max_value
+        );
+        // Normals from the mesh's own positions, away from the poles (their
+        // fans are tested elsewhere).
+        let p = |i: usize, j: usize| Vec3::from_array(m.positions[i * n_phi + j]).as_dvec3();
+        for i in 1..n_theta {
+            for j in 0..n_phi {
+                let (l, r) = ((j + n_phi - 1) % n_phi, (j + 1) % n_phi);
+                let n = (p(i + 1, j) - p(i - 1, j)).cross(p(i, r) - p(i, l));
+                let got = Vec3::from_array(m.normals[i * n_phi + j]).as_dvec3();
+                let want = if n.length() > 1e-12 {
+                    n.normalize()
+                } else if n.length() > 1e-20 {
+                    continue; // too short to compare in f32
+                } else {
+                    m.direction(i, j)
+                };
+                assert!(
+                    (got - want).length() < 1e-3,
+                    "{at}: normal ({i}, {j}) {got} vs {want}"
+                );
             }
         }
     }

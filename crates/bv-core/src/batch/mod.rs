@@ -16,7 +16,9 @@
 //! a time, so every caller can use the batch path for every model. The f64
 //! `eval` stays the reference: the parity test (`tests/batch_parity.rs`)
 //! holds each kernel, on every instruction set this machine has, within
-//! 1e-4 relative or 1e-6 absolute of it.
+//! 1e-4 relative or 1e-6 absolute of it. Work around the kernels that is
+//! worth vectors too (the lobe mesh's per-vertex pass and normals) is a
+//! [`LaneTask`], compiled per instruction set by [`run_task`] the same way.
 //!
 //! # Why explicit vectors, and why our own
 //!
@@ -225,6 +227,38 @@ pub fn run<K: LaneKernel>(k: &K, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
         #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
         Isa::Simd128 => wasm::run_simd128(k, dirs, out),
         _ => lanes_loop::<f32, K>(k, dirs, out),
+    }
+}
+
+/// Work other than a model's kernel written once against [`Lanes`] (a lobe
+/// mesh's per-vertex pass, its normals): [`run_task`] compiles `run` once
+/// per instruction set, like a [`LaneKernel`], so the loop is vector code on
+/// every CPU rather than whatever the auto-vectoriser makes of a scalar loop.
+pub trait LaneTask {
+    /// What the work returns.
+    type Output;
+    /// Does the work with vectors of `V` (whole vectors of `V::LANES`; a
+    /// remainder is the task's to handle, e.g. through `f32`'s one lane).
+    fn run<V: Lanes>(self) -> Self::Output;
+}
+
+/// Runs `task` with the instruction set `isa` (or [`Isa::best`] if this CPU
+/// lacks it).
+#[inline]
+pub fn run_task<T: LaneTask>(isa: Isa, task: T) -> T::Output {
+    let isa = if isa.is_available() { isa } else { Isa::best() };
+    match isa {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `is_available` saw AVX-512F, AVX2 and FMA on this CPU.
+        Isa::Avx512 => unsafe { x86::task_avx512(task) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `is_available` saw AVX2 and FMA on this CPU.
+        Isa::Avx2 => unsafe { x86::task_avx2(task) },
+        #[cfg(target_arch = "aarch64")]
+        Isa::Neon => neon::task_neon(task),
+        #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+        Isa::Simd128 => wasm::task_simd128(task),
+        _ => task.run::<f32>(),
     }
 }
 

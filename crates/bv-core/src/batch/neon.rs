@@ -3,7 +3,7 @@
 //! AArch64 CPU that runs Rust's `aarch64-*` targets has it.
 
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, Out};
+use super::{Dirs, LaneKernel, LaneTask, Out};
 use std::arch::aarch64::*;
 
 /// Four f32 lanes in a 128-bit NEON register.
@@ -165,4 +165,9 @@ impl Lanes for Neon {
 /// The lane loop of `k` in NEON code.
 pub(super) fn run_neon<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     super::lanes_loop::<Neon, K>(k, dirs, out);
+}
+
+/// `task` in NEON code.
+pub(super) fn task_neon<T: LaneTask>(task: T) -> T::Output {
+    task.run::<Neon>()
 }

@@ -6,7 +6,7 @@
 //! SIMD).
 
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, Out};
+use super::{Dirs, LaneKernel, LaneTask, Out};
 use std::arch::wasm32::*;
 
 /// Four f32 lanes in a `v128`.
@@ -165,4 +165,9 @@ impl Lanes for Simd128 {
 /// The lane loop of `k` in `simd128` code.
 pub(super) fn run_simd128<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     super::lanes_loop::<Simd128, K>(k, dirs, out);
+}
+
+/// `task` in `simd128` code.
+pub(super) fn task_simd128<T: LaneTask>(task: T) -> T::Output {
+    task.run::<Simd128>()
 }

@@ -9,7 +9,7 @@
 //! make one.
 
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, Out};
+use super::{Dirs, LaneKernel, LaneTask, Out};
 use std::arch::x86_64::*;
 
 // ---------------------------------------------------------------------------
@@ -194,6 +194,15 @@ impl Lanes for Avx2 {
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     super::lanes_loop::<Avx2, K>(k, dirs, out);
+}
+
+/// `task` in AVX2 + FMA code.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn task_avx2<T: LaneTask>(task: T) -> T::Output {
+    task.run::<Avx2>()
 }
 
 // ---------------------------------------------------------------------------
@@ -407,4 +416,13 @@ impl Lanes for Avx512 {
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     super::lanes_loop::<Avx512, K>(k, dirs, out);
+}
+
+/// `task` in AVX-512F code.
+///
+/// # Safety
+/// The CPU must have AVX-512F, AVX2 and FMA.
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn task_avx512<T: LaneTask>(task: T) -> T::Output {
+    task.run::<Avx512>()
 }
