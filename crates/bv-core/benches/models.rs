@@ -238,6 +238,7 @@ fn batch_eval(c: &mut Criterion) {
 
 fn lobes(c: &mut Criterion) {
     let wi = frame::from_spherical(45f64.to_radians(), 0.3);
+    let wi_plane = frame::from_spherical(45f64.to_radians(), 0.0);
     let mut g = c.benchmark_group("lobe");
     g.warm_up_time(Duration::from_millis(300));
     g.measurement_time(Duration::from_secs(1));
@@ -263,6 +264,18 @@ fn lobes(c: &mut Criterion) {
                     black_box(&mesh);
                 })
             });
+            // The same with the light in the xz-plane (φi = 0, where the
+            // sliders start): an isotropic model's rings are then evaluated
+            // half and mirrored (`lobe`'s `mirror_axis`).
+            g.bench_function(
+                format!("{name}/{n_theta}x{n_phi}/reuse-in-plane"),
+                |bench| {
+                    bench.iter(|| {
+                        lobe::build_into(b.as_ref(), black_box(wi_plane), &opts, &mut mesh);
+                        black_box(&mesh);
+                    })
+                },
+            );
         }
     }
     g.finish();

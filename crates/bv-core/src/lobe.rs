@@ -215,6 +215,10 @@ fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMes
     }
     // Rows per task: enough lanes per batch call to fill the vectors.
     let band = (2048 / n_phi).max(1);
+    // An isotropic model's lobe is symmetric about the plane of incidence;
+    // where that plane maps grid columns onto grid columns (see
+    // `mirror_axis`), half of each ring is evaluated and mirrored.
+    let mirror = mirror_axis(brdf, wi, n_phi);
     let fill = |first_row: usize, ((vals, pos), rad): BandOut<'_>| {
         let start = first_row * n_phi;
         let n = vals.len();
@@ -231,17 +235,49 @@ fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMes
             wx.fill(wi32[0]);
             wy.fill(wi32[1]);
             wz.fill(wi32[2]);
-            batch::eval_with(
-                brdf,
-                isa,
-                &batch::Dirs {
-                    wi: [&wx[..], &wy[..], &wz[..]],
-                    wo,
-                },
-                &mut Out {
-                    rgb: [&mut r[..], &mut g[..], &mut b[..]],
-                },
-            );
+            let eval = |at: std::ops::Range<usize>, [r, g, b]: [&mut [f32]; 3]| {
+                batch::eval_with(
+                    brdf,
+                    isa,
+                    &batch::Dirs {
+                        wi: [&wx[at.clone()], &wy[at.clone()], &wz[at.clone()]],
+                        wo: [&wo[0][at.clone()], &wo[1][at.clone()], &wo[2][at.clone()]],
+                    },
+                    &mut Out {
+                        rgb: [&mut r[at.clone()], &mut g[at.clone()], &mut b[at]],
+                    },
+                );
+            };
+            match mirror {
+                None => eval(0..n, [r, g, b]),
+                Some(m) => {
+                    // Per ring: the columns `first .. first + half` (mod
+                    // n_phi, so one or two runs), then the rest copied from
+                    // their mirror images `m − j`.
+                    let half = (n_phi / 2 + 2).min(n_phi);
+                    let first = m / 2;
+                    for ring in (0..n).step_by(n_phi) {
+                        let end = first + half;
+                        eval(ring + first..ring + end.min(n_phi), [r, g, b]);
+                        if end > n_phi {
+                            eval(ring..ring + end - n_phi, [r, g, b]);
+                        }
+                        // Columns `first + half ..` round to `first`, each
+                        // from its mirror column, one step back each time
+                        // (no division per column: this runs per vertex).
+                        let mut j = (first + half) % n_phi;
+                        let mut from = (m + n_phi - j) % n_phi;
+                        for _ in half..n_phi {
+                            debug_assert!((from + n_phi - first) % n_phi < half);
+                            r[ring + j] = r[ring + from];
+                            g[ring + j] = g[ring + from];
+                            b[ring + j] = b[ring + from];
+                            j = if j + 1 == n_phi { 0 } else { j + 1 };
+                            from = if from == 0 { n_phi - 1 } else { from - 1 };
+                        }
+                    }
+                }
+            }
             post_band([&r[..], &g[..], &b[..]], wo, vals, pos, rad, opts, isa)
         })
     };
@@ -285,6 +321,29 @@ fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut LobeMes
         max_radius,
         deltas: brdf.deltas(wi),
     };
+}
+
+/// The column `m` (in `0..n_phi`) such that column `j` of a ring mirrors
+/// column `m − j (mod n_phi)` across the plane of incidence, when `brdf`
+/// promises isotropy (a catalogue formula's claim: a file's observed claims
+/// are not trusted with this) and ωi's azimuth is a multiple of half a
+/// column step, π / n_phi (light in the xz-plane, φi = 0, is the common
+/// case). Then `f(ωi, ωo)` depends on φo only through |φo − φi|, and column
+/// `j`'s azimuth 2πj/n_phi mirrors to 2φi − 2πj/n_phi = 2π(m − j)/n_phi.
+fn mirror_axis(brdf: &dyn Brdf, wi: DVec3, n_phi: usize) -> Option<usize> {
+    if !(brdf.claims_declared() && brdf.claims().isotropic) {
+        return None;
+    }
+    // At normal incidence every plane through the normal is one.
+    if wi.x == 0.0 && wi.y == 0.0 {
+        return Some(0);
+    }
+    let s = wi.y.atan2(wi.x) * n_phi as f64 / PI;
+    let m = s.round();
+    if (s - m).abs() > 1e-9 || !m.is_finite() {
+        return None;
+    }
+    Some(m.rem_euclid(n_phi as f64) as usize % n_phi)
 }
 
 /// One band's values, positions and radii, as the parallel iterator zips them.
@@ -820,8 +879,16 @@ mod tests {
         // clamped channel mean (or ln(1 + mean)), position radius · direction,
         // normal the normalised (down − up) × (right − left) of the positions.
         // Sizes cover remainders of every vector width, the one-task and the
-        // parallel builds.
-        let wi = frame::from_spherical(0.6, 0.3);
+        // parallel builds; light directions where an isotropic model's rings
+        // are mirrored (φi = 0, π, odd and even multiples of π / n_phi,
+        // normal incidence) and where they are not.
+        let ward = crate::ModelSpec::from_json(
+            "ward",
+            &serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.4}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
         let ct = crate::ModelSpec::new("cook-torrance")
             .unwrap()
             .build()
@@ -830,9 +897,10 @@ mod tests {
             .unwrap()
             .build()
             .unwrap();
-        let models: [(&str, &dyn Brdf); 3] = [
+        let models: [(&str, &dyn Brdf); 4] = [
             ("cook-torrance", ct.as_ref()),
             ("rough-dielectric", dielectric.as_ref()),
+            ("anisotropic ward", ward.as_ref()),
             ("poisoned", &Poisoned),
         ];
         // `available` ends with the scalar path.
@@ -851,13 +919,47 @@ mod tests {
                         cosine,
                         scale,
                     };
-                    let mut m = LobeMesh::default();
-                    build_with(b, wi, &opts, &mut m, isa);
-                    let at = format!("{name} {n_theta}×{n_phi} {isa:?} cosine {cosine} {scale:?}");
-                    check_against_formulas(b, wi, &opts, &m, &at);
+                    let step = PI / n_phi as f64;
+                    for phi_i in [0.3, 0.0, PI, 3.0 * step, -4.0 * step] {
+                        for wi in [frame::from_spherical(0.6, phi_i), DVec3::Z] {
+                            let mut m = LobeMesh::default();
+                            build_with(b, wi, &opts, &mut m, isa);
+                            let at = format!(
+                                "{name} {n_theta}×{n_phi} {isa:?} cosine {cosine} {scale:?} wi {wi}"
+                            );
+                            check_against_formulas(b, wi, &opts, &m, &at);
+                        }
+                    }
                 }
             }
         }
+    }
+
+    #[test]
+    fn isotropic_rings_are_mirrored_where_the_plane_of_incidence_maps_columns() {
+        let ct = crate::ModelSpec::new("cook-torrance")
+            .unwrap()
+            .build()
+            .unwrap();
+        let n = 40;
+        let at = |phi: f64| frame::from_spherical(0.5, phi);
+        let step = PI / n as f64;
+        assert_eq!(mirror_axis(ct.as_ref(), at(0.0), n), Some(0));
+        assert_eq!(mirror_axis(ct.as_ref(), at(3.0 * step), n), Some(3));
+        assert_eq!(mirror_axis(ct.as_ref(), at(-4.0 * step), n), Some(36));
+        assert_eq!(mirror_axis(ct.as_ref(), at(PI), n), Some(0));
+        assert_eq!(mirror_axis(ct.as_ref(), DVec3::Z, n), Some(0));
+        assert_eq!(mirror_axis(ct.as_ref(), at(0.3), n), None);
+        // Not for a model that is not isotropic, nor for a file's claims.
+        let ward = crate::ModelSpec::from_json(
+            "ward",
+            &serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.4}),
+        )
+        .unwrap()
+        .build()
+        .unwrap();
+        assert_eq!(mirror_axis(ward.as_ref(), at(0.0), n), None);
+        assert_eq!(mirror_axis(&Poisoned, at(0.0), n), None);
     }
 
     fn check_against_formulas(b: &dyn Brdf, wi: DVec3, opts: &LobeOptions, m: &LobeMesh, at: &str) {
