@@ -75,6 +75,18 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// at every finite pair for delta models.
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb;
 
+    /// `f(wi, wo)` for a pair both above the surface whose unit half vector
+    /// `h = (wi + wo)/|wi + wo|` the caller has already (the albedo
+    /// quadrature integrates over `h` and forms `wo` from it): a model whose
+    /// `f` is built from `h` (a microfacet lobe's `D(h)`, `F(wi·h)`) may take
+    /// it from here instead of normalising `wi + wo` again. It must return
+    /// what [`Brdf::eval`] returns, to rounding (`h` may differ from the
+    /// normalised sum by a few ulp). Default: [`Brdf::eval`], ignoring `h`.
+    fn eval_with_half(&self, wi: DVec3, wo: DVec3, h: DVec3) -> Rgb {
+        let _ = h;
+        self.eval(wi, wo)
+    }
+
     /// What the model claims for its current parameters.
     fn claims(&self) -> Claims;
 

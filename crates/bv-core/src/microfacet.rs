@@ -56,6 +56,24 @@ pub fn beckmann_d(h: DVec3, ax: f64, ay: f64) -> f64 {
     (-e).exp() / (PI * ax * ay * z2 * z2)
 }
 
+/// [`beckmann_d`] from the reciprocal roughnesses `1/αx`, `1/αy` (precomputed
+/// by [`Scale`]): one division where the quotients take four, the same
+/// value to rounding.
+pub fn beckmann_d_inv(h: DVec3, inv_ax: f64, inv_ay: f64) -> f64 {
+    if h.z <= 0.0 {
+        return 0.0;
+    }
+    let z2 = h.z * h.z;
+    let (x, y) = (h.x * inv_ax, h.y * inv_ay);
+    let q = 1.0 / z2;
+    let e = (x * x + y * y) * q;
+    if e > 700.0 {
+        // As in `beckmann_d`.
+        return 0.0;
+    }
+    (-e).exp() * (inv_ax * inv_ay * FRAC_1_PI) * (q * q)
+}
+
 /// Anisotropic GGX / Trowbridge-Reitz distribution (Walter et al. 2007, eq. 33;
 /// Burley 2012, GTR2 anisotropic):
 /// `1 / (π αx αy cos⁴θh (1 + tan²θh (cos²φh/αx² + sin²φh/αy²))²)`, written as
@@ -399,7 +417,7 @@ impl Scale {
     /// D(h).
     pub fn d(&self, h: DVec3) -> f64 {
         match self.dist {
-            Distribution::Beckmann => beckmann_d(h, self.ax, self.ay),
+            Distribution::Beckmann => beckmann_d_inv(h, self.inv_ax, self.inv_ay),
             Distribution::Ggx => ggx_d_inv(h, self.inv_ax, self.inv_ay),
             Distribution::Blinn => blinn_d(h, self.ax, self.blinn_c),
         }
@@ -508,6 +526,30 @@ impl Microfacet {
             Geometry::VGroove => v_groove_g(wi, wo, h),
             Geometry::Smith => self.g1(wi) * self.g1(wo),
             Geometry::SmithCorrelated => 1.0 / (1.0 + self.lambda(wi) + self.lambda(wo)),
+        }
+    }
+
+    /// `G / (4 cos θi cos θo)`, the masking term `geometry` over the
+    /// microfacet reflection's denominator (Walter et al. 2007, eq. 20), for
+    /// `wi`, `wo` above the surface and `h` their unit half vector: one
+    /// division where `g(…) / (4 wi.z wo.z)` takes two or more (V-groove:
+    /// `min(1, 2 hz wz/(wo·h))` over the denominator is
+    /// `min(wo·h, 2 hz wi.z, 2 hz wo.z) / (4 (wo·h) wi.z wo.z)`). The same
+    /// value to rounding; 0 where [`Microfacet::g`] is.
+    #[inline]
+    pub fn g_over_cosines(&self, geometry: Geometry, wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
+        let den = 4.0 * wi.z * wo.z;
+        match geometry {
+            Geometry::VGroove => {
+                let oh = wo.dot(h);
+                if wi.z <= 0.0 || wo.z <= 0.0 || oh <= 0.0 || h.z <= 0.0 {
+                    return 0.0;
+                }
+                let k = 2.0 * h.z;
+                oh.min(k * wo.z).min(k * wi.z) / (oh * den)
+            }
+            Geometry::Smith => 1.0 / ((1.0 + self.lambda(wi)) * (1.0 + self.lambda(wo)) * den),
+            Geometry::SmithCorrelated => 1.0 / ((1.0 + self.lambda(wi) + self.lambda(wo)) * den),
         }
     }
 
@@ -835,6 +877,80 @@ pub(crate) mod tests {
         for m in cases {
             let s = hemisphere_integral(|h| m.d(h) * h.z, 256);
             assert!((s - 1.0).abs() < 1e-3, "{m:?}: ∫D cos = {s}");
+        }
+    }
+
+    /// Unit directions above the surface, a spiral from the normal to within
+    /// 1e-3 of the horizon.
+    fn upper_dirs(n: usize) -> Vec<DVec3> {
+        (0..n)
+            .map(|k| {
+                let z = 1.0 - (1.0 - 1e-3) * k as f64 / (n - 1) as f64;
+                let r = (1.0 - z * z).sqrt();
+                let phi = 2.399_963 * k as f64;
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn g_over_cosines_is_g_over_the_denominator() {
+        // The one-division form against `g(…) / (4 wi.z wo.z)` (each
+        // geometry's own formula), every distribution, anisotropic and
+        // mixed, over pairs from the normal to near grazing.
+        let ndfs = [
+            Microfacet::new(Distribution::Beckmann, 0.1, 0.6),
+            Microfacet::new(Distribution::Ggx, 0.3, 0.3),
+            Microfacet::new(Distribution::Blinn, 0.5, 0.5),
+            Microfacet::new(Distribution::Ggx, 0.2, 0.7).with_second_scale(0.05, 0.4),
+        ];
+        let dirs = upper_dirs(40);
+        for m in ndfs {
+            for geometry in [
+                Geometry::VGroove,
+                Geometry::Smith,
+                Geometry::SmithCorrelated,
+            ] {
+                for &wi in &dirs {
+                    for &wo in &dirs {
+                        let Some(h) = crate::frame::half_vector(wi, wo) else {
+                            continue;
+                        };
+                        let want = m.g(geometry, wi, wo, h) / (4.0 * wi.z * wo.z);
+                        let got = m.g_over_cosines(geometry, wi, wo, h);
+                        assert!(
+                            (got - want).abs() <= 1e-13 * want.abs(),
+                            "{m:?} {geometry:?} {wi} {wo}: {got:e} vs {want:e}"
+                        );
+                    }
+                }
+            }
+        }
+        // Zero where G is: a half vector the outgoing direction sees from
+        // behind.
+        let (wi, wo) = (DVec3::Z, DVec3::new(0.6, 0.0, 0.8));
+        let back = DVec3::new(-0.8, 0.0, 0.6);
+        let m = Microfacet::new(Distribution::Ggx, 0.3, 0.3);
+        assert_eq!(m.g_over_cosines(Geometry::VGroove, wi, wo, back), 0.0);
+    }
+
+    #[test]
+    fn beckmann_d_from_reciprocals_is_beckmann_d() {
+        for (ax, ay) in [(0.3, 0.3), (0.1, 0.6), (1.5, 0.02)] {
+            let s = Scale::new(Distribution::Beckmann, ax, ay);
+            for h in upper_dirs(200) {
+                let (got, want) = (s.d(h), beckmann_d(h, ax, ay));
+                // exp(−e) carries e's rounding (a few ulp of e) into its
+                // relative error: 1e-13 at e ≈ 430, near the horizon.
+                let e = ((h.x / ax).powi(2) + (h.y / ay).powi(2)) / (h.z * h.z);
+                assert!(
+                    (got - want).abs() <= 1e-15 * (8.0 + 4.0 * e) * want,
+                    "α ({ax}, {ay}) h {h}: {got:e} vs {want:e}"
+                );
+            }
+            // At the normal: 1/(π αx αy) (Walter et al. 2007, eq. 25).
+            assert!((s.d(DVec3::Z) * PI * ax * ay - 1.0).abs() < 1e-15);
+            assert_eq!(s.d(DVec3::new(1.0, 0.0, 0.0)), 0.0);
         }
     }
 

@@ -368,6 +368,37 @@ fn f_is_finite_and_non_negative() {
 }
 
 #[test]
+fn eval_with_half_is_eval() {
+    // `Brdf::eval_with_half` as the albedo quadrature calls it: `h` a unit
+    // half vector, `wo = 2 (wi·h) h − wi` (unit to rounding, not
+    // normalised), both above the surface. A model that overrides it must
+    // return `eval` of the same pair; 1e-8 relative leaves room for `h`'s
+    // rounding against the model's own `(wi + wo)/|wi + wo|` under the
+    // sharpest lobes of the ranges (α = 0.001), and none for a lost term.
+    let half = (0.0..1.0f64, 0.0..2.0 * PI).prop_map(|(z, p)| dir(z.max(1e-6), p));
+    for_every_model(
+        128,
+        (any::<u64>(), upper_dir(), half),
+        |m, (seed, wi, h)| {
+            let (spec, b) = random_model(m, seed);
+            let c = wi.dot(h);
+            let wo = 2.0 * c * h - wi;
+            if c <= 0.0 || wo.z <= 0.0 {
+                return Ok(());
+            }
+            let (got, want) = (b.eval_with_half(wi, wo, h), b.eval(wi, wo));
+            let scale = want.abs().max_element();
+            prop_assert!(
+                (got - want).abs().max_element() <= 1e-8 * scale,
+                "eval_with_half({wi}, {wo}, {h}) = {got} but eval = {want} for {}",
+                ctx(&spec)
+            );
+            Ok(())
+        },
+    );
+}
+
+#[test]
 fn reciprocal_where_claimed() {
     for_every_model(256, (any::<u64>(), pair()), |m, (seed, (wi, wo))| {
         let (spec, b) = random_model(m, seed);

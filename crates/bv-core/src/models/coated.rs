@@ -504,6 +504,15 @@ impl Brdf for Coated {
         Rgb::splat(self.eval_coat(wi, wo)) + self.eval_through(wi, wo)
     }
 
+    fn eval_with_half(&self, wi: DVec3, wo: DVec3, h: DVec3) -> Rgb {
+        if wi.z <= 0.0 || wo.z <= 0.0 || !(wi.is_finite() && wo.is_finite()) {
+            return Rgb::ZERO;
+        }
+        // The coat's reflection from the facet `h` (its eq. 20 in
+        // `rough-dielectric`), the base as in `eval`.
+        Rgb::splat(self.coat.reflection_at(wi, wo, h)) + self.eval_through(wi, wo)
+    }
+
     fn claims(&self) -> Claims {
         Claims {
             // Every factor is symmetric under wi ↔ wo: eq. 20 of the coat,

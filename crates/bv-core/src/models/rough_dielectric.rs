@@ -301,6 +301,9 @@ impl RoughDielectric {
         let Some((h, transmits)) = self.facet(wi, wo) else {
             return 0.0;
         };
+        if !transmits {
+            return self.reflection_at(wi, wo, h);
+        }
         let d = self.ndf.d(h);
         if d == 0.0 {
             return 0.0;
@@ -310,15 +313,33 @@ impl RoughDielectric {
         // Exact dielectric F for light arriving at the facet from wi's side
         // (a negative cosine: from inside, index 1/eta); 1 under TIR.
         let f = fresnel::dielectric(ci, self.eta);
-        let v = if transmits {
-            // Eq. 21.
-            let (ei, eo) = (self.eta_of(wi), self.eta_of(wo));
-            let den = ei * ci + eo * co;
-            (ci * co).abs() * eo * eo * (1.0 - f) * d * g / ((wi.z * wo.z).abs() * den * den)
-        } else {
-            // Eq. 20.
-            f * d * g / (4.0 * (wi.z * wo.z).abs())
-        };
+        // Eq. 21.
+        let (ei, eo) = (self.eta_of(wi), self.eta_of(wo));
+        let den = ei * ci + eo * co;
+        let v = (ci * co).abs() * eo * eo * (1.0 - f) * d * g / ((wi.z * wo.z).abs() * den * den);
+        if v.is_finite() { v.max(0.0) } else { 0.0 }
+    }
+
+    /// The reflection (eq. 20, without the tint) of a pair on one side whose
+    /// microfacet normal `h` (unit, towards +z: `±(wi + wo)/|wi + wo|`) the
+    /// caller has: [`RoughDielectric::eval_scalar`]'s reflected branch, and
+    /// [`Brdf::eval_with_half`]'s (the albedo quadrature's half vector) for
+    /// this model and `coated`'s coat. 0 where a direction sees the facet
+    /// from behind (χ⁺).
+    pub(crate) fn reflection_at(&self, wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
+        let (ci, co) = (wi.dot(h), wo.dot(h));
+        if !(h.z > 0.0 && ci * wi.z > 0.0 && co * wo.z > 0.0) {
+            return 0.0;
+        }
+        let d = self.ndf.d(h);
+        if d == 0.0 {
+            return 0.0;
+        }
+        let g = self.g(wi, wo, false);
+        // Exact dielectric F for light arriving at the facet from wi's side
+        // (a negative cosine: from inside, index 1/eta); 1 under TIR.
+        let f = fresnel::dielectric(ci, self.eta);
+        let v = f * d * g / (4.0 * (wi.z * wo.z).abs());
         if v.is_finite() { v.max(0.0) } else { 0.0 }
     }
 
@@ -373,6 +394,14 @@ impl Brdf for RoughDielectric {
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
         self.tint * self.eval_scalar(wi, wo)
+    }
+
+    fn eval_with_half(&self, wi: DVec3, wo: DVec3, h: DVec3) -> Rgb {
+        if wi.z > 0.0 && wo.z > 0.0 {
+            self.tint * self.reflection_at(wi, wo, h)
+        } else {
+            self.eval(wi, wo)
+        }
     }
 
     fn claims(&self) -> Claims {
