@@ -11,11 +11,12 @@
 
 mod common;
 use bv_core::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, PairBuf};
+use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
 use bv_core::sampling::{self, BvRng};
 use bv_core::{Brdf, Claims, ModelSpec, Rgb, catalogue};
 use common::random_float;
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rand::Rng;
 use std::f64::consts::PI;
 
@@ -690,6 +691,164 @@ fn lane_math_matches_f64_on_every_path() {
                     "[{isa}] {f:?}({x}, {y}) = {got:e}, want {want:e}"
                 );
             }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Lobe meshes: the vector passes after evaluation (`lobe`'s `LaneTask`s) on
+// every instruction set, here so that the NEON and wasm runs of this test
+// hold them too.
+
+/// `f` with non-finite values in places (NaN for x > 0.5, +∞ in green
+/// for y > 0.6) and a smooth lobe elsewhere.
+#[derive(Debug)]
+struct Poisoned;
+
+impl Brdf for Poisoned {
+    fn id(&self) -> &'static str {
+        "poisoned"
+    }
+    fn eval(&self, _wi: DVec3, wo: DVec3) -> Rgb {
+        if wo.x > 0.5 {
+            return Rgb::splat(f64::NAN);
+        }
+        let v = (1.0 + wo.x) * (1.0 + wo.z * wo.z);
+        Rgb::new(v, if wo.y > 0.6 { f64::INFINITY } else { 2.0 * v }, -v)
+    }
+    fn claims(&self) -> Claims {
+        Claims {
+            reciprocal: false,
+            energy_conserving: false,
+            isotropic: false,
+        }
+    }
+}
+
+#[test]
+fn lobe_meshes_of_every_instruction_set_follow_the_formulas() {
+    // Every path's vector passes (values to radii and positions, then the
+    // normals) against the per-vertex formulas written out here in f64:
+    // value f·|cos θo| or f, 0 where any channel is not finite, radius the
+    // clamped channel mean (or ln(1 + mean)), position radius · direction,
+    // normal the normalised (down − up) × (right − left) of the positions.
+    // Sizes cover remainders of every vector width, the one-task and the
+    // parallel builds; light directions where an isotropic model's rings
+    // are mirrored (φi = 0, π, odd and even multiples of π / n_phi,
+    // normal incidence) and where they are not.
+    let ward = ModelSpec::from_json("ward", &serde_json::json!({"alpha_x": 0.1, "alpha_y": 0.4}))
+        .unwrap()
+        .build()
+        .unwrap();
+    let ct = ModelSpec::new("cook-torrance").unwrap().build().unwrap();
+    let dielectric = ModelSpec::new("rough-dielectric").unwrap().build().unwrap();
+    let models: [(&str, &dyn Brdf); 4] = [
+        ("cook-torrance", ct.as_ref()),
+        ("rough-dielectric", dielectric.as_ref()),
+        ("anisotropic ward", ward.as_ref()),
+        ("poisoned", &Poisoned),
+    ];
+    // `available` ends with the scalar path.
+    for isa in Isa::available() {
+        for (name, b) in models {
+            for (n_theta, n_phi, cosine, scale) in [
+                (2, 3, false, RadiusScale::Linear),
+                (7, 21, true, RadiusScale::Linear),
+                (9, 37, false, RadiusScale::Log),
+                (40, 133, true, RadiusScale::Linear),
+                (33, 256, false, RadiusScale::Log),
+            ] {
+                let opts = LobeOptions {
+                    n_theta,
+                    n_phi,
+                    cosine,
+                    scale,
+                };
+                let step = PI / n_phi as f64;
+                for phi_i in [0.3, 0.0, PI, 3.0 * step, -4.0 * step] {
+                    for wi in [bv_core::frame::from_spherical(0.6, phi_i), DVec3::Z] {
+                        let mut m = LobeMesh::default();
+                        lobe::build_with(b, wi, &opts, &mut m, isa);
+                        let at = format!(
+                            "{name} {n_theta}×{n_phi} {isa:?} cosine {cosine} {scale:?} wi {wi}"
+                        );
+                        check_against_formulas(b, wi, &opts, &m, &at);
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn check_against_formulas(b: &dyn Brdf, wi: DVec3, opts: &LobeOptions, m: &LobeMesh, at: &str) {
+    let (n_theta, n_phi) = (opts.n_theta, opts.n_phi);
+    let wi32 = wi.as_vec3().as_dvec3();
+    let close = |got: f64, want: f64, rel: f64| (got - want).abs() <= (rel * want.abs()).max(1e-6);
+    let mut max_mean = 0f64;
+    for i in 0..=n_theta {
+        for j in 0..n_phi {
+            let k = i * n_phi + j;
+            let d = m.direction(i, j).as_vec3().as_dvec3();
+            let mut f = b.eval(wi32, d);
+            if opts.cosine {
+                f *= d.z.abs();
+            }
+            if !(0..3).all(|c| f[c].is_finite()) {
+                f = Rgb::splat(0.0);
+            }
+            let v = m.values[k];
+            for c in 0..3 {
+                assert!(
+                    close(v[c] as f64, f[c], 1e-4),
+                    "{at}: value {k} {v:?} vs {f}"
+                );
+            }
+            let mean = ((f[0] + f[1] + f[2]) / 3.0).max(0.0);
+            max_mean = max_mean.max(mean);
+            let r = match opts.scale {
+                RadiusScale::Linear => mean,
+                RadiusScale::Log => mean.ln_1p(),
+            };
+            assert!(
+                close(m.radii[k] as f64, r, 1e-4),
+                "{at}: radius {k}: {} vs {r}",
+                m.radii[k]
+            );
+            let p = m.positions[k];
+            for c in 0..3 {
+                let want = d[c] * r;
+                assert!(
+                    (p[c] as f64 - want).abs() <= 1e-4 * r.abs() + 1e-6,
+                    "{at}: position {k} {p:?} vs {}",
+                    d * r
+                );
+            }
+        }
+    }
+    assert!(
+        close(m.max_value, max_mean, 1e-4),
+        "{at}: max {} vs {max_mean}",
+        m.max_value
+    );
+    // Normals from the mesh's own positions, away from the poles (their
+    // fans are tested elsewhere).
+    let p = |i: usize, j: usize| Vec3::from_array(m.positions[i * n_phi + j]).as_dvec3();
+    for i in 1..n_theta {
+        for j in 0..n_phi {
+            let (l, r) = ((j + n_phi - 1) % n_phi, (j + 1) % n_phi);
+            let n = (p(i + 1, j) - p(i - 1, j)).cross(p(i, r) - p(i, l));
+            let got = Vec3::from_array(m.normals[i * n_phi + j]).as_dvec3();
+            let want = if n.length() > 1e-12 {
+                n.normalize()
+            } else if n.length() > 1e-20 {
+                continue; // too short to compare in f32
+            } else {
+                m.direction(i, j)
+            };
+            assert!(
+                (got - want).length() < 1e-3,
+                "{at}: normal ({i}, {j}) {got} vs {want}"
+            );
         }
     }
 }
