@@ -31,42 +31,26 @@ pub fn dielectric_polarized(cos_i: f64, eta: f64) -> (f64, f64) {
         (cos_i, eta)
     };
     let c = c.min(1.0);
-    let sin2_i = (1.0 - c * c).max(0.0);
-    let sin2_t = sin2_i / (eta * eta);
-    if sin2_t >= 1.0 || !sin2_t.is_finite() {
+    // Through Walter et al. 2007's `g = η cos θt = √(η² − sin²θi)` (eq. 22):
+    // multiplying r∥'s numerator and denominator by η gives
+    // `(η² c − g)/(η² c + g)`, and r⊥ = `(c − g)/(c + g)`. No division before
+    // the square root (sin²θt = sin²θi/η² put one on the critical path of
+    // every microfacet model's evaluation through `dielectric`).
+    let e2 = eta * eta;
+    let g2 = e2 - (1.0 - c * c).max(0.0);
+    // Total internal reflection (sin²θt ≥ 1), or an index that is not finite.
+    if g2 <= 0.0 || !g2.is_finite() {
         return (1.0, 1.0);
     }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    let r_par = (eta * c - cos_t) / (eta * c + cos_t);
-    let r_perp = (c - eta * cos_t) / (c + eta * cos_t);
-    (r_par, r_perp)
+    let g = g2.sqrt();
+    ((e2 * c - g) / (e2 * c + g), (c - g) / (c + g))
 }
 
 /// Exact unpolarised reflectance of a dielectric interface, `(r∥² + r⊥²)/2`
 /// (PBRT 3rd ed. §8.2.1), 1 under total internal reflection. `cos_i < 0` means
 /// light from the −z side (indices swapped).
 pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
-    // The same amplitudes as `dielectric_polarized`, through Walter et al.
-    // 2007's `g = η cos θt = √(η² − sin²θi)` (eq. 22): multiplying r∥'s
-    // numerator and denominator by η gives `(η² c − g)/(η² c + g)`, and
-    // r⊥ = `(c − g)/(c + g)`. No division before the square root (sin²θt =
-    // sin²θi/η² put one on the critical path of every microfacet model's
-    // evaluation), the same value to rounding.
-    let (c, eta) = if cos_i < 0.0 {
-        (-cos_i, 1.0 / eta)
-    } else {
-        (cos_i, eta)
-    };
-    let c = c.min(1.0);
-    let e2 = eta * eta;
-    let g2 = e2 - (1.0 - c * c).max(0.0);
-    // Total internal reflection (sin²θt ≥ 1), or an index that is not finite.
-    if g2 <= 0.0 || !g2.is_finite() {
-        return 1.0;
-    }
-    let g = g2.sqrt();
-    let rp = (e2 * c - g) / (e2 * c + g);
-    let rs = (c - g) / (c + g);
+    let (rp, rs) = dielectric_polarized(cos_i, eta);
     0.5 * (rp * rp + rs * rs)
 }
 

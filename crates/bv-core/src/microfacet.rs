@@ -43,17 +43,7 @@ fn alpha2_tan2(w: DVec3, ax: f64, ay: f64) -> f64 {
 /// anisotropic exponent of Ward 1992):
 /// `exp(−tan²θh (cos²φh/αx² + sin²φh/αy²)) / (π αx αy cos⁴θh)`, 0 below the horizon.
 pub fn beckmann_d(h: DVec3, ax: f64, ay: f64) -> f64 {
-    if h.z <= 0.0 {
-        return 0.0;
-    }
-    let z2 = h.z * h.z;
-    // tan²θ cos²φ = hx²/hz², tan²θ sin²φ = hy²/hz².
-    let e = (h.x * h.x / (ax * ax) + h.y * h.y / (ay * ay)) / z2;
-    if e > 700.0 {
-        // exp underflows long before cos⁴ does: avoid 0/0 near the horizon.
-        return 0.0;
-    }
-    (-e).exp() / (PI * ax * ay * z2 * z2)
+    beckmann_d_inv(h, 1.0 / ax, 1.0 / ay)
 }
 
 /// [`beckmann_d`] from the reciprocal roughnesses `1/αx`, `1/αy` (precomputed
@@ -68,7 +58,7 @@ pub fn beckmann_d_inv(h: DVec3, inv_ax: f64, inv_ay: f64) -> f64 {
     let q = 1.0 / z2;
     let e = (x * x + y * y) * q;
     if e > 700.0 {
-        // As in `beckmann_d`.
+        // exp underflows long before cos⁴ does: avoid 0 · ∞ near the horizon.
         return 0.0;
     }
     (-e).exp() * (inv_ax * inv_ay * FRAC_1_PI) * (q * q)
@@ -701,7 +691,7 @@ impl ScaleLanes {
         } else {
             let z2 = z * z;
             let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) / z2;
-            // As in `beckmann_d`: exp underflows (f32: e > 87) long before
+            // exp underflows long before cos⁴ does: avoid 0 · ∞ near the horizon. exp underflows (f32: e > 87) long before
             // the cos⁴ factor, so 0 there avoids 0/0 at the horizon.
             let d = math::exp(-e) * self.norm / (z2 * z2);
             e.gt(V::splat(87.0)).select(V::splat(0.0), d)
