@@ -93,8 +93,9 @@ pub struct RenderArgs {
     #[arg(long, value_name = "S")]
     pub scale: Option<f32>,
 
-    /// Samples per pixel of the environment view (default: the scene's
-    /// target, at most 256 on a software renderer such as lavapipe).
+    /// Samples per pixel of the environment view, honoured exactly (default:
+    /// the scene's target; on a software renderer such as lavapipe at most
+    /// 2²⁷ samples in all, between 32 and 256 per pixel: 64 at 1600×1200).
     #[arg(long, value_name = "N")]
     pub spp: Option<u32>,
 
@@ -239,6 +240,7 @@ pub fn apply_args(a: &RenderArgs, mut state: AppState) -> Result<AppState> {
             bail!("--spp {n}: expected 1..={MAX_TARGET_SPP} samples per pixel");
         }
         state.lighting.env.target_spp = n;
+        state.lighting.env.figure_spp = Some(n);
     }
     state.display.log |= a.log;
     state.display.cosine |= a.cosine;

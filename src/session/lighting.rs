@@ -146,6 +146,12 @@ pub struct EnvView {
     /// Samples per pixel after which accumulation stops (saves the CPU once
     /// the image is clean).
     pub target_spp: u32,
+    /// Samples per pixel of a figure as asked for (`bv render --spp`):
+    /// honoured exactly, on a software renderer too. `None`: the figure
+    /// takes `target_spp`, within a software renderer's sample budget.
+    /// Not saved: it belongs to one command.
+    #[serde(skip)]
+    pub figure_spp: Option<u32>,
     /// The plane object: the eye's elevation above the sample, degrees (90:
     /// looking straight down, normal incidence; 5: grazing).
     pub elevation_deg: f64,
@@ -168,6 +174,7 @@ impl Default for EnvView {
             rotation_deg: 0.0,
             map: None,
             target_spp: 1024,
+            figure_spp: None,
             elevation_deg: 30.0,
         }
     }
@@ -201,6 +208,7 @@ impl Lighting {
             0.0
         };
         self.env.target_spp = self.env.target_spp.clamp(1, MAX_TARGET_SPP);
+        self.env.figure_spp = self.env.figure_spp.map(|n| n.clamp(1, MAX_TARGET_SPP));
         self.env.elevation_deg = if self.env.elevation_deg.is_finite() {
             self.env
                 .elevation_deg

@@ -57,19 +57,42 @@ pub fn accumulation_scale(figure: bool, interacting: bool, software: bool) -> f3
     }
 }
 
-/// Largest sample count of a figure on a software renderer (a clean image
-/// at full resolution in well under a minute on lavapipe); a GPU takes the
-/// view's target.
-pub const SOFTWARE_FIGURE_SPP: u32 = 256;
+/// Samples in all (pixels × samples per pixel) of a figure on a software
+/// renderer when no count was asked for: lavapipe draws about 10⁷ samples a
+/// second on two cores, so a figure takes about ten seconds whatever its
+/// size (64 samples per pixel at 1600×1200, 256 at 800×600), and `bv render
+/// --view all` stays well under a minute. A GPU takes the view's target.
+pub const SOFTWARE_FIGURE_SAMPLES: u64 = 1 << 27;
 
-/// Samples per pixel of a figure.
-pub fn figure_spp(target: u32, software: bool) -> u32 {
-    let t = target.clamp(1, MAX_TARGET_SPP);
-    if software {
-        t.min(SOFTWARE_FIGURE_SPP)
-    } else {
-        t
+/// Most samples per pixel of a software figure within the budget (a clean
+/// image at 800×600 and below).
+pub const SOFTWARE_FIGURE_MAX_SPP: u32 = 256;
+
+/// Fewest samples per pixel of a software figure, however large: below
+/// this the noise of the sphere's rim and the floor's reflection shows at
+/// a glance.
+pub const SOFTWARE_FIGURE_MIN_SPP: u32 = 32;
+
+/// Samples per pixel of a figure of `pixels` pixels: `exact` (the count
+/// asked for, `bv render --spp`) when given, else the view's `target`, and
+/// on a software renderer no more than [`SOFTWARE_FIGURE_SAMPLES`] in all
+/// (the power of two below, between [`SOFTWARE_FIGURE_MIN_SPP`] and
+/// [`SOFTWARE_FIGURE_MAX_SPP`] per pixel).
+pub fn figure_spp(target: u32, exact: Option<u32>, software: bool, pixels: u64) -> u32 {
+    if let Some(n) = exact {
+        return n.clamp(1, MAX_TARGET_SPP);
     }
+    let t = target.clamp(1, MAX_TARGET_SPP);
+    if !software {
+        return t;
+    }
+    // A power of two: the quasi-random sequence is best balanced there.
+    let budget = (SOFTWARE_FIGURE_SAMPLES / pixels.max(1)).clamp(
+        u64::from(SOFTWARE_FIGURE_MIN_SPP),
+        u64::from(SOFTWARE_FIGURE_MAX_SPP),
+    );
+    let budget = 1u32 << (63 - budget.leading_zeros());
+    t.min(budget)
 }
 
 /// Field of view of the background behind the objects (vertical, degrees).
@@ -449,7 +472,8 @@ impl EnvironmentView {
         renderer.set_object(gpu_image::env_object(env.object));
         if figure {
             // A figure is drawn in one go: accumulate to the target now.
-            let target = figure_spp(env.target_spp, software);
+            let pixels = u64::from(size.0) * u64::from(size.1);
+            let target = figure_spp(env.target_spp, env.figure_spp, software, pixels);
             let specs: Vec<ModelSpec> = drawables.iter().map(|d| d.spec.clone()).collect();
             let settings = Self::settings(env, turn_deg);
             let mut texture = None;
@@ -942,5 +966,65 @@ impl View for EnvironmentView {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn software_figures_keep_to_their_sample_budget() {
+        // The sizes of `bv render` (default, 1080p, the deck's 4K), small
+        // ones and degenerate ones.
+        for (w, h) in [
+            (1600u64, 1200u64),
+            (1920, 1080),
+            (3840, 2160),
+            (800, 600),
+            (640, 480),
+            (1, 1),
+            (0, 0),
+            (16384, 16384),
+        ] {
+            let pixels = w * h;
+            let spp = figure_spp(1024, None, true, pixels);
+            assert!(spp.is_power_of_two(), "{w}×{h}: {spp}");
+            assert!((SOFTWARE_FIGURE_MIN_SPP..=SOFTWARE_FIGURE_MAX_SPP).contains(&spp));
+            if spp > SOFTWARE_FIGURE_MIN_SPP {
+                // Within the budget, and not half of what it allows.
+                assert!(
+                    pixels * u64::from(spp) <= SOFTWARE_FIGURE_SAMPLES,
+                    "{w}×{h}"
+                );
+            }
+            if spp < SOFTWARE_FIGURE_MAX_SPP {
+                assert!(
+                    pixels * u64::from(2 * spp) > SOFTWARE_FIGURE_SAMPLES,
+                    "{w}×{h}"
+                );
+            }
+            // A smaller target is kept; a GPU takes the target.
+            assert_eq!(figure_spp(8, None, true, pixels), 8);
+            assert_eq!(figure_spp(1024, None, false, pixels), 1024);
+        }
+        assert_eq!(figure_spp(1024, None, true, 1600 * 1200), 64);
+        assert_eq!(figure_spp(1024, None, true, 800 * 600), 256);
+        assert_eq!(figure_spp(1024, None, true, 3840 * 2160), 32);
+    }
+
+    #[test]
+    fn a_count_asked_for_is_honoured_exactly() {
+        for software in [false, true] {
+            for n in [1, 3, 100, 1000, 4096, MAX_TARGET_SPP] {
+                assert_eq!(figure_spp(1024, Some(n), software, 3840 * 2160), n);
+            }
+            assert_eq!(figure_spp(1024, Some(0), software, 100), 1);
+            assert_eq!(
+                figure_spp(1024, Some(u32::MAX), software, 100),
+                MAX_TARGET_SPP
+            );
+            assert_eq!(figure_spp(0, None, software, 100), 1);
+        }
     }
 }
