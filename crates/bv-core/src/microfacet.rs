@@ -699,6 +699,34 @@ impl ScaleLanes {
         z.gt(V::splat(0.0)).select(v, V::splat(0.0))
     }
 
+    /// D(h) at `h = hu/√l2` from the unnormalised half vector `hu = wi + wo`
+    /// and `l2 = |hu|²`, without normalising it: Beckmann's tan²θh and
+    /// Blinn's θh do not depend on |hu|, Beckmann's 1/cos⁴θh is
+    /// `(l2/huz²)²` and GGX's `1/(h·A⁻²h)²` is `l2²/(hu·A⁻²hu)²` (as in
+    /// [`ScaleLanes::ggx_dg`]). One division (Beckmann) or none before the
+    /// caller's, where [`ScaleLanes::d`] after a normalisation takes three.
+    #[inline(always)]
+    pub fn d_of_sum<const DIST: u8, V: Lanes>(&self, hu: [V; 3], l2: V) -> V {
+        let [x, y, z] = hu;
+        let v = if DIST == Self::GGX {
+            let (u, v) = (x * self.inv_ax, y * self.inv_ay);
+            let t = u * u + v * v + z * z;
+            l2 * l2 * self.norm / (t * t)
+        } else if DIST == Self::BLINN {
+            let theta = math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
+            let e = theta * self.inv_ax;
+            math::exp(-e * e) * self.norm
+        } else {
+            let inv_z2 = V::splat(1.0) / (z * z);
+            let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) * inv_z2;
+            let r = l2 * inv_z2;
+            // As in `d`: 0 where exp underflows, before 1/cos⁴ overflows.
+            let d = math::exp(-e) * self.norm * (r * r);
+            e.gt(V::splat(87.0)).select(V::splat(0.0), d)
+        };
+        z.gt(V::splat(0.0)).select(v, V::splat(0.0))
+    }
+
     /// GGX's `D(h) G(wi, wo) / (4 cosθi cosθo)` with separable
     /// (`CORRELATED = false`) or height-correlated Smith G, from the
     /// unnormalised half vector `hu = wi + wo` and `l2 = |hu|²`, with a single

@@ -321,12 +321,28 @@ fn every_cook_torrance_combination_is_checked() {
     let dirs = pairs(8);
     for dist in ["beckmann", "ggx", "blinn"] {
         for geo in ["v-groove", "smith", "smith-correlated"] {
-            for fresnel in ["none", "schlick", "dielectric", "conductor"] {
+            // The dielectric with one index per channel and with one for all
+            // (its own kernel), above and below 1 (η = 0.195: the critical
+            // angle near grazing).
+            let cases = [
+                ("none", 0.0),
+                ("schlick", 0.0),
+                ("dielectric", 0.0),
+                ("dielectric", 1.5),
+                ("dielectric", 0.195),
+                ("conductor", 0.0),
+            ];
+            for (fresnel, grey) in cases {
+                let eta = if grey > 0.0 {
+                    serde_json::json!(grey)
+                } else {
+                    serde_json::json!([0.2, 0.92, 1.1])
+                };
                 for (ax, ay, w2) in [(0.001, 0.001, 0.0), (0.3, 0.1, 0.0), (2.0, 2.0, 0.3)] {
                     let p = serde_json::json!({"kd": [0.2, 0.1, 0.0], "ks": 0.8,
                         "distribution": dist, "geometry": geo, "fresnel": fresnel,
                         "alpha_x": ax, "alpha_y": ay, "alpha2": 0.05, "weight2": w2,
-                        "eta": [0.2, 0.92, 1.1], "k": [3.9, 2.45, 2.14], "f0": 0.04});
+                        "eta": eta, "k": [3.9, 2.45, 2.14], "f0": 0.04});
                     let b = ModelSpec::from_json("cook-torrance", &p)
                         .unwrap()
                         .build()

@@ -653,7 +653,7 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
     #[inline(always)]
     fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
         let k = self.0;
-        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let zero = V::splat(0.0);
         let above = wi[2].gt(zero) & wo[2].gt(zero);
         // The unnormalised half vector wi + wo and its squared length.
         let hu = math::add3(wi, wo);
@@ -673,25 +673,36 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
             };
             (dg, l2.sqrt() * 0.5)
         } else {
-            // frame::half_vector: one square root and one division.
-            let h = math::scale3(hu, one / l2.sqrt());
+            // No unit half vector either: D from wi + wo itself
+            // (`ScaleLanes::d_of_sum`), V-groove's `2 (n·h)(n·w)/(wo·h)` as
+            // `2 huz w.z / (wo·hu)`, its `min(1, ·)` taken over `wo·hu` and
+            // divided out with the cosines, and Fresnel's cos θd as
+            // wi·hu/|hu|: one square root and two or three divisions, where
+            // normalising h and the separate quotients of D, G and the
+            // cosines took a square root and five. (|hu|/2, as above, moves
+            // F by 1e-4 near wo = −wi with a large η, where f32's |w|² ≠ 1
+            // is a percent of the small l2.)
             let w1 = 1.0 - k.w2;
             let d = if MIX {
-                k.first.d::<D, V>(h) * w1 + k.second.d::<D, V>(h) * k.w2
+                k.first.d_of_sum::<D, V>(hu, l2) * w1 + k.second.d_of_sum::<D, V>(hu, l2) * k.w2
             } else {
-                k.first.d::<D, V>(h)
+                k.first.d_of_sum::<D, V>(hu, l2)
             };
-            let g = match G {
+            let cosines = wi[2] * wo[2] * 4.0;
+            let scalar = match G {
                 VGROOVE => {
-                    let oh = math::dot(wo, h);
-                    let kk = h[2] * 2.0 / oh;
-                    let g = one.min(kk * wo[2]).min(kk * wi[2]);
-                    (oh.gt(zero) & h[2].gt(zero)).select(g, zero)
+                    // wo·hu, not l2/2 (equal for unit vectors): near
+                    // wo = −wi, where l2 is small, f32's |w|² ≠ 1 would
+                    // move l2/2 by a percent.
+                    let ohu = math::dot(wo, hu);
+                    let t = hu[2] * 2.0;
+                    let g_ohu = ohu.min(t * wo[2]).min(t * wi[2]);
+                    (ohu.gt(zero) & hu[2].gt(zero)).select(d * g_ohu / (ohu * cosines), zero)
                 }
-                SMITH => one / (self.one_plus_lambda(wi) * self.one_plus_lambda(wo)),
-                _ => one / (self.one_plus_lambda(wi) + self.one_plus_lambda(wo) - 1.0),
+                SMITH => d / (self.one_plus_lambda(wi) * self.one_plus_lambda(wo) * cosines),
+                _ => d / ((self.one_plus_lambda(wi) + self.one_plus_lambda(wo) - 1.0) * cosines),
             };
-            (d * g / (wi[2] * wo[2] * 4.0), math::dot(wi, h))
+            (scalar, math::dot(wi, hu) / l2.sqrt())
         };
         let ok = above & finite_h & scalar.is_finite();
         let scalar = ok.select(scalar * k.ks, zero);
@@ -722,6 +733,9 @@ impl Kernel for CtKernel {
             ($d:expr, $g:expr) => {
                 match self.fresnel.kind {
                     FresnelLanes::DIELECTRIC => go!($d, $g, { FresnelLanes::DIELECTRIC }),
+                    FresnelLanes::DIELECTRIC_GREY => {
+                        go!($d, $g, { FresnelLanes::DIELECTRIC_GREY })
+                    }
                     FresnelLanes::CONDUCTOR => go!($d, $g, { FresnelLanes::CONDUCTOR }),
                     FresnelLanes::SCHLICK => go!($d, $g, { FresnelLanes::SCHLICK }),
                     _ => go!($d, $g, { FresnelLanes::NONE }),
