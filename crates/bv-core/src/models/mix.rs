@@ -93,15 +93,44 @@ impl crate::batch::Kernel for Mix {
         out: &mut crate::batch::Out<'_>,
     ) {
         let n = dirs.len().min(out.len());
-        for ch in out.rgb.iter_mut() {
-            ch[..n].fill(0.0);
+        let mut parts = self.parts.iter();
+        let Some(first) = parts.next() else {
+            for ch in out.rgb.iter_mut() {
+                ch[..n].fill(0.0);
+            }
+            return;
+        };
+        // The first part straight into `out`, scaled there; the others
+        // through a scratch buffer taken from this thread (taken, not
+        // borrowed: a mix inside a mix finds it empty and allocates its
+        // own), so that a lobe's many small batches allocate nothing.
+        {
+            let [r, g, b] = &mut out.rgb;
+            let mut head = crate::batch::Out {
+                rgb: [&mut r[..n], &mut g[..n], &mut b[..n]],
+            };
+            crate::batch::eval_with(first.brdf.as_ref(), isa, dirs, &mut head);
         }
-        let mut part = [vec![0.0f32; n], vec![0.0f32; n], vec![0.0f32; n]];
-        for p in &self.parts {
+        let w = first.weight as f32;
+        if w != 1.0 {
+            for ch in out.rgb.iter_mut() {
+                for d in &mut ch[..n] {
+                    *d *= w;
+                }
+            }
+        }
+        if parts.len() == 0 {
+            return;
+        }
+        let mut part = MIX_SCRATCH.with_borrow_mut(std::mem::take);
+        for ch in &mut part {
+            ch.resize(n, 0.0);
+        }
+        for p in parts {
             {
                 let [r, g, b] = &mut part;
                 let mut tmp = crate::batch::Out {
-                    rgb: [r.as_mut_slice(), g.as_mut_slice(), b.as_mut_slice()],
+                    rgb: [&mut r[..n], &mut g[..n], &mut b[..n]],
                 };
                 crate::batch::eval_with(p.brdf.as_ref(), isa, dirs, &mut tmp);
             }
@@ -112,7 +141,15 @@ impl crate::batch::Kernel for Mix {
                 }
             }
         }
+        MIX_SCRATCH.with_borrow_mut(|s| *s = part);
     }
+}
+
+thread_local! {
+    /// [`Mix`]'s scratch channels for its second and later parts.
+    static MIX_SCRATCH: std::cell::RefCell<[Vec<f32>; 3]> = const {
+        std::cell::RefCell::new([Vec::new(), Vec::new(), Vec::new()])
+    };
 }
 
 /// A weighted sum of models.
