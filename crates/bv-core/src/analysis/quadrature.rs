@@ -292,13 +292,15 @@ fn kink_roots(
             dirs[k] = dir(xs[k]);
         }
     }
+    // Each kink at the scan's points once (neighbouring steps share one).
+    let mut vals = [f64::NAN; MAX_SCAN + 1];
     for kink in kinks {
         let value = |phi: f64| dir(phi).map(kink);
+        for (v, d) in vals.iter_mut().zip(&dirs).take(scan + 1) {
+            *v = d.map_or(f64::NAN, kink);
+        }
         for k in 0..scan {
-            let (Some(a), Some(b)) = (dirs[k], dirs[k + 1]) else {
-                continue;
-            };
-            let (mut fa, mut fb) = (kink(a), kink(b));
+            let (mut fa, mut fb) = (vals[k], vals[k + 1]);
             if !(fa.is_finite() && fb.is_finite()) || (fa > 0.0) == (fb > 0.0) {
                 continue;
             }
