@@ -25,17 +25,6 @@ use crate::{BvError, Result, Rgb};
 /// incidence with `eta = 1` Snell's law puts θt at 90° too; that limit is
 /// treated as total reflection, as for every `eta ≠ 1`.
 pub fn dielectric_polarized(cos_i: f64, eta: f64) -> (f64, f64) {
-    let Some((c, e2, g)) = g_form(cos_i, eta) else {
-        return (1.0, 1.0);
-    };
-    ((e2 * c - g) / (e2 * c + g), (c - g) / (c + g))
-}
-
-/// `(c, η², g)` of [`dielectric_polarized`]'s form for light at `cos_i`
-/// (indices swapped for `cos_i < 0`), `None` under total internal
-/// reflection or for an index that is not finite.
-#[inline]
-fn g_form(cos_i: f64, eta: f64) -> Option<(f64, f64, f64)> {
     let (c, eta) = if cos_i < 0.0 {
         (-cos_i, 1.0 / eta)
     } else {
@@ -51,38 +40,18 @@ fn g_form(cos_i: f64, eta: f64) -> Option<(f64, f64, f64)> {
     let g2 = e2 - (1.0 - c * c).max(0.0);
     // Total internal reflection (sin²θt ≥ 1), or an index that is not finite.
     if g2 <= 0.0 || !g2.is_finite() {
-        return None;
+        return (1.0, 1.0);
     }
-    Some((c, e2, g2.sqrt()))
+    let g = g2.sqrt();
+    ((e2 * c - g) / (e2 * c + g), (c - g) / (c + g))
 }
 
 /// Exact unpolarised reflectance of a dielectric interface, `(r∥² + r⊥²)/2`
 /// (PBRT 3rd ed. §8.2.1), 1 under total internal reflection. `cos_i < 0` means
 /// light from the −z side (indices swapped).
-///
-/// The amplitudes of [`dielectric_polarized`], `r∥ = a/b` and `r⊥ = p/q`,
-/// squared and summed over one denominator, `(a² q² + p² b²)/(2 b² q²)`:
-/// one division on every microfacet model's evaluation instead of two.
-/// `b q ≥ g² = g2 > 0` outside total reflection, so the division is safe
-/// (the branch for 0 is a guard).
 pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
-    let Some((c, e2, g)) = g_form(cos_i, eta) else {
-        return 1.0;
-    };
-    let (a, b) = (e2 * c - g, e2 * c + g);
-    let (p, q) = (c - g, c + g);
-    let (aq, pb, bq) = (a * q, p * b, b * q);
-    // |a| ≤ b and |p| ≤ q, so the numerator is finite where `den` is.
-    let den = 2.0 * bq * bq;
-    if den > 0.0 && den < f64::INFINITY {
-        (aq * aq + pb * pb) / den
-    } else if den == 0.0 {
-        0.0
-    } else {
-        // b q overflowed (an index beyond 1e70): the quotients one by one.
-        let (rp, rs) = (a / b, p / q);
-        0.5 * (rp * rp + rs * rs)
-    }
+    let (rp, rs) = dielectric_polarized(cos_i, eta);
+    0.5 * (rp * rp + rs * rs)
 }
 
 /// Exact unpolarised reflectance of a conductor with complex relative index
@@ -603,7 +572,7 @@ mod tests {
     }
 
     #[test]
-    fn one_denominator_is_the_textbook_average_everywhere() {
+    fn dielectric_is_the_textbook_average_everywhere() {
         // PBRT's form through Snell's law, written out here.
         let textbook = |cos_i: f64, eta: f64| {
             let (c, eta) = if cos_i < 0.0 {
@@ -635,7 +604,7 @@ mod tests {
             }
         }
         // Grazing at η = 1 is total reflection (as documented), and an
-        // index so large that b q overflows still gives F → 1.
+        // index whose square overflows gives F → 1.
         assert_eq!(dielectric(1e-200, 1.0), 1.0);
         assert!((dielectric(0.5, 1e160) - 1.0).abs() < 1e-12);
         assert!(dielectric(0.5, 1e160).is_finite());
