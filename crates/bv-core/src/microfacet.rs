@@ -675,28 +675,10 @@ impl ScaleLanes {
         ))
     }
 
-    /// D(h) for a unit `h`.
+    /// D(h) for a unit `h`: [`ScaleLanes::d_of_sum`] with `|h|² = 1`.
     #[inline(always)]
     pub fn d<const DIST: u8, V: Lanes>(&self, h: [V; 3]) -> V {
-        let [x, y, z] = h;
-        let v = if DIST == Self::GGX {
-            let (u, v) = (x * self.inv_ax, y * self.inv_ay);
-            let t = u * u + v * v + z * z;
-            V::splat(self.norm) / (t * t)
-        } else if DIST == Self::BLINN {
-            // As `blinn_d`: θh = atan2(√(x² + y²), z), e = θh/α.
-            let theta = math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
-            let e = theta * self.inv_ax;
-            math::exp(-e * e) * self.norm
-        } else {
-            let z2 = z * z;
-            let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) / z2;
-            // exp underflows long before cos⁴ does: avoid 0 · ∞ near the horizon. exp underflows (f32: e > 87) long before
-            // the cos⁴ factor, so 0 there avoids 0/0 at the horizon.
-            let d = math::exp(-e) * self.norm / (z2 * z2);
-            e.gt(V::splat(87.0)).select(V::splat(0.0), d)
-        };
-        z.gt(V::splat(0.0)).select(v, V::splat(0.0))
+        self.d_of_sum::<DIST, V>(h, V::splat(1.0))
     }
 
     /// D(h) at `h = hu/√l2` from the unnormalised half vector `hu = wi + wo`
@@ -713,6 +695,7 @@ impl ScaleLanes {
             let t = u * u + v * v + z * z;
             l2 * l2 * self.norm / (t * t)
         } else if DIST == Self::BLINN {
+            // As `blinn_d`: θh = atan2(√(x² + y²), z), e = θh/α.
             let theta = math::atan2_first_quadrant((x * x + y * y).sqrt(), z);
             let e = theta * self.inv_ax;
             math::exp(-e * e) * self.norm
@@ -720,7 +703,8 @@ impl ScaleLanes {
             let inv_z2 = V::splat(1.0) / (z * z);
             let e = (x * x * self.inv_ax2 + y * y * self.inv_ay2) * inv_z2;
             let r = l2 * inv_z2;
-            // As in `d`: 0 where exp underflows, before 1/cos⁴ overflows.
+            // exp underflows (f32: e > 87) long before 1/cos⁴ overflows:
+            // 0 there avoids 0 · ∞ at the horizon.
             let d = math::exp(-e) * self.norm * (r * r);
             e.gt(V::splat(87.0)).select(V::splat(0.0), d)
         };
