@@ -104,3 +104,74 @@ fn a_bad_deck_names_the_entry_and_the_key() {
     assert!(!out.join("slides").exists(), "nothing written");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Mean absolute difference between horizontally adjacent pixels (all three
+/// channels) in the middle of an image: Monte Carlo noise, where the
+/// environment view's sphere is.
+fn pixel_noise(img: &image::RgbaImage) -> f64 {
+    let (w, h) = img.dimensions();
+    let (mut sum, mut n) = (0.0, 0u32);
+    for y in h * 2 / 5..h * 3 / 5 {
+        for x in w * 2 / 5..w * 3 / 5 {
+            let a = img.get_pixel(x, y).0;
+            let b = img.get_pixel(x + 1, y).0;
+            for c in 0..3 {
+                sum += (f64::from(a[c]) - f64::from(b[c])).abs();
+                n += 1;
+            }
+        }
+    }
+    sum / f64::from(n)
+}
+
+/// `--spp N` reaches every environment scene of a deck: one sample per
+/// pixel leaves the sphere visibly noisy, 64 far less so; and a count out of
+/// range is refused before anything is written.
+#[test]
+fn a_deck_takes_the_sample_count_asked_for() {
+    let out = out_dir("spp");
+    std::fs::create_dir_all(&out).unwrap();
+    let path = out.join("env.toml");
+    std::fs::write(
+        &path,
+        "format = \"bv-deck\"\nversion = 1\n[[scene]]\ntitle = \"Plastic\"\ncaption = \"c\"\n\
+         view = \"environment\"\n[scene.state]\nselected = 1\n[[scene.state.brdfs]]\nid = 1\n\
+         color = [78, 151, 234]\nvisible = true\n\
+         spec = { model = \"cook-torrance\", params = { alpha = 0.3 } }\n",
+    )
+    .unwrap();
+    let render = |spp: &str, name: &str| {
+        Command::new(bin())
+            .args(["render", "--deck"])
+            .arg(&path)
+            .args(["--width", "480", "--height", "270", "--spp", spp, "--out"])
+            .arg(out.join(name))
+            .output()
+            .unwrap()
+    };
+    let noise = |spp: &str| {
+        let run = render(spp, spp);
+        assert!(
+            run.status.success(),
+            "--spp {spp}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let img = image::open(out.join(spp).join("01-plastic.png"))
+            .unwrap()
+            .to_rgba8();
+        pixel_noise(&img)
+    };
+    let (one, many) = (noise("1"), noise("64"));
+    println!("pixel-to-pixel difference: {one:.2} at 1 spp, {many:.2} at 64");
+    assert!(
+        one > 3.0 * many,
+        "1 spp {one:.2} against 64 spp {many:.2}: the count did not reach the scene"
+    );
+
+    let bad = render("0", "zero");
+    assert!(!bad.status.success());
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(err.contains("--spp 0"), "{err}");
+    assert!(!out.join("zero").exists(), "nothing written");
+    let _ = std::fs::remove_dir_all(&out);
+}
