@@ -396,9 +396,90 @@ fn every_rough_dielectric_combination_is_checked() {
                         .build()
                         .unwrap();
                     let dirs = sphere_pairs(b.as_ref(), 12);
-                    if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
-                        panic!("{p}: {e}");
+                    // Mixed vectors take the kernel's general branch; the
+                    // same pairs sorted by sides fill whole vectors with one
+                    // case (reflection above or below, transmission from
+                    // above or below), which take the branches that skip
+                    // the other lobe.
+                    for dirs in [by_sides(&dirs), dirs] {
+                        if let Some(e) = first_mismatch(b.as_ref(), &dirs) {
+                            panic!("{p}: {e}");
+                        }
                     }
+                }
+            }
+        }
+    }
+}
+
+/// `dirs` sorted (stably) by the sides of each pair: both above, both
+/// below, wi above and wo below, wi below and wo above, then the rest (a
+/// direction in the plane of the surface).
+fn by_sides(dirs: &PairBuf) -> PairBuf {
+    let key = |i: usize| match (dirs.wi[2][i], dirs.wo[2][i]) {
+        (zi, zo) if zi > 0.0 && zo > 0.0 => 0,
+        (zi, zo) if zi < 0.0 && zo < 0.0 => 1,
+        (zi, zo) if zi > 0.0 && zo < 0.0 => 2,
+        (zi, zo) if zi < 0.0 && zo > 0.0 => 3,
+        _ => 4,
+    };
+    let mut order: Vec<usize> = (0..dirs.len()).collect();
+    order.sort_by_key(|&i| key(i));
+    let mut out = PairBuf::default();
+    for i in order {
+        for c in 0..3 {
+            out.wi[c].push(dirs.wi[c][i]);
+            out.wo[c].push(dirs.wo[c][i]);
+        }
+    }
+    out
+}
+
+/// Writes, for each lane, whether any and whether every lane of its vector
+/// has `wi.x > 0` (1 or 0).
+#[derive(Debug)]
+struct MaskProbe;
+impl LaneKernel for MaskProbe {
+    fn lane<V: Lanes>(&self, wi: [V; 3], _wo: [V; 3]) -> [V; 3] {
+        let m = wi[0].gt(V::splat(0.0));
+        let bit = |b: bool| V::splat(if b { 1.0 } else { 0.0 });
+        [bit(m.any()), bit(m.all()), V::splat(0.0)]
+    }
+}
+
+#[test]
+fn any_and_all_see_every_lane_on_every_path() {
+    // Vectors of every pattern that matters: none, one lane (each position
+    // in turn), all but one, all. The probe's pairs start at 0 and fill
+    // whole vectors of each width (16 is a multiple of 1, 4, 8 and 16).
+    let mut patterns: Vec<Vec<bool>> = vec![vec![false; 16], vec![true; 16]];
+    for k in 0..16 {
+        patterns.push((0..16).map(|i| i == k).collect());
+        patterns.push((0..16).map(|i| i != k).collect());
+    }
+    for isa in Isa::available() {
+        let w = isa.lanes();
+        for pattern in &patterns {
+            let mut dirs = PairBuf::default();
+            for &on in pattern {
+                let x = if on { 0.5 } else { -0.5 };
+                dirs.push(DVec3::new(x, 0.0, 0.8), DVec3::Z);
+            }
+            let n = dirs.len();
+            let (mut any, mut all, mut z) = (vec![-1f32; n], vec![-1f32; n], vec![-1f32; n]);
+            batch::run(
+                &MaskProbe,
+                isa,
+                &dirs.dirs(0..n),
+                &mut Out {
+                    rgb: [&mut any[..], &mut all[..], &mut z[..]],
+                },
+            );
+            for (v, chunk) in pattern.chunks(w).enumerate() {
+                let want = (chunk.iter().any(|&b| b), chunk.iter().all(|&b| b));
+                for i in v * w..(v + 1) * w {
+                    let got = (any[i] == 1.0, all[i] == 1.0);
+                    assert_eq!(got, want, "[{isa}] {pattern:?}, lane {i}");
                 }
             }
         }

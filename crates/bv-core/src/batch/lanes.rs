@@ -28,6 +28,14 @@ use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub
 pub trait LaneMask:
     Copy + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
 {
+    /// Whether any lane is true: for a kernel that skips the work of a
+    /// case no lane of the vector is in (a branch on the whole vector, not
+    /// a select per lane).
+    fn any(self) -> bool;
+
+    /// Whether every lane is true.
+    fn all(self) -> bool;
+
     /// `a` in the lanes where the mask is true, `b` elsewhere.
     #[inline(always)]
     fn select<V: Lanes<Mask = Self>>(self, a: V, b: V) -> V {
@@ -145,7 +153,16 @@ pub trait WideLanes:
 // ---------------------------------------------------------------------------
 // The scalar fallback: one lane, `f32` itself.
 
-impl LaneMask for bool {}
+impl LaneMask for bool {
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+}
 
 impl Lanes for f32 {
     type Mask = bool;
@@ -345,7 +362,8 @@ pub(crate) use vector_ops;
 /// Implements `&`, `|` and `!` of a mask type whose field `.0` is the
 /// register (see [`vector_ops`] for the safety argument).
 macro_rules! mask_ops {
-    ($t:ident, $and:path, $or:path, |$x:ident| $not:expr) => {
+    ($t:ident, $and:path, $or:path, |$x:ident| $not:expr,
+     any |$a:ident| $any:expr, all |$b:ident| $all:expr) => {
         impl std::ops::BitAnd for $t {
             type Output = Self;
             #[inline(always)]
@@ -370,7 +388,18 @@ macro_rules! mask_ops {
                 $not
             }
         }
-        impl $crate::batch::lanes::LaneMask for $t {}
+        impl $crate::batch::lanes::LaneMask for $t {
+            #[inline(always)]
+            fn any(self) -> bool {
+                let $a = self;
+                $any
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                let $b = self;
+                $all
+            }
+        }
     };
 }
 pub(crate) use mask_ops;

@@ -19,9 +19,15 @@ pub(super) struct NeonWide([float64x2_t; 2]);
 vector_ops!(Neon, f32, vaddq_f32, vsubq_f32, vmulq_f32, vdivq_f32, |x| {
     Neon(unsafe { vnegq_f32(x.0) })
 });
-mask_ops!(NeonMask, vandq_u32, vorrq_u32, |x| NeonMask(unsafe {
-    vmvnq_u32(x.0)
-}));
+mask_ops!(
+    NeonMask,
+    vandq_u32,
+    vorrq_u32,
+    |x| NeonMask(unsafe { vmvnq_u32(x.0) }),
+    // SAFETY: NEON is baseline on AArch64.
+    any | x | unsafe { vmaxvq_u32(x.0) } != 0,
+    all | x | unsafe { vminvq_u32(x.0) } != 0
+);
 
 impl From<f32> for Neon {
     #[inline(always)]

@@ -33,9 +33,14 @@ mod ops {
         f32x4_div,
         |x| Simd128(f32x4_neg(x.0))
     );
-    mask_ops!(Simd128Mask, v128_and, v128_or, |x| Simd128Mask(v128_not(
-        x.0
-    )));
+    mask_ops!(
+        Simd128Mask,
+        v128_and,
+        v128_or,
+        |x| Simd128Mask(v128_not(x.0)),
+        any | x | v128_any_true(x.0),
+        all | x | i32x4_all_true(x.0)
+    );
     wide_pair!(
         Simd128Wide,
         Simd128,

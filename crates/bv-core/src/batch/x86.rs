@@ -34,9 +34,15 @@ vector_ops!(
     _mm256_div_ps,
     |x| Avx2(unsafe { _mm256_xor_ps(x.0, _mm256_set1_ps(-0.0)) })
 );
-mask_ops!(Avx2Mask, _mm256_and_ps, _mm256_or_ps, |x| Avx2Mask(
-    unsafe { _mm256_xor_ps(x.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) }
-));
+mask_ops!(
+    Avx2Mask,
+    _mm256_and_ps,
+    _mm256_or_ps,
+    |x| Avx2Mask(unsafe { _mm256_xor_ps(x.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) }),
+    // The lanes' sign bits, one bit each.
+    any | x | unsafe { _mm256_movemask_ps(x.0) } != 0,
+    all | x | unsafe { _mm256_movemask_ps(x.0) } == 0xff
+);
 wide_pair!(
     Avx2Wide,
     Avx2,
@@ -243,7 +249,14 @@ vector_ops!(
         ))
     })
 );
-mask_ops!(Avx512Mask, and16, or16, |x| Avx512Mask(!x.0));
+mask_ops!(
+    Avx512Mask,
+    and16,
+    or16,
+    |x| Avx512Mask(!x.0),
+    any | x | x.0 != 0,
+    all | x | x.0 == 0xffff
+);
 wide_pair!(
     Avx512Wide,
     Avx512,

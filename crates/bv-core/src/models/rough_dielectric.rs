@@ -703,16 +703,52 @@ fn beta_lanes<V: Lanes>(x: V, y: V) -> V {
 #[derive(Debug)]
 struct RdLane<'a, const D: u8, const CORRELATED: bool>(&'a RdKernel);
 
+/// Which lobes a vector of pairs needs ([`RdLane::sides`]): both, only the
+/// reflected one (every pair on one side) or only the transmitted one.
+const BOTH: u8 = 0;
+const REFLECT: u8 = 1;
+const TRANSMIT: u8 = 2;
+
 impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATED> {
     #[inline(always)]
     fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let zero = V::splat(0.0);
+        let (up_i, up_o) = (wi[2].gt(zero), wo[2].gt(zero));
+        // Opposite sides: exactly one of the two is above.
+        let trans = (up_i & !up_o) | (up_o & !up_i);
+        // A lobe mesh's rows lie wholly above or wholly below the surface
+        // except near the horizon, so most vectors need one lobe: the
+        // other's half vector, Fresnel term and G (for the correlated G of
+        // transmission, a Beta function: logarithms, an exponential and
+        // eighteen divisions) are skipped there. Each branch computes the
+        // same values for its lanes as the general one.
+        if !trans.any() {
+            self.sides::<REFLECT, V>(wi, wo, up_i, up_o, trans)
+        } else if trans.all() {
+            self.sides::<TRANSMIT, V>(wi, wo, up_i, up_o, trans)
+        } else {
+            self.sides::<BOTH, V>(wi, wo, up_i, up_o, trans)
+        }
+    }
+}
+
+impl<const D: u8, const CORRELATED: bool> RdLane<'_, D, CORRELATED> {
+    /// The lane values for vectors whose pairs need the lobes `S` ([`BOTH`],
+    /// [`REFLECT`] or [`TRANSMIT`]); `up_i`, `up_o` and `trans` are the
+    /// sides of each pair as [`LaneKernel::lane`] found them.
+    #[inline(always)]
+    fn sides<const S: u8, V: Lanes>(
+        &self,
+        wi: [V; 3],
+        wo: [V; 3],
+        up_i: V::Mask,
+        up_o: V::Mask,
+        trans: V::Mask,
+    ) -> [V; 3] {
         let k = self.0;
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
         let (zi, zo) = (wi[2], wo[2]);
-        let (up_i, up_o) = (zi.gt(zero), zo.gt(zero));
         let off = zi.eq(zero) | zo.eq(zero);
-        // Opposite sides: exactly one of the two is above.
-        let trans = (up_i & !up_o) | (up_o & !up_i);
         let eta = V::splat(k.eta);
         let eo = up_o.select(one, eta);
         // The half vector candidates in f64 lanes: reflection wi + wo
@@ -720,14 +756,15 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         // (ηi = 1, ηo = η) or below (ηi = η, ηo = 1). Near the refracted
         // direction the latter's tangential part cancels, and a product
         // rounded to f32 first would leave an error of 1e-7 against a lobe
-        // of width α = 0.001.
+        // of width α = 0.001. Only the candidates some lane picks are
+        // formed; the others stay 0, which no lane selects.
         let [ix, iy, iz] = math::widen3(wi);
         let [ox, oy, oz] = math::widen3(wo);
         let e = k.eta64;
-        let cands = [
-            [ix + ox, iy + oy, iz + oz],
-            [ix + ox * e, iy + oy * e, iz + oz * e],
-            [ix * e + ox, iy * e + oy, iz * e + oz],
+        let need = [
+            S != TRANSMIT,
+            S != REFLECT && up_i.any(),
+            S != REFLECT && !up_i.all(),
         ];
         // For each: |hu|² and the numerator of Fresnel's
         // g² = η²rel − 1 + (wi·h)² (Walter eq. 22, ηrel the index beyond the
@@ -735,20 +772,33 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         // in f64 too: near total internal reflection g² is a small
         // difference, and 1 − F ∝ g there.
         let (m_up, m_down) = (e * e - 1.0, 1.0 / (e * e) - 1.0);
+        let mut hus = [[zero; 3]; 3];
         let mut l2s = [zero; 3];
         let mut g2s = [[zero; 2]; 3];
-        for (j, h) in cands.iter().enumerate() {
+        for j in 0..3 {
+            if !need[j] {
+                continue;
+            }
+            let h = match j {
+                0 => [ix + ox, iy + oy, iz + oz],
+                1 => [ix + ox * e, iy + oy * e, iz + oz * e],
+                _ => [ix * e + ox, iy * e + oy, iz * e + oz],
+            };
             let l2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
-            let c = ix * h[0] + iy * h[1] + iz * h[2];
+            let wih = ix * h[0] + iy * h[1] + iz * h[2];
+            hus[j] = math::channels!(|c| V::narrow(h[c]));
             l2s[j] = V::narrow(l2);
-            g2s[j] = [V::narrow(l2 * m_up + c * c), V::narrow(l2 * m_down + c * c)];
+            g2s[j] = [
+                V::narrow(l2 * m_up + wih * wih),
+                V::narrow(l2 * m_down + wih * wih),
+            ];
         }
-        let pick = |a: [V; 3]| trans.select(up_i.select(a[1], a[2]), a[0]);
-        let hu: [V; 3] = math::channels!(|c| pick([
-            V::narrow(cands[0][c]),
-            V::narrow(cands[1][c]),
-            V::narrow(cands[2][c])
-        ]));
+        let pick = |a: [V; 3]| match S {
+            REFLECT => a[0],
+            TRANSMIT => up_i.select(a[1], a[2]),
+            _ => trans.select(up_i.select(a[1], a[2]), a[0]),
+        };
+        let hu: [V; 3] = math::channels!(|c| pick([hus[0][c], hus[1][c], hus[2][c]]));
         let l2 = pick(l2s);
         let g2n = up_i.select(
             pick([g2s[0][0], g2s[1][0], g2s[2][0]]),
@@ -765,7 +815,11 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         let opl_i = k.scale.one_plus_lambda::<D, V>([wi[0], wi[1], zi.abs()]);
         let opl_o = k.scale.one_plus_lambda::<D, V>([wo[0], wo[1], zo.abs()]);
         let g = if CORRELATED {
-            trans.select(beta_lanes(opl_i, opl_o), one / (opl_i + opl_o - 1.0))
+            match S {
+                REFLECT => one / (opl_i + opl_o - 1.0),
+                TRANSMIT => beta_lanes(opl_i, opl_o),
+                _ => trans.select(beta_lanes(opl_i, opl_o), one / (opl_i + opl_o - 1.0)),
+            }
         } else {
             one / (opl_i * opl_o)
         };
@@ -778,15 +832,30 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         let c = ci.abs();
         let tir = g2n.le(zero);
         let gg = (g2n / l2).max(zero).sqrt();
-        let (s1, s2) = (c + gg, n2 * c + gg);
-        let (rs, rp) = ((c - gg) / s1, (n2 * c - gg) / s2);
-        let fr = tir.select(one, (rs * rs + rp * rp) * 0.5);
-        let ft = tir.select(zero, fresnel_t_lanes(c, gg, n2));
         let zz = (zi * zo).abs();
         // Eq. 20, and eq. 21 with (ηi wi·h + ηo wo·h)² = |ηi wi + ηo wo|² = l2.
-        let refl = fr * d * g / (zz * 4.0);
-        let tr = (ci * co).abs() * eo * eo * ft * d * g / (zz * l2);
-        let v = trans.select(tr, refl);
+        // (Plain blocks, not closures: a closure the optimiser leaves out of
+        // line is compiled without the caller's instruction set, and every
+        // vector operation in it becomes a call.)
+        let refl = if S == TRANSMIT {
+            zero
+        } else {
+            let (s1, s2) = (c + gg, n2 * c + gg);
+            let (rs, rp) = ((c - gg) / s1, (n2 * c - gg) / s2);
+            let fr = tir.select(one, (rs * rs + rp * rp) * 0.5);
+            fr * d * g / (zz * 4.0)
+        };
+        let tr = if S == REFLECT {
+            zero
+        } else {
+            let ft = tir.select(zero, fresnel_t_lanes(c, gg, n2));
+            (ci * co).abs() * eo * eo * ft * d * g / (zz * l2)
+        };
+        let v = match S {
+            REFLECT => refl,
+            TRANSMIT => tr,
+            _ => trans.select(tr, refl),
+        };
         let v = (ok & v.is_finite()).select(v.max(zero), zero);
         math::channels!(|c| v * k.tint[c])
     }
