@@ -769,14 +769,27 @@ impl<const D: u8, const CORRELATED: bool> RdLane<'_, D, CORRELATED> {
         // For each: |hu|² and the numerator of Fresnel's
         // g² = η²rel − 1 + (wi·h)² (Walter eq. 22, ηrel the index beyond the
         // facet over wi's), g² |hu|² = (η²rel − 1) |hu|² + (wi·hu)², formed
-        // in f64 too: near total internal reflection g² is a small
-        // difference, and 1 − F ∝ g there.
+        // in f64 too: near total internal reflection (η²rel < 1) g² is a
+        // small difference, and 1 − F ∝ g there.
         let (m_up, m_down) = (e * e - 1.0, 1.0 / (e * e) - 1.0);
         let mut hus = [[zero; 3]; 3];
         let mut l2s = [zero; 3];
         let mut g2s = [[zero; 2]; 3];
+        // Reflection above a denser side (every pair of a coat, and the
+        // upper rows of this model's lobe at η > 1) needs no f64: wi + wo
+        // cancels exactly where it cancels (Sterbenz), and g² |hu|² is a
+        // sum of two positive terms there, (η² − 1) |hu|² + (wi·hu)².
+        let f32_reflect = S == REFLECT && up_i.all() && e > 1.0;
+        if f32_reflect {
+            let h = math::channels!(|c| wi[c] + wo[c]);
+            let l2 = math::dot(h, h);
+            let wih = math::dot(wi, h);
+            hus[0] = h;
+            l2s[0] = l2;
+            g2s[0] = [l2 * (m_up as f32) + wih * wih, zero];
+        }
         for j in 0..3 {
-            if !need[j] {
+            if !need[j] || (j == 0 && f32_reflect) {
                 continue;
             }
             let h = match j {
