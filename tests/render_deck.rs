@@ -22,6 +22,19 @@ fn out_dir(name: &str) -> PathBuf {
     d
 }
 
+/// A deck file `name` in the fresh folder `out`: the format header, then
+/// `scenes` (TOML).
+fn deck_file(out: &Path, name: &str, scenes: &str) -> PathBuf {
+    std::fs::create_dir_all(out).unwrap();
+    let path = out.join(name);
+    std::fs::write(
+        &path,
+        format!("format = \"bv-deck\"\nversion = 1\n{scenes}"),
+    )
+    .unwrap();
+    path
+}
+
 fn deck_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(DECK)
 }
@@ -80,14 +93,12 @@ fn the_lecture_deck_renders_one_png_per_scene() {
 #[test]
 fn a_bad_deck_names_the_entry_and_the_key() {
     let out = out_dir("bad");
-    std::fs::create_dir_all(&out).unwrap();
-    let path = out.join("bad.toml");
-    std::fs::write(
-        &path,
-        "format = \"bv-deck\"\nversion = 1\n[[scene]]\ntitle = \"Phong\"\ncaption = \"c\"\n\
+    let path = deck_file(
+        &out,
+        "bad.toml",
+        "[[scene]]\ntitle = \"Phong\"\ncaption = \"c\"\n\
          view = \"lobe\"\n[scene.state]\nincident = { theta_deg = 190.0, phi_deg = 0.0 }\n",
-    )
-    .unwrap();
+    );
     let run = Command::new(bin())
         .args(["render", "--deck"])
         .arg(&path)
@@ -130,16 +141,14 @@ fn pixel_noise(img: &image::RgbaImage) -> f64 {
 #[test]
 fn a_deck_takes_the_sample_count_asked_for() {
     let out = out_dir("spp");
-    std::fs::create_dir_all(&out).unwrap();
-    let path = out.join("env.toml");
-    std::fs::write(
-        &path,
-        "format = \"bv-deck\"\nversion = 1\n[[scene]]\ntitle = \"Plastic\"\ncaption = \"c\"\n\
+    let path = deck_file(
+        &out,
+        "env.toml",
+        "[[scene]]\ntitle = \"Plastic\"\ncaption = \"c\"\n\
          view = \"environment\"\n[scene.state]\nselected = 1\n[[scene.state.brdfs]]\nid = 1\n\
          color = [78, 151, 234]\nvisible = true\n\
          spec = { model = \"cook-torrance\", params = { alpha = 0.3 } }\n",
-    )
-    .unwrap();
+    );
     let render = |spp: &str, name: &str| {
         Command::new(bin())
             .args(["render", "--deck"])

@@ -231,24 +231,27 @@ pub fn apply_args(a: &RenderArgs, mut state: AppState) -> Result<AppState> {
         inc.phi_deg = p;
     }
     state.incident = inc.clamped();
+    apply_looks(a, &mut state)?;
+    state.display.caption |= a.caption;
+    state.maximised = None;
+    Ok(state.sanitised())
+}
+
+/// The options that change how a state is drawn, not what: `--light` or
+/// `--dark`, `--log`, `--cosine`, and `--spp N` (the environment view's
+/// target and its figures' exact count; a figure on a software renderer
+/// otherwise keeps to a sample budget,
+/// [`crate::views::environment::figure_spp`]). A single view and every
+/// scene of a deck take them alike.
+fn apply_looks(a: &RenderArgs, state: &mut AppState) -> Result<()> {
     if a.light {
         state.theme = Theme::Light;
     }
     if a.dark {
         state.theme = Theme::Dark;
     }
-    apply_spp(a, &mut state)?;
     state.display.log |= a.log;
     state.display.cosine |= a.cosine;
-    state.display.caption |= a.caption;
-    state.maximised = None;
-    Ok(state.sanitised())
-}
-
-/// `--spp N`: the environment view's target and its figures' exact count
-/// (a figure on a software renderer otherwise keeps to a sample budget:
-/// [`crate::views::environment::figure_spp`]).
-fn apply_spp(a: &RenderArgs, state: &mut AppState) -> Result<()> {
     if let Some(n) = a.spp {
         if !(1..=MAX_TARGET_SPP).contains(&n) {
             bail!("--spp {n}: expected 1..={MAX_TARGET_SPP} samples per pixel");
@@ -489,19 +492,7 @@ fn render_deck(
     }
     let mut d = loaded.deck;
     for s in &mut d.slides {
-        if a.light {
-            s.state.theme = Theme::Light;
-        }
-        if a.dark {
-            s.state.theme = Theme::Dark;
-        }
-        if a.log {
-            s.state.display.log = true;
-        }
-        if a.cosine {
-            s.state.display.cosine = true;
-        }
-        apply_spp(a, &mut s.state)?;
+        apply_looks(a, &mut s.state)?;
     }
     if Kind::of(&a.out).is_some() {
         bail!(
