@@ -721,8 +721,13 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
         // other's half vector, Fresnel term and G (for the correlated G of
         // transmission, a Beta function: logarithms, an exponential and
         // eighteen divisions) are skipped there. Each branch computes the
-        // same values for its lanes as the general one.
-        if !trans.any() {
+        // same values for its lanes as the general one. The one-lane
+        // fallback keeps the general path: LLVM vectorises its loop over
+        // pairs only without a branch per pair (with the branch, 51 against
+        // 70 M evals/s on one core here).
+        if V::LANES == 1 {
+            self.sides::<BOTH, V>(wi, wo, up_i, up_o, trans)
+        } else if !trans.any() {
             self.sides::<REFLECT, V>(wi, wo, up_i, up_o, trans)
         } else if trans.all() {
             self.sides::<TRANSMIT, V>(wi, wo, up_i, up_o, trans)
