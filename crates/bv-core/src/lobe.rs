@@ -3,7 +3,7 @@
 //! `f · cos θo`, on a linear or logarithmic scale. The 3D view and the headless
 //! export draw this mesh; it carries a per-vertex value for colouring.
 
-use crate::batch::{self, Isa, LaneTask, Lanes, Out};
+use crate::batch::{self, Isa, LaneMask, LaneTask, Lanes, Out};
 use crate::{Brdf, DeltaLobe, frame};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -609,20 +609,9 @@ impl PostBand<'_> {
         *mm = V::select(mean.gt(*mm), mean, *mm);
         *mr = V::select(r2.gt(*mr), r2, *mr);
         mean.store(&mut self.radii[k..]);
-        // The mesh's arrays are [x, y, z] per vertex: through lane buffers.
-        let mut t = [[0f32; 16]; 6];
-        f[0].store(&mut t[0]);
-        f[1].store(&mut t[1]);
-        f[2].store(&mut t[2]);
-        p[0].store(&mut t[3]);
-        p[1].store(&mut t[4]);
-        p[2].store(&mut t[5]);
-        let vals = &mut self.vals[k..k + V::LANES];
-        let pos = &mut self.pos[k..k + V::LANES];
-        for (l, (v, p)) in vals.iter_mut().zip(pos).enumerate() {
-            *v = [t[0][l], t[1][l], t[2][l]];
-            *p = [t[3][l], t[4][l], t[5][l]];
-        }
+        // The mesh's arrays are [x, y, z] per vertex.
+        V::store3(f[0], f[1], f[2], &mut self.vals[k..]);
+        V::store3(p[0], p[1], p[2], &mut self.pos[k..]);
     }
 }
 
@@ -676,16 +665,26 @@ impl InteriorNormals<'_> {
         );
         let b = sub(position::<V>(r, d, k + 1), position::<V>(r, d, k - 1));
         let c = cross(a, b);
-        let l = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
-        let inv = V::splat(1.0) / l;
-        let ok = l.gt(V::splat(1e-20)) & l.lt(V::splat(f32::INFINITY));
-        let mut t = [[0f32; 16]; 3];
-        V::select(ok, c[0] * inv, load_at::<V>(d[0], k)).store(&mut t[0]);
-        V::select(ok, c[1] * inv, load_at::<V>(d[1], k)).store(&mut t[1]);
-        V::select(ok, c[2] * inv, load_at::<V>(d[2], k)).store(&mut t[2]);
-        for (l, o) in self.out[j..j + V::LANES].iter_mut().enumerate() {
-            *o = [t[0][l], t[1][l], t[2][l]];
-        }
+        let l2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        // 1/|c| from the instruction set's estimate: a square root and a
+        // division per vector shared one divider and took a third of this
+        // pass on AVX2. A vector with a lane the estimate does not cover (a
+        // subnormal or overflowed |c|²) takes the exact path, whose test is
+        // the edge columns' (`grid_normals`).
+        let fast = l2.ge(V::splat(f32::MIN_POSITIVE)) & l2.lt(V::splat(f32::INFINITY));
+        let (inv, ok) = if fast.all() {
+            (l2.rsqrt(), fast)
+        } else {
+            let l = l2.sqrt();
+            let ok = l.gt(V::splat(1e-20)) & l.lt(V::splat(f32::INFINITY));
+            (V::splat(1.0) / l, ok)
+        };
+        V::store3(
+            V::select(ok, c[0] * inv, load_at::<V>(d[0], k)),
+            V::select(ok, c[1] * inv, load_at::<V>(d[1], k)),
+            V::select(ok, c[2] * inv, load_at::<V>(d[2], k)),
+            &mut self.out[j..],
+        );
     }
 }
 

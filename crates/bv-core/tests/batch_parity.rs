@@ -10,7 +10,9 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
-use bv_core::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, PairBuf};
+use bv_core::batch::{
+    self, Dirs, Isa, Kernel, LaneKernel, LaneMask, LaneTask, Lanes, Out, PairBuf,
+};
 use bv_core::lobe::{self, LobeMesh, LobeOptions, RadiusScale};
 use bv_core::params::{ParamDecl, ParamKind, ParamValue, Params};
 use bv_core::sampling::{self, BvRng};
@@ -483,6 +485,74 @@ fn any_and_all_see_every_lane_on_every_path() {
                 }
             }
         }
+    }
+}
+
+/// `out[k] = [a[k], b[k], c[k]]` through [`Lanes::store3`] and
+/// `inv[k] = a[k].rsqrt()`, whole vectors of the path's width (the arrays
+/// are a multiple of 16 long).
+struct StoreAndRsqrt<'a> {
+    a: [&'a [f32]; 3],
+    out: &'a mut [[f32; 3]],
+    inv: &'a mut [f32],
+}
+impl LaneTask for StoreAndRsqrt<'_> {
+    type Output = ();
+    fn run<V: Lanes>(self) {
+        let mut k = 0;
+        while k < self.out.len() {
+            let [a, b, c] = self.a.map(|x| V::load(&x[k..]));
+            V::store3(a, b, c, &mut self.out[k..]);
+            a.rsqrt().store(&mut self.inv[k..]);
+            k += V::LANES;
+        }
+    }
+}
+
+#[test]
+fn interleaving_stores_and_reciprocal_roots_hold_on_every_path() {
+    // Every lane of every vector distinct, so a lane landing in the wrong
+    // place shows; the guard cells after the arrays' end must stay as
+    // they are. The roots cover f32's normal range, from MIN_POSITIVE to
+    // MAX, in steps that change the exponent and the mantissa.
+    let n = 48 * 16;
+    let mut rng = sampling::rng(7);
+    let mut a: Vec<f32> = (0..n)
+        .map(|k| {
+            let t = k as f64 / (n - 1) as f64;
+            let e = -126.0 + t * 252.9;
+            (2f64.powf(e) * (1.0 + 0.5 * rng.random::<f64>())) as f32
+        })
+        .collect();
+    a[0] = f32::MIN_POSITIVE;
+    a[n - 1] = f32::MAX;
+    let b: Vec<f32> = (0..n).map(|k| -(k as f32) - 0.25).collect();
+    let c: Vec<f32> = (0..n).map(|k| k as f32 * 3.0 + 0.5).collect();
+    for isa in Isa::available() {
+        let guard = [-7.0f32; 3];
+        let mut out = vec![guard; n + 1];
+        let mut inv = vec![-7.0f32; n + 1];
+        batch::run_task(
+            isa,
+            StoreAndRsqrt {
+                a: [&a, &b, &c],
+                out: &mut out[..n],
+                inv: &mut inv[..n],
+            },
+        );
+        for k in 0..n {
+            assert_eq!(out[k], [a[k], b[k], c[k]], "[{isa}] store3, place {k}");
+            let want = 1.0 / (a[k] as f64).sqrt();
+            let rel = (inv[k] as f64 - want).abs() / want;
+            assert!(
+                rel <= 2f64.powi(-21),
+                "[{isa}] rsqrt({}) = {} against {want}: {rel:e}",
+                a[k],
+                inv[k]
+            );
+        }
+        assert_eq!(out[n], guard, "[{isa}] store3 wrote past the end");
+        assert_eq!(inv[n], -7.0, "[{isa}] rsqrt's store wrote past the end");
     }
 }
 

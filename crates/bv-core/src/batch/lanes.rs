@@ -19,7 +19,10 @@
 //! - comparisons are ordered: any comparison with a NaN is false;
 //! - `a.min(b)` and `a.max(b)` return `b` when `a` is NaN (as
 //!   `f32::min`/`max` do; a NaN `b` is not specified);
-//! - [`Lanes::round`] rounds half to even.
+//! - [`Lanes::round`] rounds half to even;
+//! - [`Lanes::rsqrt`] is the one approximate operation (within 2⁻²¹
+//!   relative, not the same bits on every path): for the lobe mesh's
+//!   normals, never for a model's value.
 
 use std::fmt::Debug;
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
@@ -74,9 +77,20 @@ pub trait Lanes:
     fn load(s: &[f32]) -> Self;
     /// Writes the lanes to the first [`Self::LANES`] places of `s`.
     fn store(self, s: &mut [f32]);
+    /// Writes `[a, b, c]` of lane `l` to `out[l]`, for the first
+    /// [`Self::LANES`] places of `out`: a mesh's `[x, y, z]` vertices from
+    /// structure-of-arrays lanes, interleaved in registers. (Through lane
+    /// buffers, LLVM stored them a float at a time: a third of a Lambert
+    /// lobe's time on AVX2.)
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]);
 
     /// `√x` per lane.
     fn sqrt(self) -> Self;
+    /// `1/√x` per lane for finite `x` ≥ `f32::MIN_POSITIVE`, within 2⁻²¹
+    /// relative: the instruction set's estimate refined by Newton's method
+    /// where it has one (no divider), `1/√x` rounded twice where it has not.
+    /// Unspecified for other `x`: a caller selects those lanes away.
+    fn rsqrt(self) -> Self;
     /// `|x|` per lane.
     fn abs(self) -> Self;
     /// The smaller of the two per lane (`o` where `self` is NaN).
@@ -182,8 +196,16 @@ impl Lanes for f32 {
         s[0] = self;
     }
     #[inline(always)]
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
+        out[0] = [a, b, c];
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        1.0 / f32::sqrt(self)
     }
     #[inline(always)]
     fn abs(self) -> Self {

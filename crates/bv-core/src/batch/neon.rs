@@ -72,9 +72,29 @@ impl Lanes for Neon {
         unsafe { vst1q_f32(s.as_mut_ptr(), self.0) }
     }
     #[inline(always)]
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
+        let s = out[..4].as_flattened_mut();
+        // SAFETY: `s` has room for 12 floats; `vst3q_f32` is NEON's
+        // three-way interleaving store; NEON is baseline on AArch64.
+        unsafe { vst3q_f32(s.as_mut_ptr(), float32x4x3_t(a.0, b.0, c.0)) }
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         // SAFETY: NEON is baseline on AArch64.
         Self(unsafe { vsqrtq_f32(self.0) })
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        // The estimate is good to about 2⁻⁸; each `vrsqrts` step, (3 − x·y²)/2,
+        // squares the error.
+        // SAFETY: NEON is baseline on AArch64.
+        unsafe {
+            let x = self.0;
+            let mut y = vrsqrteq_f32(x);
+            y = vmulq_f32(y, vrsqrtsq_f32(vmulq_f32(x, y), y));
+            y = vmulq_f32(y, vrsqrtsq_f32(vmulq_f32(x, y), y));
+            Self(y)
+        }
     }
     #[inline(always)]
     fn abs(self) -> Self {

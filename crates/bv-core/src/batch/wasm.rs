@@ -90,8 +90,32 @@ impl Lanes for Simd128 {
         unsafe { v128_store(s.as_mut_ptr().cast(), self.0) }
     }
     #[inline(always)]
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
+        let s = out[..4].as_flattened_mut();
+        let (a, b, c) = (a.0, b.0, c.0);
+        // [a0 b0 c0 a1] [b1 c1 a2 b2] [c2 a3 b3 c3]; indices 4–7 name the
+        // second operand's lanes.
+        let ab = i32x4_shuffle::<0, 4, 1, 5>(a, b);
+        let v0 = i32x4_shuffle::<0, 1, 4, 2>(ab, c);
+        let bc = i32x4_shuffle::<1, 5, 2, 6>(b, c);
+        let v1 = i32x4_shuffle::<0, 1, 6, 2>(bc, a);
+        let ab3 = i32x4_shuffle::<3, 7, 3, 7>(a, b);
+        let v2 = i32x4_shuffle::<2, 4, 5, 3>(c, ab3);
+        // SAFETY: `s` has room for 12 floats (48 bytes); unaligned stores.
+        unsafe {
+            v128_store(s.as_mut_ptr().cast(), v0);
+            v128_store(s[4..].as_mut_ptr().cast(), v1);
+            v128_store(s[8..].as_mut_ptr().cast(), v2);
+        }
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         Self(f32x4_sqrt(self.0))
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        // simd128 has no estimate.
+        Self(f32x4_div(f32x4_splat(1.0), f32x4_sqrt(self.0)))
     }
     #[inline(always)]
     fn abs(self) -> Self {

@@ -97,9 +97,54 @@ impl Lanes for Avx2 {
         unsafe { _mm256_storeu_ps(s.as_mut_ptr(), self.0) }
     }
     #[inline(always)]
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
+        let s = out[..8].as_flattened_mut();
+        // Output vector k's place p holds lane (8k + p) / 3 of input
+        // (8k + p) mod 3: one lane permutation per output vector applied
+        // to a, b and c, then two blends by the input each place is from.
+        // SAFETY: `s` has room for 24 floats; see the module doc.
+        unsafe {
+            let i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2);
+            let i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5);
+            let i2 = _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7);
+            // Places of a (p ≡ −8k mod 3) and of b (≡ 1 − 8k) as blend masks.
+            let v0 = _mm256_blend_ps::<0b1001_0010>(
+                _mm256_blend_ps::<0b0100_1001>(
+                    _mm256_permutevar8x32_ps(c.0, i0),
+                    _mm256_permutevar8x32_ps(a.0, i0),
+                ),
+                _mm256_permutevar8x32_ps(b.0, i0),
+            );
+            let v1 = _mm256_blend_ps::<0b0010_0100>(
+                _mm256_blend_ps::<0b1001_0010>(
+                    _mm256_permutevar8x32_ps(c.0, i1),
+                    _mm256_permutevar8x32_ps(a.0, i1),
+                ),
+                _mm256_permutevar8x32_ps(b.0, i1),
+            );
+            let v2 = _mm256_blend_ps::<0b0100_1001>(
+                _mm256_blend_ps::<0b0010_0100>(
+                    _mm256_permutevar8x32_ps(c.0, i2),
+                    _mm256_permutevar8x32_ps(a.0, i2),
+                ),
+                _mm256_permutevar8x32_ps(b.0, i2),
+            );
+            _mm256_storeu_ps(s.as_mut_ptr(), v0);
+            _mm256_storeu_ps(s[8..].as_mut_ptr(), v1);
+            _mm256_storeu_ps(s[16..].as_mut_ptr(), v2);
+        }
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         // SAFETY: see the module doc.
         Self(unsafe { _mm256_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        // SAFETY: see the module doc.
+        let y = Self(unsafe { _mm256_rsqrt_ps(self.0) });
+        // The estimate is good to 1.5 · 2⁻¹²; one Newton step squares that.
+        y * (Self::splat(1.5) - (self * 0.5) * y * y)
     }
     #[inline(always)]
     fn abs(self) -> Self {
@@ -214,6 +259,43 @@ pub(super) unsafe fn task_avx2<T: LaneTask>(task: T) -> T::Output {
 // ---------------------------------------------------------------------------
 // AVX-512F.
 
+/// [`Avx512`]'s `store3`: the input lane each place `p` of output vector `k`
+/// takes, `(16k + p) / 3`.
+const STORE3_LANE: [[i32; 16]; 3] = {
+    let mut t = [[0; 16]; 3];
+    let mut k = 0;
+    while k < 3 {
+        let mut p = 0;
+        while p < 16 {
+            t[k][p] = ((16 * k + p) / 3) as i32;
+            p += 1;
+        }
+        k += 1;
+    }
+    t
+};
+/// The places (bit `p`) of output vector `k` that come from input `i`,
+/// those with `(16k + p) mod 3 = i`.
+const fn store3_of(i: usize) -> [u16; 3] {
+    let mut t = [0u16; 3];
+    let mut k = 0;
+    while k < 3 {
+        let mut p = 0;
+        while p < 16 {
+            if (16 * k + p) % 3 == i {
+                t[k] |= 1 << p;
+            }
+            p += 1;
+        }
+        k += 1;
+    }
+    t
+}
+/// See [`store3_of`]: the places from the first input.
+const STORE3_OF_A: [u16; 3] = store3_of(0);
+/// See [`store3_of`]: the places from the second input.
+const STORE3_OF_B: [u16; 3] = store3_of(1);
+
 /// Sixteen f32 lanes in a 512-bit register (AVX-512F; see the module doc).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Avx512(__m512);
@@ -323,9 +405,38 @@ impl Lanes for Avx512 {
         unsafe { _mm512_storeu_ps(s.as_mut_ptr(), self.0) }
     }
     #[inline(always)]
+    fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
+        let s = out[..16].as_flattened_mut();
+        // As on AVX2: output vector k's place p holds lane (16k + p) / 3 of
+        // input (16k + p) mod 3.
+        // SAFETY: `s` has room for 48 floats; see the module doc.
+        unsafe {
+            for (k, chunk) in s.chunks_exact_mut(16).enumerate() {
+                let idx = _mm512_loadu_si512(STORE3_LANE[k].as_ptr().cast());
+                let v = _mm512_mask_blend_ps(
+                    STORE3_OF_B[k],
+                    _mm512_mask_blend_ps(
+                        STORE3_OF_A[k],
+                        _mm512_permutexvar_ps(idx, c.0),
+                        _mm512_permutexvar_ps(idx, a.0),
+                    ),
+                    _mm512_permutexvar_ps(idx, b.0),
+                );
+                _mm512_storeu_ps(chunk.as_mut_ptr(), v);
+            }
+        }
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         // SAFETY: see the module doc.
         Self(unsafe { _mm512_sqrt_ps(self.0) })
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> Self {
+        // SAFETY: see the module doc.
+        let y = Self(unsafe { _mm512_rsqrt14_ps(self.0) });
+        // The estimate is good to 2⁻¹⁴; one Newton step squares that.
+        y * (Self::splat(1.5) - (self * 0.5) * y * y)
     }
     #[inline(always)]
     fn abs(self) -> Self {
