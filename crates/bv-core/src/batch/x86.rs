@@ -550,3 +550,35 @@ pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut
 pub(super) unsafe fn task_avx512<T: LaneTask>(task: T) -> T::Output {
     task.run::<Avx512>()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{STORE3_LANE, STORE3_OF_A, STORE3_OF_B};
+
+    #[test]
+    fn avx512_store3_tables_interleave() {
+        // The AVX-512 path runs only where the CPU has it; its tables are
+        // checked everywhere, through the instructions' definitions:
+        // permutexvar(idx, v)[p] = v[idx[p]], mask_blend(k, x, y)[p] =
+        // y[p] where bit p of k is set, else x[p].
+        let input = |i: usize| -> [f32; 16] { std::array::from_fn(|l| (3 * l + i) as f32) };
+        let (a, b, c) = (input(0), input(1), input(2));
+        for k in 0..3 {
+            for (p, &l) in STORE3_LANE[k].iter().enumerate() {
+                let l = l as usize;
+                let from_a = STORE3_OF_A[k] >> p & 1 == 1;
+                let from_b = STORE3_OF_B[k] >> p & 1 == 1;
+                let v = if from_b {
+                    b[l]
+                } else if from_a {
+                    a[l]
+                } else {
+                    c[l]
+                };
+                // Place 16k + p of the interleaved output holds 16k + p.
+                assert_eq!(v, (16 * k + p) as f32, "vector {k}, place {p}");
+                assert!(!(from_a && from_b));
+            }
+        }
+    }
+}
