@@ -99,39 +99,36 @@ impl Lanes for Avx2 {
     #[inline(always)]
     fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
         let s = out[..8].as_flattened_mut();
-        // Output vector k's place p holds lane (8k + p) / 3 of input
-        // (8k + p) mod 3: one lane permutation per output vector applied
-        // to a, b and c, then two blends by the input each place is from.
-        // SAFETY: `s` has room for 24 floats; see the module doc.
-        unsafe {
-            let i0 = _mm256_setr_epi32(0, 0, 0, 1, 1, 1, 2, 2);
-            let i1 = _mm256_setr_epi32(2, 3, 3, 3, 4, 4, 4, 5);
-            let i2 = _mm256_setr_epi32(5, 5, 6, 6, 6, 7, 7, 7);
-            // Places of a (p ≡ −8k mod 3) and of b (≡ 1 − 8k) as blend masks.
-            let v0 = _mm256_blend_ps::<0b1001_0010>(
-                _mm256_blend_ps::<0b0100_1001>(
-                    _mm256_permutevar8x32_ps(c.0, i0),
-                    _mm256_permutevar8x32_ps(a.0, i0),
+        // See `store3_lanes`: one lane permutation per output vector
+        // applied to a, b and c, then two blends by the input each place
+        // is from (immediates, hence one call per output vector).
+        let (a, b, c) = (a.0, b.0, c.0);
+        // SAFETY: see the module doc.
+        let v = unsafe {
+            [
+                avx2_store3_part::<{ STORE3_OF_A8[0] as i32 }, { STORE3_OF_B8[0] as i32 }>(
+                    a,
+                    b,
+                    c,
+                    &STORE3_LANE8[0],
                 ),
-                _mm256_permutevar8x32_ps(b.0, i0),
-            );
-            let v1 = _mm256_blend_ps::<0b0010_0100>(
-                _mm256_blend_ps::<0b1001_0010>(
-                    _mm256_permutevar8x32_ps(c.0, i1),
-                    _mm256_permutevar8x32_ps(a.0, i1),
+                avx2_store3_part::<{ STORE3_OF_A8[1] as i32 }, { STORE3_OF_B8[1] as i32 }>(
+                    a,
+                    b,
+                    c,
+                    &STORE3_LANE8[1],
                 ),
-                _mm256_permutevar8x32_ps(b.0, i1),
-            );
-            let v2 = _mm256_blend_ps::<0b0100_1001>(
-                _mm256_blend_ps::<0b0010_0100>(
-                    _mm256_permutevar8x32_ps(c.0, i2),
-                    _mm256_permutevar8x32_ps(a.0, i2),
+                avx2_store3_part::<{ STORE3_OF_A8[2] as i32 }, { STORE3_OF_B8[2] as i32 }>(
+                    a,
+                    b,
+                    c,
+                    &STORE3_LANE8[2],
                 ),
-                _mm256_permutevar8x32_ps(b.0, i2),
-            );
-            _mm256_storeu_ps(s.as_mut_ptr(), v0);
-            _mm256_storeu_ps(s[8..].as_mut_ptr(), v1);
-            _mm256_storeu_ps(s[16..].as_mut_ptr(), v2);
+            ]
+        };
+        for (chunk, v) in s.chunks_exact_mut(8).zip(v) {
+            // SAFETY: `chunk` has room for 8 floats; see the module doc.
+            unsafe { _mm256_storeu_ps(chunk.as_mut_ptr(), v) }
         }
     }
     #[inline(always)]
@@ -142,9 +139,8 @@ impl Lanes for Avx2 {
     #[inline(always)]
     fn rsqrt(self) -> Self {
         // SAFETY: see the module doc.
-        let y = Self(unsafe { _mm256_rsqrt_ps(self.0) });
-        // The estimate is good to 1.5 · 2⁻¹²; one Newton step squares that.
-        y * (Self::splat(1.5) - (self * 0.5) * y * y)
+        // The estimate is good to 1.5 · 2⁻¹².
+        rsqrt_step(self, Self(unsafe { _mm256_rsqrt_ps(self.0) }))
     }
     #[inline(always)]
     fn abs(self) -> Self {
@@ -256,33 +252,43 @@ pub(super) unsafe fn task_avx2<T: LaneTask>(task: T) -> T::Output {
     task.run::<Avx2>()
 }
 
-// ---------------------------------------------------------------------------
-// AVX-512F.
+/// One Newton step for `1/√x` from the estimate `y`:
+/// `y (3/2 − x/2 · y²)`, which squares `y`'s relative error (both paths'
+/// [`Lanes::rsqrt`]).
+#[inline(always)]
+fn rsqrt_step<V: Lanes>(x: V, y: V) -> V {
+    y * (V::splat(1.5) - (x * 0.5) * y * y)
+}
 
-/// [`Avx512`]'s `store3`: the input lane each place `p` of output vector `k`
-/// takes, `(16k + p) / 3`.
-const STORE3_LANE: [[i32; 16]; 3] = {
-    let mut t = [[0; 16]; 3];
+// ---------------------------------------------------------------------------
+// `store3`'s tables, shared by both widths.
+
+/// For vectors of `W` lanes: the input lane that place `p` of output vector
+/// `k` takes, `(Wk + p) / 3`, from input `(Wk + p) mod 3` (see
+/// [`store3_from`]): the interleaved `[a0, b0, c0, a1, …]` cut into three
+/// vectors.
+const fn store3_lanes<const W: usize>() -> [[i32; W]; 3] {
+    let mut t = [[0; W]; 3];
     let mut k = 0;
     while k < 3 {
         let mut p = 0;
-        while p < 16 {
-            t[k][p] = ((16 * k + p) / 3) as i32;
+        while p < W {
+            t[k][p] = ((W * k + p) / 3) as i32;
             p += 1;
         }
         k += 1;
     }
     t
-};
+}
 /// The places (bit `p`) of output vector `k` that come from input `i`,
-/// those with `(16k + p) mod 3 = i`.
-const fn store3_of(i: usize) -> [u16; 3] {
+/// those with `(Wk + p) mod 3 = i`, for vectors of `W ≤ 16` lanes.
+const fn store3_from<const W: usize>(i: usize) -> [u16; 3] {
     let mut t = [0u16; 3];
     let mut k = 0;
     while k < 3 {
         let mut p = 0;
-        while p < 16 {
-            if (16 * k + p) % 3 == i {
+        while p < W {
+            if (W * k + p) % 3 == i {
                 t[k] |= 1 << p;
             }
             p += 1;
@@ -291,10 +297,47 @@ const fn store3_of(i: usize) -> [u16; 3] {
     }
     t
 }
-/// See [`store3_of`]: the places from the first input.
-const STORE3_OF_A: [u16; 3] = store3_of(0);
-/// See [`store3_of`]: the places from the second input.
-const STORE3_OF_B: [u16; 3] = store3_of(1);
+/// [`store3_lanes`] for [`Avx2`].
+const STORE3_LANE8: [[i32; 8]; 3] = store3_lanes::<8>();
+/// [`store3_from`] the first input, for [`Avx2`].
+const STORE3_OF_A8: [u16; 3] = store3_from::<8>(0);
+/// [`store3_from`] the second input, for [`Avx2`].
+const STORE3_OF_B8: [u16; 3] = store3_from::<8>(1);
+/// [`store3_lanes`] for [`Avx512`].
+const STORE3_LANE16: [[i32; 16]; 3] = store3_lanes::<16>();
+/// [`store3_from`] the first input, for [`Avx512`].
+const STORE3_OF_A16: [u16; 3] = store3_from::<16>(0);
+/// [`store3_from`] the second input, for [`Avx512`].
+const STORE3_OF_B16: [u16; 3] = store3_from::<16>(1);
+
+/// One output vector of [`Avx2`]'s `store3`: `a`, `b` and `c` permuted by
+/// `lanes`, then the places in `FROM_A` taken from `a`, those in `FROM_B`
+/// from `b` (blend immediates), the rest from `c`.
+///
+/// # Safety
+/// The CPU must have AVX2 (see the module doc).
+#[inline(always)]
+unsafe fn avx2_store3_part<const FROM_A: i32, const FROM_B: i32>(
+    a: __m256,
+    b: __m256,
+    c: __m256,
+    lanes: &[i32; 8],
+) -> __m256 {
+    // SAFETY: `lanes` holds 8 i32 (unaligned load); the caller has AVX2.
+    unsafe {
+        let idx = _mm256_loadu_si256(lanes.as_ptr().cast());
+        _mm256_blend_ps::<FROM_B>(
+            _mm256_blend_ps::<FROM_A>(
+                _mm256_permutevar8x32_ps(c, idx),
+                _mm256_permutevar8x32_ps(a, idx),
+            ),
+            _mm256_permutevar8x32_ps(b, idx),
+        )
+    }
+}
+
+// ---------------------------------------------------------------------------
+// AVX-512F.
 
 /// Sixteen f32 lanes in a 512-bit register (AVX-512F; see the module doc).
 #[derive(Clone, Copy, Debug)]
@@ -407,16 +450,15 @@ impl Lanes for Avx512 {
     #[inline(always)]
     fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
         let s = out[..16].as_flattened_mut();
-        // As on AVX2: output vector k's place p holds lane (16k + p) / 3 of
-        // input (16k + p) mod 3.
+        // See `store3_lanes`.
         // SAFETY: `s` has room for 48 floats; see the module doc.
         unsafe {
             for (k, chunk) in s.chunks_exact_mut(16).enumerate() {
-                let idx = _mm512_loadu_si512(STORE3_LANE[k].as_ptr().cast());
+                let idx = _mm512_loadu_si512(STORE3_LANE16[k].as_ptr().cast());
                 let v = _mm512_mask_blend_ps(
-                    STORE3_OF_B[k],
+                    STORE3_OF_B16[k],
                     _mm512_mask_blend_ps(
-                        STORE3_OF_A[k],
+                        STORE3_OF_A16[k],
                         _mm512_permutexvar_ps(idx, c.0),
                         _mm512_permutexvar_ps(idx, a.0),
                     ),
@@ -434,9 +476,8 @@ impl Lanes for Avx512 {
     #[inline(always)]
     fn rsqrt(self) -> Self {
         // SAFETY: see the module doc.
-        let y = Self(unsafe { _mm512_rsqrt14_ps(self.0) });
-        // The estimate is good to 2⁻¹⁴; one Newton step squares that.
-        y * (Self::splat(1.5) - (self * 0.5) * y * y)
+        // The estimate is good to 2⁻¹⁴.
+        rsqrt_step(self, Self(unsafe { _mm512_rsqrt14_ps(self.0) }))
     }
     #[inline(always)]
     fn abs(self) -> Self {
@@ -553,21 +594,21 @@ pub(super) unsafe fn task_avx512<T: LaneTask>(task: T) -> T::Output {
 
 #[cfg(test)]
 mod tests {
-    use super::{STORE3_LANE, STORE3_OF_A, STORE3_OF_B};
+    use super::{
+        STORE3_LANE8, STORE3_LANE16, STORE3_OF_A8, STORE3_OF_A16, STORE3_OF_B8, STORE3_OF_B16,
+    };
 
-    #[test]
-    fn avx512_store3_tables_interleave() {
-        // The AVX-512 path runs only where the CPU has it; its tables are
-        // checked everywhere, through the instructions' definitions:
-        // permutexvar(idx, v)[p] = v[idx[p]], mask_blend(k, x, y)[p] =
-        // y[p] where bit p of k is set, else x[p].
-        let input = |i: usize| -> [f32; 16] { std::array::from_fn(|l| (3 * l + i) as f32) };
+    /// Checks `store3`'s tables for vectors of `W` lanes through the
+    /// instructions' definitions: permute(idx, v)[p] = v[idx[p]],
+    /// blend(k, x, y)[p] = y[p] where bit p of k is set, else x[p].
+    fn check_tables<const W: usize>(lanes: &[[i32; W]; 3], of_a: &[u16; 3], of_b: &[u16; 3]) {
+        let input = |i: usize| -> [f32; W] { std::array::from_fn(|l| (3 * l + i) as f32) };
         let (a, b, c) = (input(0), input(1), input(2));
         for k in 0..3 {
-            for (p, &l) in STORE3_LANE[k].iter().enumerate() {
+            for (p, &l) in lanes[k].iter().enumerate() {
                 let l = l as usize;
-                let from_a = STORE3_OF_A[k] >> p & 1 == 1;
-                let from_b = STORE3_OF_B[k] >> p & 1 == 1;
+                let from_a = of_a[k] >> p & 1 == 1;
+                let from_b = of_b[k] >> p & 1 == 1;
                 let v = if from_b {
                     b[l]
                 } else if from_a {
@@ -575,10 +616,19 @@ mod tests {
                 } else {
                     c[l]
                 };
-                // Place 16k + p of the interleaved output holds 16k + p.
-                assert_eq!(v, (16 * k + p) as f32, "vector {k}, place {p}");
+                // Place Wk + p of the interleaved output holds Wk + p.
+                assert_eq!(v, (W * k + p) as f32, "{W} lanes: vector {k}, place {p}");
                 assert!(!(from_a && from_b));
             }
         }
+    }
+
+    #[test]
+    fn avx512_store3_tables_interleave() {
+        // The AVX-512 path runs only where the CPU has it; its tables are
+        // checked everywhere (and the AVX2 path's, which it shares the
+        // builders with).
+        check_tables(&STORE3_LANE16, &STORE3_OF_A16, &STORE3_OF_B16);
+        check_tables(&STORE3_LANE8, &STORE3_OF_A8, &STORE3_OF_B8);
     }
 }
