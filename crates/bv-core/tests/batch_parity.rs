@@ -438,29 +438,36 @@ fn by_sides(dirs: &PairBuf) -> PairBuf {
 }
 
 /// Writes, for each lane, whether any and whether every lane of its vector
-/// has `wi.x > 0` (1 or 0).
+/// has `wi.x > 0` (1 or 0); `TWICE` as the kernel's
+/// [`LaneKernel::TWICE`].
 #[derive(Debug)]
-struct MaskProbe;
-impl LaneKernel for MaskProbe {
+struct MaskProbe<const TWICE: bool>;
+impl<const TWICE: bool> LaneKernel for MaskProbe<TWICE> {
     fn lane<V: Lanes>(&self, wi: [V; 3], _wo: [V; 3]) -> [V; 3] {
         let m = wi[0].gt(V::splat(0.0));
         let bit = |b: bool| V::splat(if b { 1.0 } else { 0.0 });
         [bit(m.any()), bit(m.all()), V::splat(0.0)]
     }
+    const TWICE: bool = TWICE;
 }
 
 #[test]
 fn any_and_all_see_every_lane_on_every_path() {
     // Vectors of every pattern that matters: none, one lane (each position
     // in turn), all but one, all. The probe's pairs start at 0 and fill
-    // whole vectors of each width (16 is a multiple of 1, 4, 8 and 16).
+    // whole vectors of each width (16 is a multiple of 1, 4, 8 and 16, and
+    // of 16 lanes as two vectors of 8).
     let mut patterns: Vec<Vec<bool>> = vec![vec![false; 16], vec![true; 16]];
     for k in 0..16 {
         patterns.push((0..16).map(|i| i == k).collect());
         patterns.push((0..16).map(|i| i != k).collect());
     }
-    for isa in Isa::available() {
-        let w = isa.lanes();
+    for (isa, twice) in Isa::available()
+        .into_iter()
+        .flat_map(|isa| [(isa, false), (isa, true)])
+    {
+        // A kernel's vector: two of the path's where it runs `Twice`.
+        let w = isa.lanes() * if twice && isa.twice() { 2 } else { 1 };
         for pattern in &patterns {
             let mut dirs = PairBuf::default();
             for &on in pattern {
@@ -469,8 +476,12 @@ fn any_and_all_see_every_lane_on_every_path() {
             }
             let n = dirs.len();
             let (mut any, mut all, mut z) = (vec![-1f32; n], vec![-1f32; n], vec![-1f32; n]);
-            batch::run(
-                &MaskProbe,
+            let probe: &dyn Kernel = if twice {
+                &MaskProbe::<true>
+            } else {
+                &MaskProbe::<false>
+            };
+            probe.eval(
                 isa,
                 &dirs.dirs(0..n),
                 &mut Out {
@@ -481,7 +492,7 @@ fn any_and_all_see_every_lane_on_every_path() {
                 let want = (chunk.iter().any(|&b| b), chunk.iter().all(|&b| b));
                 for i in v * w..(v + 1) * w {
                     let got = (any[i] == 1.0, all[i] == 1.0);
-                    assert_eq!(got, want, "[{isa}] {pattern:?}, lane {i}");
+                    assert_eq!(got, want, "[{isa}, twice {twice}] {pattern:?}, lane {i}");
                 }
             }
         }

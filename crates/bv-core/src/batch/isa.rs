@@ -85,6 +85,14 @@ impl Isa {
         }
     }
 
+    /// Whether kernels run two vectors per step on this path
+    /// ([`super::Twice`], for those whose [`super::LaneKernel::TWICE`]
+    /// allows it): AVX2, where it measured faster. AVX-512 has not been
+    /// measured (no machine here has it), and NEON and `simd128` keep one.
+    pub fn twice(self) -> bool {
+        matches!(self, Isa::Avx2)
+    }
+
     /// Whether this CPU and build can run it.
     pub fn is_available(self) -> bool {
         match self {

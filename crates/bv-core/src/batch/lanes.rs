@@ -15,7 +15,9 @@
 //! Semantics shared by every implementation, so that a kernel gives the same
 //! answer on every path up to the rounding of its own operations:
 //! - `+ − × ÷` and `sqrt` are IEEE-754 single precision, correctly rounded
-//!   (no fused multiply-add is formed behind the kernel's back);
+//!   (no fused multiply-add is formed behind the kernel's back: only
+//!   [`Lanes::mul_add`] asks for one, and it is fused where the instruction
+//!   set has the instruction, two roundings elsewhere);
 //! - comparisons are ordered: any comparison with a NaN is false;
 //! - `a.min(b)` and `a.max(b)` return `b` when `a` is NaN (as
 //!   `f32::min`/`max` do; a NaN `b` is not specified);
@@ -84,6 +86,15 @@ pub trait Lanes:
     /// lobe's time on AVX2.)
     fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]);
 
+    /// `self · b + c` per lane, rounded once where the instruction set has
+    /// a fused multiply-add (AVX2 + FMA, AVX-512, NEON) and twice where it
+    /// has not (wasm `simd128`, and the scalar fallback, which is built for
+    /// any CPU: there `f32::mul_add` would be a software `fmaf`). For the
+    /// dependency chains of [`super::math`]'s polynomials, whose error
+    /// bounds hold for either rounding: one instruction of 4 cycles'
+    /// latency where a multiply and an add take 6 (Zen 3), and the exp in a
+    /// Phong kernel is a chain of seven.
+    fn mul_add(self, b: Self, c: Self) -> Self;
     /// `√x` per lane.
     fn sqrt(self) -> Self;
     /// `1/√x` per lane for finite `x` ≥ `f32::MIN_POSITIVE`, within 2⁻²¹
@@ -198,6 +209,11 @@ impl Lanes for f32 {
     #[inline(always)]
     fn store3(a: Self, b: Self, c: Self, out: &mut [[f32; 3]]) {
         out[0] = [a, b, c];
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // Two roundings: see the trait doc.
+        self * b + c
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

@@ -44,12 +44,13 @@ pub fn exp<V: Lanes>(x: V) -> V {
     x.gt(V::splat(88.7)).select(V::splat(f32::INFINITY), v)
 }
 
-/// `c[0] + x (c[1] + x (c[2] + …))` by Horner's rule.
+/// `c[0] + x (c[1] + x (c[2] + …))` by Horner's rule, each step one
+/// [`Lanes::mul_add`].
 #[inline(always)]
 fn poly<V: Lanes>(x: V, c: &[f32]) -> V {
     let mut acc = V::splat(c[c.len() - 1]);
     for &k in c[..c.len() - 1].iter().rev() {
-        acc = acc * x + k;
+        acc = acc.mul_add(x, V::splat(k));
     }
     acc
 }
@@ -67,24 +68,44 @@ fn atanh2<V: Lanes>(s: V) -> V {
 /// `pow` with large exponents). Non-positive `x` gives −∞.
 #[inline(always)]
 pub fn ln<V: Lanes>(x: V) -> V {
+    let (base, num, den) = ln_reduced(x);
+    finish_ln(x, base + atanh2(num / den))
+}
+
+/// `ln x = e ln 2 + 2 atanh((m − 1)/(m + 1))` with `x = m · 2ᵉ` and
+/// `m ∈ [√½, √2)` (then the ratio's `|s| ≤ 0.1716`), as
+/// `(e ln 2, m − 1, m + 1)`: the division is left to the caller, so that
+/// [`ln_near_one`] divides once for both of its forms.
+#[inline(always)]
+fn ln_reduced<V: Lanes>(x: V) -> (V, V, V) {
     let (e, m) = x.exponent_mantissa();
-    // m ∈ [√½, √2): then s = (m − 1)/(m + 1) has |s| ≤ 0.1716.
     let big = m.gt(V::splat(std::f32::consts::SQRT_2));
     let m = big.select(m * 0.5, m);
     let e = big.select(e + 1.0, e);
-    let s = (m - 1.0) / (m + 1.0);
-    let v = e * std::f32::consts::LN_2 + atanh2(s);
+    (e * std::f32::consts::LN_2, m - 1.0, m + 1.0)
+}
+
+/// −∞ where `x` is not positive, `v` elsewhere.
+#[inline(always)]
+fn finish_ln<V: Lanes>(x: V, v: V) -> V {
     x.gt(V::splat(0.0)).select(v, V::splat(f32::NEG_INFINITY))
 }
 
 /// `ln x` given both `x` and `y = 1 − x` (each accurate to f32 rounding),
 /// accurate relative to the result also near `x = 1`, where `ln x` from a
 /// rounded `x` would lose every digit: `2 atanh(−y/(2 − y))` by the series of
-/// [`ln`] for `y < 0.29` (`|s| ≤ 0.17`), [`ln`]`(x)` otherwise.
+/// [`ln`] for `y < 0.29` (`|s| ≤ 0.17`), [`ln`]`(x)` otherwise. The two
+/// forms share one division and one series: the lanes pick their ratio
+/// before it (a division is 10 cycles' latency on Zen 3, and the Phong
+/// lobes' chain runs through this).
 #[inline(always)]
 pub fn ln_near_one<V: Lanes>(x: V, y: V) -> V {
-    let s = -y / (V::splat(2.0) - y);
-    y.lt(V::splat(0.29)).select(atanh2(s), ln(x))
+    let (base, num, den) = ln_reduced(x);
+    let near = y.lt(V::splat(0.29));
+    let num = near.select(-y, num);
+    let den = near.select(V::splat(2.0) - y, den);
+    let base = near.select(V::splat(0.0), base);
+    finish_ln(x, base + atanh2(num / den))
 }
 
 /// The Phong lobe `clamped_pow(R(wo)·wi, e)` of `phong` and

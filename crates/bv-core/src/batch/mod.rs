@@ -11,7 +11,10 @@
 //! it once per instruction set ([`Isa`]: AVX-512 with 16 lanes, AVX2 + FMA
 //! with 8, NEON and wasm `simd128` with 4, and `f32` itself as the scalar
 //! fallback) and calls the copy for the instruction set chosen at run time
-//! ([`isa`]: the widest this CPU has, or `BV_ISA`'s). A model without a
+//! ([`isa`]: the widest this CPU has, or `BV_ISA`'s). On AVX2 the copy
+//! steps two vectors at a time ([`Twice`]): a kernel with a transcendental
+//! is one long dependency chain, and two chains side by side keep the core
+//! busy where one left it waiting. A model without a
 //! kernel is evaluated by [`eval`] through its scalar f64 `eval`, one lane at
 //! a time, so every caller can use the batch path for every model. The f64
 //! `eval` stays the reference: the parity test (`tests/batch_parity.rs`)
@@ -45,6 +48,7 @@ pub mod lanes;
 pub mod math;
 #[cfg(target_arch = "aarch64")]
 mod neon;
+pub mod twice;
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 mod wasm;
 #[cfg(target_arch = "x86_64")]
@@ -52,6 +56,7 @@ mod x86;
 
 pub use isa::{Isa, IsaError};
 pub use lanes::{LaneMask, Lanes, WideLanes};
+pub use twice::Twice;
 
 use crate::Brdf;
 use glam::DVec3;
@@ -190,6 +195,13 @@ pub trait Kernel: Send + Sync + std::fmt::Debug {
 pub trait LaneKernel: Send + Sync + std::fmt::Debug {
     /// `f(wi, wo)` per channel for each lane of `wi` and `wo`.
     fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3];
+
+    /// Whether an instruction set that runs kernels two vectors at a time
+    /// ([`Twice`], see [`twice`]: AVX2) does so for this one. True unless
+    /// the kernel measured slower that way (a kernel that branches on
+    /// whole vectors sees fewer uniform ones at twice the width, and one
+    /// with many live values spills more).
+    const TWICE: bool = true;
 }
 
 impl<K: LaneKernel> Kernel for K {
@@ -268,12 +280,38 @@ pub fn run_task<T: LaneTask>(isa: Isa, task: T) -> T::Output {
 #[inline(always)]
 fn lanes_loop<V: Lanes, K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     let n = dirs.len().min(out.len());
+    let whole = whole_vectors::<V, K>(k, dirs, out, 0, n);
+    padded_rest::<V, K>(k, dirs, out, whole, n);
+}
+
+/// [`lanes_loop`] through [`Twice`]`<V>` (two vectors per step, see
+/// [`twice`]) while two whole vectors remain, then one `V` at a time, so
+/// that the remainder pads at most `V::LANES − 1` lanes.
+#[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+fn lanes_loop_twice<V: Lanes, K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    let n = dirs.len().min(out.len());
+    let pairs = whole_vectors::<Twice<V>, K>(k, dirs, out, 0, n);
+    let whole = whole_vectors::<V, K>(k, dirs, out, pairs, n);
+    padded_rest::<V, K>(k, dirs, out, whole, n);
+}
+
+/// Lanes `from..` in whole vectors of `V` up to `n` (`from + V::LANES·m ≤
+/// n`); returns where they end.
+#[inline(always)]
+fn whole_vectors<V: Lanes, K: LaneKernel>(
+    k: &K,
+    dirs: &Dirs<'_>,
+    out: &mut Out<'_>,
+    from: usize,
+    n: usize,
+) -> usize {
     let [ix, iy, iz] = dirs.wi.map(|a| &a[..n]);
     let [ox, oy, oz] = dirs.wo.map(|a| &a[..n]);
     let [r, g, b] = &mut out.rgb;
     let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
-    let whole = n - n % V::LANES;
-    let mut i = 0;
+    let whole = from + (n - from) / V::LANES * V::LANES;
+    let mut i = from;
     while i < whole {
         let wi = [V::load(&ix[i..]), V::load(&iy[i..]), V::load(&iz[i..])];
         let wo = [V::load(&ox[i..]), V::load(&oy[i..]), V::load(&oz[i..])];
@@ -283,33 +321,51 @@ fn lanes_loop<V: Lanes, K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>
         f[2].store(&mut b[i..]);
         i += V::LANES;
     }
+    whole
+}
+
+/// The lanes `whole..n` (fewer than `V::LANES`) through one vector padded
+/// with the normal direction (its lanes are computed and dropped).
+#[inline(always)]
+fn padded_rest<V: Lanes, K: LaneKernel>(
+    k: &K,
+    dirs: &Dirs<'_>,
+    out: &mut Out<'_>,
+    whole: usize,
+    n: usize,
+) {
+    // The widest vector a remainder goes through has 16 lanes.
+    const { assert!(V::LANES <= 16) };
     let rest = n - whole;
-    if rest > 0 {
-        // The widest vector has 16 lanes.
-        let pad = |src: &[f32], fill: f32| {
-            let mut a = [fill; 16];
-            a[..rest].copy_from_slice(&src[whole..]);
-            a
-        };
-        let wi = [
-            V::load(&pad(ix, 0.0)),
-            V::load(&pad(iy, 0.0)),
-            V::load(&pad(iz, 1.0)),
-        ];
-        let wo = [
-            V::load(&pad(ox, 0.0)),
-            V::load(&pad(oy, 0.0)),
-            V::load(&pad(oz, 1.0)),
-        ];
-        let f = k.lane(wi, wo);
-        let mut a = [[0f32; 16]; 3];
-        f[0].store(&mut a[0]);
-        f[1].store(&mut a[1]);
-        f[2].store(&mut a[2]);
-        r[whole..].copy_from_slice(&a[0][..rest]);
-        g[whole..].copy_from_slice(&a[1][..rest]);
-        b[whole..].copy_from_slice(&a[2][..rest]);
+    if rest == 0 {
+        return;
     }
+    let [ix, iy, iz] = dirs.wi.map(|a| &a[..n]);
+    let [ox, oy, oz] = dirs.wo.map(|a| &a[..n]);
+    let [r, g, b] = &mut out.rgb;
+    let pad = |src: &[f32], fill: f32| {
+        let mut a = [fill; 16];
+        a[..rest].copy_from_slice(&src[whole..]);
+        a
+    };
+    let wi = [
+        V::load(&pad(ix, 0.0)),
+        V::load(&pad(iy, 0.0)),
+        V::load(&pad(iz, 1.0)),
+    ];
+    let wo = [
+        V::load(&pad(ox, 0.0)),
+        V::load(&pad(oy, 0.0)),
+        V::load(&pad(oz, 1.0)),
+    ];
+    let f = k.lane(wi, wo);
+    let mut a = [[0f32; 16]; 3];
+    f[0].store(&mut a[0]);
+    f[1].store(&mut a[1]);
+    f[2].store(&mut a[2]);
+    r[whole..n].copy_from_slice(&a[0][..rest]);
+    g[whole..n].copy_from_slice(&a[1][..rest]);
+    b[whole..n].copy_from_slice(&a[2][..rest]);
 }
 
 /// Which path a batch took.

@@ -79,6 +79,12 @@ impl Lanes for Neon {
         unsafe { vst3q_f32(s.as_mut_ptr(), float32x4x3_t(a.0, b.0, c.0)) }
     }
     #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // `vfmaq_f32(c, a, b)` is `c + a·b`, fused.
+        // SAFETY: NEON is baseline on AArch64.
+        Self(unsafe { vfmaq_f32(c.0, self.0, b.0) })
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         // SAFETY: NEON is baseline on AArch64.
         Self(unsafe { vsqrtq_f32(self.0) })

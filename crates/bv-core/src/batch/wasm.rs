@@ -109,6 +109,12 @@ impl Lanes for Simd128 {
         }
     }
     #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // simd128 has no fused multiply-add (relaxed-simd's `relaxed_madd`
+        // may or may not fuse, and is not enabled for the web build).
+        Self(f32x4_add(f32x4_mul(self.0, b.0), c.0))
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         Self(f32x4_sqrt(self.0))
     }

@@ -132,6 +132,11 @@ impl Lanes for Avx2 {
         }
     }
     #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // SAFETY: see the module doc (the kernel is compiled with `fma`).
+        Self(unsafe { _mm256_fmadd_ps(self.0, b.0, c.0) })
+    }
+    #[inline(always)]
     fn sqrt(self) -> Self {
         // SAFETY: see the module doc.
         Self(unsafe { _mm256_sqrt_ps(self.0) })
@@ -240,7 +245,12 @@ impl Lanes for Avx2 {
 /// The CPU must have AVX2 and FMA.
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::lanes_loop::<Avx2, K>(k, dirs, out);
+    // Two vectors side by side where the kernel allows it: see `Twice`.
+    if K::TWICE {
+        super::lanes_loop_twice::<Avx2, K>(k, dirs, out);
+    } else {
+        super::lanes_loop::<Avx2, K>(k, dirs, out);
+    }
 }
 
 /// `task` in AVX2 + FMA code.
@@ -467,6 +477,11 @@ impl Lanes for Avx512 {
                 _mm512_storeu_ps(chunk.as_mut_ptr(), v);
             }
         }
+    }
+    #[inline(always)]
+    fn mul_add(self, b: Self, c: Self) -> Self {
+        // SAFETY: see the module doc.
+        Self(unsafe { _mm512_fmadd_ps(self.0, b.0, c.0) })
     }
     #[inline(always)]
     fn sqrt(self) -> Self {

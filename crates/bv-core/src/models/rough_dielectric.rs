@@ -735,6 +735,15 @@ impl<const D: u8, const CORRELATED: bool> LaneKernel for RdLane<'_, D, CORRELATE
             self.sides::<BOTH, V>(wi, wo, up_i, up_o, trans)
         }
     }
+
+    // One vector at a time: through `Twice` on AVX2 the 128 × 256 lobe,
+    // which a slider drag waits for, took 193–225 µs against 183–203
+    // (criterion `lobe/rough-dielectric/128x256/reuse`, 5 interleaved
+    // rounds on a Zen 3), though random pairs gained 7 % (`batch/
+    // rough-dielectric/avx2x8`, 3.48–3.65 against 3.73–4.02 ms): the
+    // lobe's vectors mostly take one side's branch, and at 16 lanes fewer
+    // of them are uniform near the horizon.
+    const TWICE: bool = false;
 }
 
 impl<const D: u8, const CORRELATED: bool> RdLane<'_, D, CORRELATED> {
