@@ -89,7 +89,7 @@ impl Isa {
     /// ([`super::Twice`], for those whose [`super::LaneKernel::TWICE`]
     /// allows it): AVX2, where it measured faster. AVX-512 has not been
     /// measured (no machine here has it), and NEON and `simd128` keep one.
-    pub fn twice(self) -> bool {
+    pub const fn twice(self) -> bool {
         matches!(self, Isa::Avx2)
     }
 

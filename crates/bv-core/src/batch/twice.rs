@@ -69,34 +69,38 @@ impl<M: LaneMask> LaneMask for TwiceMask<M> {
     }
 }
 
-/// `Twice<V> op Twice<V>` and `Twice<V> op f32`, halves apart.
-macro_rules! twice_ops {
-    ($($tr:ident $f:ident),*) => {$(
-        impl<V: Lanes> $tr for Twice<V> {
+/// The arithmetic of a pair type `$t<$p>` (`Twice`, `TwiceWide`), each
+/// half by itself: `$t op $t` for the first list of operators, `$t op
+/// $scalar` for the second, and `-$t`.
+macro_rules! halves_ops {
+    ($t:ident<$p:ident: $bound:ident>, $scalar:ty;
+     [$($tr:ident $f:ident),*]; [$($str:ident $sf:ident),*]) => {
+        $(impl<$p: $bound> $tr for $t<$p> {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: Self) -> Self {
                 Self(self.0.$f(o.0), self.1.$f(o.1))
             }
-        }
-        impl<V: Lanes> $tr<f32> for Twice<V> {
+        })*
+        $(impl<$p: $bound> $str<$scalar> for $t<$p> {
             type Output = Self;
             #[inline(always)]
-            fn $f(self, o: f32) -> Self {
-                Self(self.0.$f(o), self.1.$f(o))
+            fn $sf(self, o: $scalar) -> Self {
+                Self(self.0.$sf(o), self.1.$sf(o))
+            }
+        })*
+        impl<$p: $bound> Neg for $t<$p> {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                Self(-self.0, -self.1)
             }
         }
-    )*};
+    };
 }
-twice_ops!(Add add, Sub sub, Mul mul, Div div);
+halves_ops!(Twice<V: Lanes>, f32; [Add add, Sub sub, Mul mul, Div div]; [Add add, Sub sub, Mul mul, Div div]);
+halves_ops!(TwiceWide<W: WideLanes>, f64; [Add add, Sub sub, Mul mul]; [Add add, Mul mul]);
 
-impl<V: Lanes> Neg for Twice<V> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Self(-self.0, -self.1)
-    }
-}
 impl<V: Lanes> AddAssign for Twice<V> {
     #[inline(always)]
     fn add_assign(&mut self, o: Self) {
@@ -217,41 +221,6 @@ impl<V: Lanes> Lanes for Twice<V> {
     #[inline(always)]
     fn narrow(w: Self::Wide) -> Self {
         Self(V::narrow(w.0), V::narrow(w.1))
-    }
-}
-
-macro_rules! twice_wide_ops {
-    ($($tr:ident $f:ident),*) => {$(
-        impl<W: WideLanes> $tr for TwiceWide<W> {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(self, o: Self) -> Self {
-                Self(self.0.$f(o.0), self.1.$f(o.1))
-            }
-        }
-        impl<W: WideLanes> $tr<f64> for TwiceWide<W> {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(self, o: f64) -> Self {
-                Self(self.0.$f(o), self.1.$f(o))
-            }
-        }
-    )*};
-}
-twice_wide_ops!(Add add, Mul mul);
-
-impl<W: WideLanes> Sub for TwiceWide<W> {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        Self(self.0 - o.0, self.1 - o.1)
-    }
-}
-impl<W: WideLanes> Neg for TwiceWide<W> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        Self(-self.0, -self.1)
     }
 }
 

@@ -9,7 +9,7 @@
 //! make one.
 
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, LaneTask, Out};
+use super::{Dirs, Isa, LaneKernel, LaneTask, Out};
 use std::arch::x86_64::*;
 
 // ---------------------------------------------------------------------------
@@ -245,8 +245,8 @@ impl Lanes for Avx2 {
 /// The CPU must have AVX2 and FMA.
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    // Two vectors side by side where the kernel allows it: see `Twice`.
-    if K::TWICE {
+    // Two vectors side by side where the kernel and `Isa::twice` allow it.
+    if K::TWICE && Isa::Avx2.twice() {
         super::lanes_loop_twice::<Avx2, K>(k, dirs, out);
     } else {
         super::lanes_loop::<Avx2, K>(k, dirs, out);
