@@ -455,12 +455,13 @@ impl<const TWICE: bool> LaneKernel for MaskProbe<TWICE> {
 fn any_and_all_see_every_lane_on_every_path() {
     // Vectors of every pattern that matters: none, one lane (each position
     // in turn), all but one, all. The probe's pairs start at 0 and fill
-    // whole vectors of each width (16 is a multiple of 1, 4, 8 and 16, and
-    // of 16 lanes as two vectors of 8).
-    let mut patterns: Vec<Vec<bool>> = vec![vec![false; 16], vec![true; 16]];
-    for k in 0..16 {
-        patterns.push((0..16).map(|i| i == k).collect());
-        patterns.push((0..16).map(|i| i != k).collect());
+    // whole vectors of each width (32 is a multiple of 1, 4, 8 and 16, and
+    // of two vectors of 8 or of 16).
+    const N: usize = 32;
+    let mut patterns: Vec<Vec<bool>> = vec![vec![false; N], vec![true; N]];
+    for k in 0..N {
+        patterns.push((0..N).map(|i| i == k).collect());
+        patterns.push((0..N).map(|i| i != k).collect());
     }
     for (isa, twice) in Isa::available()
         .into_iter()
@@ -643,14 +644,17 @@ fn a_wrong_kernel_is_caught() {
 
 #[test]
 fn every_length_fills_exactly_its_lanes() {
-    // Whole vectors and every remainder (0 to 16 lanes past a multiple of the
-    // width): lanes 0..n hold the scalar path's values, lanes n.. are untouched.
+    // Whole vectors and every remainder, through each step of the loops:
+    // two vectors at a time (32 lanes on AVX-512), then one, then the padded
+    // rest (lengths up to 80 reach two pair steps, a single vector after
+    // them and every remainder on every path). Lanes
+    // 0..n hold the scalar path's values, lanes n.. are untouched.
     let b = ModelSpec::from_json("cook-torrance", &serde_json::json!({}))
         .unwrap()
         .build()
         .unwrap();
     let dirs = pairs(11);
-    let m = 40;
+    let m = 80;
     let mut want = [vec![0f32; m], vec![0f32; m], vec![0f32; m]];
     {
         let [r, g, bl] = &mut want;

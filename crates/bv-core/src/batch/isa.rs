@@ -87,10 +87,11 @@ impl Isa {
 
     /// Whether kernels run two vectors per step on this path
     /// ([`super::Twice`], for those whose [`super::LaneKernel::TWICE`]
-    /// allows it): AVX2, where it measured faster. AVX-512 has not been
-    /// measured (no machine here has it), and NEON and `simd128` keep one.
+    /// allows it): AVX2 and AVX-512, where it measured faster (see
+    /// [`super::twice`]). NEON and `simd128` keep one vector: no machine
+    /// here times them (qemu and Node give no real timings).
     pub const fn twice(self) -> bool {
-        matches!(self, Isa::Avx2)
+        matches!(self, Isa::Avx2 | Isa::Avx512)
     }
 
     /// Whether this CPU and build can run it.

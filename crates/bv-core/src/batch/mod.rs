@@ -11,8 +11,8 @@
 //! it once per instruction set ([`Isa`]: AVX-512 with 16 lanes, AVX2 + FMA
 //! with 8, NEON and wasm `simd128` with 4, and `f32` itself as the scalar
 //! fallback) and calls the copy for the instruction set chosen at run time
-//! ([`isa`]: the widest this CPU has, or `BV_ISA`'s). On AVX2 the copy
-//! steps two vectors at a time ([`Twice`]): a kernel with a transcendental
+//! ([`isa`]: the widest this CPU has, or `BV_ISA`'s). On AVX2 and AVX-512
+//! the copy steps two vectors at a time ([`Twice`]): a kernel with a transcendental
 //! is one long dependency chain, and two chains side by side keep the core
 //! busy where one left it waiting. A model without a
 //! kernel is evaluated by [`eval`] through its scalar f64 `eval`, one lane at
@@ -197,7 +197,7 @@ pub trait LaneKernel: Send + Sync + std::fmt::Debug {
     fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3];
 
     /// Whether an instruction set that runs kernels two vectors at a time
-    /// ([`Twice`], see [`twice`]: AVX2) does so for this one. True unless
+    /// ([`Twice`], see [`twice`]: AVX2 and AVX-512) does so for this one. True unless
     /// the kernel measured slower that way (a kernel that branches on
     /// whole vectors sees fewer uniform ones at twice the width, and one
     /// with many live values spills more).

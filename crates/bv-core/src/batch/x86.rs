@@ -595,7 +595,12 @@ impl Lanes for Avx512 {
 /// The CPU must have AVX-512F, AVX2 and FMA.
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::lanes_loop::<Avx512, K>(k, dirs, out);
+    // Two vectors side by side where the kernel and `Isa::twice` allow it.
+    if K::TWICE && Isa::Avx512.twice() {
+        super::lanes_loop_twice::<Avx512, K>(k, dirs, out);
+    } else {
+        super::lanes_loop::<Avx512, K>(k, dirs, out);
+    }
 }
 
 /// `task` in AVX-512F code.
