@@ -284,6 +284,19 @@ fn lanes_loop<V: Lanes, K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>
     padded_rest::<V, K>(k, dirs, out, whole, n);
 }
 
+/// The lane loop of the path `isa` (whose vector is `V`): two vectors per
+/// step where [`Isa::twice`] and the kernel's [`LaneKernel::TWICE`] both
+/// allow it ([`lanes_loop_twice`]), one otherwise ([`lanes_loop`]).
+#[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+fn path_loop<V: Lanes, K: LaneKernel>(isa: Isa, k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+    if K::TWICE && isa.twice() {
+        lanes_loop_twice::<V, K>(k, dirs, out);
+    } else {
+        lanes_loop::<V, K>(k, dirs, out);
+    }
+}
+
 /// [`lanes_loop`] through [`Twice`]`<V>` (two vectors per step, see
 /// [`twice`]) while two whole vectors remain, then one `V` at a time, so
 /// that the remainder pads at most `V::LANES − 1` lanes.

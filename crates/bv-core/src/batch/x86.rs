@@ -245,12 +245,7 @@ impl Lanes for Avx2 {
 /// The CPU must have AVX2 and FMA.
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    // Two vectors side by side where the kernel and `Isa::twice` allow it.
-    if K::TWICE && Isa::Avx2.twice() {
-        super::lanes_loop_twice::<Avx2, K>(k, dirs, out);
-    } else {
-        super::lanes_loop::<Avx2, K>(k, dirs, out);
-    }
+    super::path_loop::<Avx2, K>(Isa::Avx2, k, dirs, out);
 }
 
 /// `task` in AVX2 + FMA code.
@@ -595,12 +590,7 @@ impl Lanes for Avx512 {
 /// The CPU must have AVX-512F, AVX2 and FMA.
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    // Two vectors side by side where the kernel and `Isa::twice` allow it.
-    if K::TWICE && Isa::Avx512.twice() {
-        super::lanes_loop_twice::<Avx512, K>(k, dirs, out);
-    } else {
-        super::lanes_loop::<Avx512, K>(k, dirs, out);
-    }
+    super::path_loop::<Avx512, K>(Isa::Avx512, k, dirs, out);
 }
 
 /// `task` in AVX-512F code.
