@@ -657,6 +657,39 @@ fn a_slider_step_redraws_the_mesh_as_a_fresh_upload_would() {
     );
 }
 
+#[test]
+fn priming_the_lobe_pipelines_changes_no_pixel() {
+    // `LobeRenderer::prime` draws its empty frame with every pipeline under
+    // a view key of its own and removes it: a GPU error there would panic
+    // here (wgpu's default handler), and a figure drawn after it must be
+    // the one an unprimed renderer draws, view for view.
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu_options(),
+    );
+    let new = || LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
+    let mut primed = new();
+    primed.prime(&rs.device, &rs.queue, rs.target_format);
+    let mut s = LobeOnly::new("cook-torrance", serde_json::json!({"alpha": 0.3}));
+    let bg = bv::views::lobe3d::background(true);
+    let scene = build_scene(&s.state, &s.runtime, false);
+    let frame = s.view.frame(&scene, egui::vec2(200.0, 160.0), bg, true);
+    let render = |r: &mut LobeRenderer| {
+        r.render_to_image(&rs.device, &rs.queue, &frame, 200, 160, 1.0)
+            .unwrap()
+    };
+    let (a, b) = (render(&mut primed), render(&mut new()));
+    let off_bg = a
+        .pixels()
+        .filter(|p| (p.0[0] as f32 - bg[0] * 255.0).abs() > 8.0)
+        .count();
+    assert!(
+        off_bg > 500,
+        "the primed renderer drew {off_bg} lobe pixels"
+    );
+    assert!(a == b, "priming changed the figure");
+}
+
 /// Timing of the offscreen lobe pass alone (not a pass/fail test: run with
 /// `cargo test --release --test gui -- --ignored --nocapture lobe_pass_timing`).
 #[test]

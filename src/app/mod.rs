@@ -185,6 +185,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 crate::views::install_gpu(
                     &mut renderer.callback_resources,
                     &rs.device,
+                    &rs.queue,
                     Some(&rs.adapter),
                     rs.target_format,
                 );

@@ -190,6 +190,7 @@ impl WebApp {
             crate::views::install_gpu(
                 &mut renderer.callback_resources,
                 &rs.device,
+                &rs.queue,
                 Some(&rs.adapter),
                 rs.target_format,
             );

@@ -2,7 +2,7 @@
 //! viewer runs, laid out by a fresh egui context, painted by egui-wgpu into an
 //! offscreen `Rgba8Unorm` texture and read back. Views with their own wgpu
 //! pipelines (the lobe) render inside it through their paint callbacks, whose
-//! resources [`crate::views::install_gpu`] puts into this renderer.
+//! resources [`crate::views::GpuResources`] puts into this renderer.
 //!
 //! Pixels per point are set on the context, so a 2× or 4× image is laid out
 //! and rasterised at that resolution (text, lines and the lobe's own target),
@@ -80,14 +80,12 @@ impl Offscreen {
     ) -> Self {
         // A GPU error must become a message, never wgpu's default panic.
         let errors = errors::watch(&device);
+        // The views' pipelines first: a CPU rasteriser compiles their shaders
+        // on its queue thread while egui's renderer is made here.
+        let views = crate::views::GpuResources::new(&device, &queue, Some(&adapter), FORMAT);
         let mut renderer =
             egui_wgpu::Renderer::new(&device, FORMAT, egui_wgpu::RendererOptions::PREDICTABLE);
-        crate::views::install_gpu(
-            &mut renderer.callback_resources,
-            &device,
-            Some(&adapter),
-            FORMAT,
-        );
+        views.install(&mut renderer.callback_resources);
         Self {
             rs: egui_wgpu::RenderState {
                 // egui-wgpu lists the adapters only where it can enumerate

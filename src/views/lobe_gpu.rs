@@ -13,17 +13,19 @@ use eframe::egui_wgpu::{self, CallbackResources, CallbackTrait, ScreenDescriptor
 use eframe::wgpu;
 use std::sync::Arc;
 
-/// Puts a [`LobeRenderer`] for `target_format` into a renderer's callback
-/// resources (once per window or test harness).
-pub fn install_into(
-    resources: &mut CallbackResources,
+/// A [`LobeRenderer`] for `target_format`, primed
+/// ([`LobeRenderer::prime`]: a CPU rasteriser compiles its shaders while the
+/// caller goes on); `None` where its shaders do not compose.
+pub fn renderer(
     device: &wgpu::Device,
+    queue: &wgpu::Queue,
     adapter: Option<&wgpu::Adapter>,
     target_format: wgpu::TextureFormat,
-) {
+) -> Option<LobeRenderer> {
     match LobeRenderer::new(device, adapter, target_format) {
-        Ok(r) => {
-            resources.insert(r);
+        Ok(mut r) => {
+            r.prime(device, queue, target_format);
+            Some(r)
         }
         // The shaders are compiled into bv and composed by its tests, so this
         // is a broken build; the lobe view then stays empty (its callback
@@ -32,6 +34,7 @@ pub fn install_into(
         Err(e) => {
             use std::io::Write as _;
             let _ = writeln!(std::io::stderr(), "bv: the lobe view cannot draw: {e:#}");
+            None
         }
     }
 }
@@ -39,13 +42,19 @@ pub fn install_into(
 /// Installs the lobe pipeline into egui-wgpu's render state (eframe's window or
 /// a kittest harness's).
 pub fn install(render_state: &egui_wgpu::RenderState) {
-    let mut renderer = render_state.renderer.write();
-    install_into(
-        &mut renderer.callback_resources,
+    let lobe = renderer(
         &render_state.device,
+        &render_state.queue,
         Some(&render_state.adapter),
         render_state.target_format,
     );
+    if let Some(lobe) = lobe {
+        render_state
+            .renderer
+            .write()
+            .callback_resources
+            .insert(lobe);
+    }
 }
 
 /// The paint callback of one lobe view for one frame.

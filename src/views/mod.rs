@@ -5,7 +5,7 @@
 //! one [`Scene`] per frame and ask for changes by pushing [`Command`]s. A view
 //! is added by writing its module and one line in [`REGISTRY`]; the window,
 //! screenshots and `bv render` all go through the registry. A view with its
-//! own wgpu pipeline also adds one line to [`install_gpu`]; one that renders
+//! own wgpu pipeline also adds one field to [`GpuResources`]; one that renders
 //! into a texture of its own finds egui's render state through its context
 //! ([`install_context`]).
 
@@ -231,20 +231,51 @@ pub fn find_view(name: &str) -> Option<&'static ViewEntry> {
     views::find(name).and_then(|v| entry(v.id))
 }
 
+/// The GPU resources of every view with its own pipeline, made on a device
+/// before they are put into a renderer's paint-callback resources
+/// ([`GpuResources::install`]), so that their shaders compile while the
+/// caller goes on (an offscreen renderer makes egui's renderer meanwhile).
+pub struct GpuResources {
+    lobe: Option<crate::gpu::lobe::LobeRenderer>,
+}
+
+impl GpuResources {
+    /// Makes (and primes) the views' pipelines for passes of
+    /// `target_format`.
+    pub fn new(
+        device: &eframe::wgpu::Device,
+        queue: &eframe::wgpu::Queue,
+        adapter: Option<&eframe::wgpu::Adapter>,
+        target_format: eframe::wgpu::TextureFormat,
+    ) -> Self {
+        // wgpu's default answer to an error outside an error scope is a
+        // panic; bv records it and shows it instead.
+        crate::gpu::errors::watch(device);
+        Self {
+            lobe: lobe_gpu::renderer(device, queue, adapter, target_format),
+        }
+    }
+
+    /// Puts them into a renderer's paint-callback resources.
+    pub fn install(self, resources: &mut eframe::egui_wgpu::CallbackResources) {
+        if let Some(lobe) = self.lobe {
+            resources.insert(lobe);
+        }
+    }
+}
+
 /// Installs the GPU resources of every view with its own pipeline into a
-/// renderer's paint-callback resources (eframe's window, an offscreen
-/// renderer, a test harness). `target_format` is the format of the pass the
-/// views paint into.
+/// renderer's paint-callback resources (eframe's window, a test harness):
+/// [`GpuResources::new`] then [`GpuResources::install`]. `target_format` is
+/// the format of the pass the views paint into.
 pub fn install_gpu(
     resources: &mut eframe::egui_wgpu::CallbackResources,
     device: &eframe::wgpu::Device,
+    queue: &eframe::wgpu::Queue,
     adapter: Option<&eframe::wgpu::Adapter>,
     target_format: eframe::wgpu::TextureFormat,
 ) {
-    // wgpu's default answer to an error outside an error scope is a panic;
-    // bv records it and shows it instead.
-    crate::gpu::errors::watch(device);
-    lobe_gpu::install_into(resources, device, adapter, target_format);
+    GpuResources::new(device, queue, adapter, target_format).install(resources);
 }
 
 /// The label of the value the views show.

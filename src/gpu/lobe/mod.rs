@@ -17,6 +17,7 @@
 mod frame;
 mod mesh;
 mod pipelines;
+mod prime;
 mod target;
 
 pub use frame::{LineSeg, LobeCamera, LobeFrame, MeshDraw, MeshStyle};
