@@ -19,8 +19,9 @@ use super::{LobeCamera, LobeFrame, LobeRenderer, MeshDraw, MeshStyle, PixelSize}
 use bv_core::lobe::LobeMesh;
 use std::sync::Arc;
 
-/// The view key the priming frame is drawn under, removed afterwards (a
-/// real view's key is an egui id's value, which is never this).
+/// The view key the priming frame is drawn under. Its resources are removed
+/// before `prime` returns, which is before any view draws, so a view whose
+/// key happened to be the same would find nothing of it.
 const PRIME_VIEW: u64 = u64::MAX;
 
 /// Side in pixels of the priming frame's targets: not a power of two, as a
