@@ -306,21 +306,24 @@ impl LobeRenderer {
     /// Blits view `view`'s offscreen image into the current pass (whose viewport
     /// egui has set to the callback's rectangle).
     pub fn paint(&self, view: u64, pass: &mut wgpu::RenderPass<'static>) {
-        let Some(target) = self.views.get(&view).and_then(|v| v.target.as_ref()) else {
-            return;
-        };
+        if let Some(copy) = self.copy_draw(view) {
+            fullscreen::draw(pass, &copy);
+        }
+    }
+
+    /// The draw that copies view `view`'s image (through FXAA where its
+    /// target is smoothed); `None` before the view has a target.
+    fn copy_draw(&self, view: u64) -> Option<fullscreen::Draw<'_>> {
+        let target = self.views.get(&view)?.target.as_ref()?;
         let pipeline = match &self.blit_smooth {
             Some(smooth) if target.smooth => smooth,
             _ => &self.blit,
         };
-        fullscreen::draw(
-            pass,
-            &fullscreen::Draw {
-                pipeline,
-                bind_group: &target.blit_bg,
-                scissor: None,
-            },
-        );
+        Some(fullscreen::Draw {
+            pipeline,
+            bind_group: &target.blit_bg,
+            scissor: None,
+        })
     }
 
     /// Renders `frame` headless at `width × height` pixels and reads the

@@ -97,24 +97,8 @@ impl LobeRenderer {
             view_formats: &[],
         });
         let view = copy.create_view(&Default::default());
-        {
-            let mut pass = encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("bv lobe priming copy"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                            store: wgpu::StoreOp::Discard,
-                        },
-                    })],
-                    ..Default::default()
-                })
-                .forget_lifetime();
-            self.paint(PRIME_VIEW, &mut pass);
-        }
+        let draw = self.copy_draw(PRIME_VIEW);
+        super::fullscreen::pass(&mut encoder, "bv lobe priming copy", &view, draw.as_slice());
         queue.submit(std::iter::once(encoder.finish()));
         // wgpu keeps what the submitted work uses alive until it is done.
         self.views.remove(&PRIME_VIEW);
