@@ -690,6 +690,180 @@ fn priming_the_lobe_pipelines_changes_no_pixel() {
     assert!(a == b, "priming changed the figure");
 }
 
+/// Lobe frames of several kinds at `size` points: lobes narrow and wide,
+/// above and below the surface, overlaid, seen from the side, from above,
+/// and from so close that the lobe leaves the view or lies behind the eye.
+fn varied_lobe_frames(size: egui::Vec2) -> Vec<(String, bv::gpu::lobe::LobeFrame)> {
+    use bv::session::state::Camera;
+    let cases: [(&str, serde_json::Value, f64, Camera); 6] = [
+        (
+            "cook-torrance",
+            serde_json::json!({"alpha": 0.15}),
+            40.0,
+            Camera::default(),
+        ),
+        ("lambert", serde_json::json!({}), 0.0, Camera::default()),
+        (
+            "rough-dielectric",
+            serde_json::json!({"alpha": 0.3}),
+            60.0,
+            Camera {
+                pitch_deg: -10.0,
+                ..Camera::default()
+            },
+        ),
+        (
+            "phong",
+            serde_json::json!({}),
+            70.0,
+            Camera {
+                pitch_deg: 85.0,
+                yaw_deg: 10.0,
+                ..Camera::default()
+            },
+        ),
+        (
+            "ward",
+            serde_json::json!({}),
+            30.0,
+            Camera {
+                distance: 1.6,
+                ..Camera::default()
+            },
+        ),
+        (
+            "oren-nayar",
+            serde_json::json!({}),
+            20.0,
+            Camera {
+                distance: 0.3,
+                ..Camera::default()
+            },
+        ),
+    ];
+    let bg = bv::views::lobe3d::background(true);
+    cases
+        .into_iter()
+        .filter(|(model, ..)| bv_core::find(model).is_ok())
+        .map(|(model, params, theta, camera)| {
+            let mut s = LobeOnly::new(model, params);
+            if model == "ward" {
+                // Two lobes overlaid (the second translucent).
+                s.state.add(bv_core::ModelSpec::new("lambert").unwrap());
+                s.runtime.sync(&s.state);
+            }
+            s.state.incident.theta_deg = theta;
+            s.state.camera = camera;
+            let scene = build_scene(&s.state, &s.runtime, false);
+            let mut frame = (*s.view.frame(&scene, size, bg, true)).clone();
+            frame.interacting = false;
+            let name = format!("{model} at θi {theta}° from {camera:?}");
+            (name, frame)
+        })
+        .collect()
+}
+
+#[test]
+fn the_content_rectangle_holds_every_pixel_drawn() {
+    // FXAA runs only inside `content`'s rectangle: every pixel the lobe's
+    // pass draws off the background must lie inside it, with a pixel to
+    // spare for FXAA's neighbourhood, for every kind of frame.
+    use bv::gpu::lobe::{Content, content};
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu_options(),
+    );
+    let (w, h) = (240u32, 180u32);
+    let mut bounded = 0;
+    for (name, frame) in varied_lobe_frames(egui::vec2(w as f32, h as f32)) {
+        // A renderer per frame: the frames come from different views, whose
+        // mesh keys and revisions may coincide.
+        let mut renderer =
+            LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
+        let img = renderer
+            .render_to_image(&rs.device, &rs.queue, &frame, w, h, 1.0)
+            .unwrap();
+        let bg = frame.background.map(|c| (c * 255.0).round());
+        let drawn: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|(_, _, p)| (0..3).any(|c| (f32::from(p.0[c]) - bg[c]).abs() > 1.0))
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        match content(&frame, [w, h], 1.0) {
+            Content::Everywhere => {}
+            Content::Empty => assert!(drawn.is_empty(), "{name}: drawn, said empty"),
+            Content::Within([x, y, cw, ch]) => {
+                bounded += 1;
+                for &(px, py) in &drawn {
+                    assert!(
+                        // A pixel to spare, except at the target's edges.
+                        (px > x || x == 0)
+                            && (py > y || y == 0)
+                            && (px + 1 < x + cw || x + cw == w)
+                            && (py + 1 < y + ch || y + ch == h),
+                        "{name}: pixel ({px}, {py}) drawn outside [{x}, {y}, {cw}, {ch}] less a pixel"
+                    );
+                }
+                if name.starts_with("cook-torrance") {
+                    assert!(
+                        u64::from(cw) * u64::from(ch) < u64::from(w) * u64::from(h) * 3 / 4,
+                        "{name}: the rectangle [{x}, {y}, {cw}, {ch}] spares FXAA little"
+                    );
+                }
+            }
+        }
+    }
+    assert!(bounded >= 3, "only {bounded} frames had a bounded content");
+}
+
+#[test]
+fn smoothing_only_the_content_changes_no_pixel() {
+    // The copy at rest runs FXAA only about what the frame draws, and the
+    // plain copy elsewhere: the image must be the one FXAA everywhere gives,
+    // for every kind of frame and for a view drawn stretched (odd sizes).
+    let rs = egui_kittest::wgpu::create_render_state(
+        egui_kittest::wgpu::default_wgpu_setup(),
+        egui_wgpu_options(),
+    );
+    let new = || LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
+    if new().samples() > 1 {
+        eprintln!("skipped: this device multisamples the lobe, and its copy has no FXAA");
+        return;
+    }
+    for (w, h) in [(240u32, 180u32), (173, 251)] {
+        for (name, frame) in varied_lobe_frames(egui::vec2(w as f32, h as f32)) {
+            // A renderer per frame: the frames come from different views,
+            // whose mesh keys and revisions may coincide.
+            let mut renderer = new();
+            let mut copied = |everywhere: bool| {
+                renderer.set_smooth_everywhere(everywhere);
+                renderer
+                    .render_copied(&rs.device, &rs.queue, &frame, w, h, 1.0)
+                    .unwrap()
+            };
+            let (part, all) = (copied(false), copied(true));
+            let differ = part
+                .pixels()
+                .zip(all.pixels())
+                .filter(|(a, b)| a != b)
+                .count();
+            assert_eq!(differ, 0, "{name} at {w}x{h}: {differ} pixels differ");
+            // Not vacuous: FXAA changed the image drawn.
+            if name.starts_with("cook-torrance") {
+                let drawn = renderer
+                    .render_to_image(&rs.device, &rs.queue, &frame, w, h, 1.0)
+                    .unwrap();
+                let smoothed = drawn
+                    .pixels()
+                    .zip(all.pixels())
+                    .filter(|(a, b)| a != b)
+                    .count();
+                assert!(smoothed > 20, "{name}: FXAA changed {smoothed} pixels");
+            }
+        }
+    }
+}
+
 /// Timing of the offscreen lobe pass alone (not a pass/fail test: run with
 /// `cargo test --release --test gui -- --ignored --nocapture lobe_pass_timing`).
 #[test]

@@ -173,6 +173,9 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
         options.wgpu_options.surface.present_mode = eframe::wgpu::PresentMode::AutoNoVsync;
     }
 
+    // The lobe's shaders need no device: composed on another core while
+    // eframe opens the window and the device.
+    crate::gpu::lobe::compose_in_background();
     let outcome: Arc<Mutex<Option<anyhow::Result<()>>>> = Arc::new(Mutex::new(None));
     let args2 = args.clone();
     let outcome2 = outcome.clone();

@@ -65,6 +65,9 @@ impl Offscreen {
     /// adapter wgpu finds, preferring a real GPU; lavapipe on a server
     /// without one).
     pub fn headless() -> Result<Self> {
+        // The lobe's shaders need no device: composed on another core while
+        // the device opens.
+        crate::gpu::lobe::compose_in_background();
         let h = crate::gpu::Headless::open()?;
         Ok(Self::new(h.instance, h.adapter, h.device, h.queue))
     }

@@ -109,12 +109,16 @@ impl CallbackTrait for LobeCallback {
 
     fn paint(
         &self,
-        _info: egui::PaintCallbackInfo,
+        info: egui::PaintCallbackInfo,
         pass: &mut wgpu::RenderPass<'static>,
         resources: &CallbackResources,
     ) {
         if let Some(r) = resources.get::<LobeRenderer>() {
-            r.paint(self.view, pass);
+            let pixels = |v: egui::epaint::ViewportInPixels| {
+                [v.left_px, v.top_px, v.width_px, v.height_px].map(|x| x.max(0) as u32)
+            };
+            let (viewport, clip) = (info.viewport_in_pixels(), info.clip_rect_in_pixels());
+            r.paint(self.view, pass, pixels(viewport), pixels(clip));
         }
     }
 }

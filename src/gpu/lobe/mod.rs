@@ -14,14 +14,18 @@
 //! when the frame's fingerprint changes. It depends on bv-core's meshes and
 //! wgpu only: what the view computes (camera, colours) arrives as plain data.
 
+mod content;
 mod frame;
 mod mesh;
 mod pipelines;
 mod prime;
+mod sources;
 mod target;
 
+pub use content::{Content, content};
 pub use frame::{LineSeg, LobeCamera, LobeFrame, MeshDraw, MeshStyle};
 pub use mesh::wire_indices;
+pub use sources::compose_in_background;
 pub use target::fit_texture;
 
 use super::{errors, fullscreen, readback};
@@ -74,6 +78,11 @@ pub struct LobeRenderer {
     blit: wgpu::RenderPipeline,
     /// The copy through FXAA, where the target has one sample.
     blit_smooth: Option<wgpu::RenderPipeline>,
+    /// Copy every pixel through FXAA, not only those about what is drawn
+    /// ([`Self::set_smooth_everywhere`]).
+    smooth_everywhere: bool,
+    /// The format of the passes the copies draw into.
+    target_format: wgpu::TextureFormat,
     views: HashMap<u64, ViewResources>,
 }
 
@@ -81,6 +90,14 @@ impl LobeRenderer {
     /// The offscreen sample count of frames drawn at rest.
     pub fn samples(&self) -> u32 {
         self.pipelines.samples
+    }
+
+    /// With `true`, a smoothed copy runs FXAA over the whole image instead of
+    /// only over the rectangle about what the frame draws ([`content`]).
+    /// The pixels are the same and it costs more: a reference for tests and
+    /// measurements.
+    pub fn set_smooth_everywhere(&mut self, on: bool) {
+        self.smooth_everywhere = on;
     }
 
     /// Uploads what changed in `frame` and records its offscreen pass for view
@@ -211,6 +228,11 @@ impl LobeRenderer {
         // A drag's frames are copied as drawn: they follow each other too
         // fast for their edges to be seen, and the frame at rest is smoothed.
         target.smooth = self.blit_smooth.is_some() && !frame.interacting;
+        // Where the smoothed copy needs FXAA: found once per image (a drag's
+        // last frame, drawn unsmoothed, may be the one copied at rest).
+        if target.smooth && target.content.is_none_or(|(f, _)| f != fingerprint) {
+            target.content = Some((fingerprint, content::content(frame, size, ppp)));
+        }
         if target.drawn == Some(fingerprint) {
             // Same image as last time: egui repainted for something else.
             return;
@@ -303,27 +325,60 @@ impl LobeRenderer {
         }
     }
 
-    /// Blits view `view`'s offscreen image into the current pass (whose viewport
-    /// egui has set to the callback's rectangle).
-    pub fn paint(&self, view: u64, pass: &mut wgpu::RenderPass<'static>) {
-        if let Some(copy) = self.copy_draw(view) {
+    /// Blits view `view`'s offscreen image into the current pass, whose
+    /// viewport egui has set to the callback's rectangle, `viewport`, and
+    /// whose scissor to `clip` (both `[x, y, width, height]` in the pass's
+    /// pixels).
+    pub fn paint(
+        &self,
+        view: u64,
+        pass: &mut wgpu::RenderPass<'static>,
+        viewport: [u32; 4],
+        clip: [u32; 4],
+    ) {
+        for copy in self.copy_draws(view, viewport, clip) {
             fullscreen::draw(pass, &copy);
         }
     }
 
-    /// The draw that copies view `view`'s image (through FXAA where its
-    /// target is smoothed); `None` before the view has a target.
-    fn copy_draw(&self, view: u64) -> Option<fullscreen::Draw<'_>> {
-        let target = self.views.get(&view)?.target.as_ref()?;
-        let pipeline = match &self.blit_smooth {
-            Some(smooth) if target.smooth => smooth,
-            _ => &self.blit,
+    /// The draws that copy view `view`'s image over `viewport` within `clip`
+    /// (see [`Self::paint`]): as it stands, or, where the target is smoothed,
+    /// through FXAA about what the frame draws ([`content`]) and as it
+    /// stands elsewhere. None before the view has a target.
+    fn copy_draws(
+        &self,
+        view: u64,
+        viewport: [u32; 4],
+        clip: [u32; 4],
+    ) -> Vec<fullscreen::Draw<'_>> {
+        let Some(target) = self.views.get(&view).and_then(|v| v.target.as_ref()) else {
+            return Vec::new();
         };
-        Some(fullscreen::Draw {
+        let draw = |pipeline, scissor| fullscreen::Draw {
             pipeline,
             bind_group: &target.blit_bg,
-            scissor: None,
-        })
+            scissor,
+        };
+        let smooth = match &self.blit_smooth {
+            Some(smooth) if target.smooth => smooth,
+            _ => return vec![draw(&self.blit, None)],
+        };
+        let content = match target.content {
+            _ if self.smooth_everywhere => Content::Everywhere,
+            Some((_, c)) => c,
+            None => Content::Everywhere,
+        };
+        match content {
+            Content::Everywhere => vec![draw(smooth, None)],
+            Content::Empty => vec![draw(&self.blit, None)],
+            Content::Within(rect) => {
+                let plain = draw(&self.blit, None);
+                match content::scissor(rect, target.size, viewport, clip) {
+                    Some(inside) => vec![plain, draw(smooth, Some(inside))],
+                    None => vec![plain],
+                }
+            }
+        }
     }
 
     /// Renders `frame` headless at `width × height` pixels and reads the
@@ -365,5 +420,64 @@ impl LobeRenderer {
             readback::read_rgba8(device, queue, &target.resolve)
         })
         .map_err(|e| format!("{e:#}"))
+    }
+
+    /// Renders `frame` headless as [`Self::render_to_image`] does and reads
+    /// back what a figure shows of it: the image copied by [`Self::paint`]'s
+    /// draws (through FXAA about the frame's content at rest, where the
+    /// target has one sample) into a texture of the format the renderer was
+    /// made for, pixel for pixel.
+    pub fn render_copied(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        frame: &LobeFrame,
+        width: u32,
+        height: u32,
+        ppp: f32,
+    ) -> Result<image::RgbaImage, String> {
+        // A view key of its own, so a window's targets are left alone.
+        const COPIED: u64 = u64::MAX - 1;
+        let format = self.target_format;
+        let result = errors::scoped(device, "drawing and copying the lobe", || {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("bv lobe copied"),
+            });
+            let pixels = PixelSize {
+                size: [width, height],
+                ppp,
+            };
+            self.prepare(device, queue, &mut encoder, COPIED, frame, pixels);
+            let size = self
+                .views
+                .get(&COPIED)
+                .and_then(|v| v.target.as_ref())
+                .map(|t| t.size)
+                .ok_or_else(|| anyhow::anyhow!("no target"))?;
+            let copy = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("bv lobe copied"),
+                size: wgpu::Extent3d {
+                    width: size[0],
+                    height: size[1],
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = copy.create_view(&Default::default());
+            let all = [0, 0, size[0], size[1]];
+            let draws = self.copy_draws(COPIED, all, all);
+            fullscreen::pass(&mut encoder, "bv lobe copied", &view, &draws);
+            queue.submit(std::iter::once(encoder.finish()));
+            let image = readback::read_rgba8(device, queue, &copy);
+            copy.destroy();
+            image
+        });
+        self.views.remove(&COPIED);
+        result.map_err(|e| format!("{e:#}"))
     }
 }

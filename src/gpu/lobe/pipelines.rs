@@ -8,7 +8,6 @@ use super::mesh::Vertex;
 use super::{DEPTH_FORMAT, LobeRenderer, OFFSCREEN_FORMAT};
 use crate::gpu::fullscreen;
 use crate::gpu::pipeline_cache::DiskPipelineCache;
-use crate::gpu::shaders::ShaderLibrary;
 use anyhow::Result;
 use std::collections::HashMap;
 
@@ -123,10 +122,16 @@ impl LobeRenderer {
             ..Default::default()
         });
 
-        let mut library = ShaderLibrary::new()?;
-        let lobe_module = library.shader_module(device, "lobe")?;
-        let lines_module = library.shader_module(device, "lines")?;
-        let blit_module = library.shader_module(device, "blit")?;
+        let sources = super::sources::sources()?;
+        let module = |name: &str, wgsl: &str| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(wgsl.into()),
+            })
+        };
+        let lobe_module = module("lobe", &sources.lobe);
+        let lines_module = module("lines", &sources.lines);
+        let blit_module = module("blit", &sources.blit);
 
         let mesh_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("bv lobe mesh layout"),
@@ -180,6 +185,8 @@ impl LobeRenderer {
             sampler,
             blit,
             blit_smooth,
+            smooth_everywhere: false,
+            target_format,
             views: HashMap::new(),
         })
     }

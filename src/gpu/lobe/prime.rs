@@ -97,8 +97,11 @@ impl LobeRenderer {
             view_formats: &[],
         });
         let view = copy.create_view(&Default::default());
-        let draw = self.copy_draw(PRIME_VIEW);
-        super::fullscreen::pass(&mut encoder, "bv lobe priming copy", &view, draw.as_slice());
+        // The line's pixels get FXAA, the rest the plain copy: both copies'
+        // pipelines run.
+        let all = [0, 0, PRIME_SIDE, PRIME_SIDE];
+        let draws = self.copy_draws(PRIME_VIEW, all, all);
+        super::fullscreen::pass(&mut encoder, "bv lobe priming copy", &view, &draws);
         queue.submit(std::iter::once(encoder.finish()));
         // wgpu keeps what the submitted work uses alive until it is done.
         self.views.remove(&PRIME_VIEW);

@@ -13,6 +13,9 @@ pub(super) struct Target {
     /// Whether it is copied into egui's pass through FXAA (one sample, at
     /// rest).
     pub(super) smooth: bool,
+    /// Where the smoothed copy needs FXAA, and the fingerprint of the image
+    /// it was found for.
+    pub(super) content: Option<(u64, super::Content)>,
     pub(super) msaa_color: Option<wgpu::TextureView>,
     pub(super) depth: wgpu::TextureView,
     pub(super) resolve: wgpu::Texture,
@@ -104,6 +107,7 @@ pub(super) fn create_target(
         samples,
         drawn: None,
         smooth: false,
+        content: None,
         msaa_color,
         depth,
         resolve,
