@@ -669,7 +669,7 @@ fn priming_the_lobe_pipelines_changes_no_pixel() {
     );
     let new = || LobeRenderer::new(&rs.device, Some(&rs.adapter), rs.target_format).unwrap();
     let mut primed = new();
-    primed.prime(&rs.device, &rs.queue, rs.target_format);
+    primed.prime(&rs.device, &rs.queue);
     let mut s = LobeOnly::new("cook-torrance", serde_json::json!({"alpha": 0.3}));
     let bg = bv::views::lobe3d::background(true);
     let scene = build_scene(&s.state, &s.runtime, false);

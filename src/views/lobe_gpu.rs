@@ -24,7 +24,7 @@ pub fn renderer(
 ) -> Option<LobeRenderer> {
     match LobeRenderer::new(device, adapter, target_format) {
         Ok(mut r) => {
-            r.prime(device, queue, target_format);
+            r.prime(device, queue);
             Some(r)
         }
         // The shaders are compiled into bv and composed by its tests, so this

@@ -422,6 +422,31 @@ impl LobeRenderer {
         .map_err(|e| format!("{e:#}"))
     }
 
+    /// A one-sample texture of `size` in the format the copies draw into,
+    /// for a pass of the renderer's own to copy into.
+    fn copy_texture(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        size: [u32; 2],
+        usage: wgpu::TextureUsages,
+    ) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.target_format,
+            usage,
+            view_formats: &[],
+        })
+    }
+
     /// Renders `frame` headless as [`Self::render_to_image`] does and reads
     /// back what a figure shows of it: the image copied by [`Self::paint`]'s
     /// draws (through FXAA about the frame's content at rest, where the
@@ -438,7 +463,6 @@ impl LobeRenderer {
     ) -> Result<image::RgbaImage, String> {
         // A view key of its own, so a window's targets are left alone.
         const COPIED: u64 = u64::MAX - 1;
-        let format = self.target_format;
         let result = errors::scoped(device, "drawing and copying the lobe", || {
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("bv lobe copied"),
@@ -454,20 +478,12 @@ impl LobeRenderer {
                 .and_then(|v| v.target.as_ref())
                 .map(|t| t.size)
                 .ok_or_else(|| anyhow::anyhow!("no target"))?;
-            let copy = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("bv lobe copied"),
-                size: wgpu::Extent3d {
-                    width: size[0],
-                    height: size[1],
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            });
+            let copy = self.copy_texture(
+                device,
+                "bv lobe copied",
+                size,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            );
             let view = copy.create_view(&Default::default());
             let all = [0, 0, size[0], size[1]];
             let draws = self.copy_draws(COPIED, all, all);

@@ -32,15 +32,10 @@ const PRIME_SIDE: u32 = 3;
 impl LobeRenderer {
     /// Records and submits a frame with one empty mesh in each way a mesh is
     /// drawn (opaque, wireframe, translucent), one line segment, and its copy
-    /// into a small texture of `target_format` through the copy a figure at
+    /// into a small texture of the renderer's target format through the copy a figure at
     /// rest uses, without waiting for it. Its resources are released once
     /// submitted; the pipelines and the driver's compiled shaders stay.
-    pub fn prime(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        target_format: wgpu::TextureFormat,
-    ) {
+    pub fn prime(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
         let mesh = |alpha: f32, wireframe: bool, key: u64| MeshDraw {
             key,
             revision: 0,
@@ -82,20 +77,12 @@ impl LobeRenderer {
             ppp: 1.0,
         };
         self.prepare(device, queue, &mut encoder, PRIME_VIEW, &frame, pixels);
-        let copy = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("bv lobe priming copy"),
-            size: wgpu::Extent3d {
-                width: PRIME_SIDE,
-                height: PRIME_SIDE,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: target_format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let copy = self.copy_texture(
+            device,
+            "bv lobe priming copy",
+            [PRIME_SIDE; 2],
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
         let view = copy.create_view(&Default::default());
         // The line's pixels get FXAA, the rest the plain copy: both copies'
         // pipelines run.
