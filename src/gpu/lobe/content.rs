@@ -26,8 +26,8 @@ pub enum Content {
     Empty,
     /// `[x, y, width, height]`: everything drawn lies inside, with a margin.
     Within([u32; 4]),
-    /// Anywhere (a point at or behind the camera's plane, where the
-    /// projection bounds nothing).
+    /// Anywhere: what is drawn spans the target, or a point lies at or
+    /// behind the camera's plane, where the projection bounds nothing.
     Everywhere,
 }
 
@@ -89,6 +89,10 @@ pub fn content(frame: &LobeFrame, size: [u32; 2], ppp: f32) -> Content {
     if x1 <= x0 || y1 <= y0 {
         // All of it off the target.
         return Content::Empty;
+    }
+    if x0 == 0.0 && y0 == 0.0 && x1 == w && y1 == h {
+        // One FXAA copy, not the plain copy under it as well.
+        return Content::Everywhere;
     }
     Content::Within([x0 as u32, y0 as u32, (x1 - x0) as u32, (y1 - y0) as u32])
 }
