@@ -694,60 +694,31 @@ fn priming_the_lobe_pipelines_changes_no_pixel() {
 /// above and below the surface, overlaid, seen from the side, from above,
 /// and from so close that the lobe leaves the view or lies behind the eye.
 fn varied_lobe_frames(size: egui::Vec2) -> Vec<(String, bv::gpu::lobe::LobeFrame)> {
-    use bv::session::state::Camera;
-    let cases: [(&str, serde_json::Value, f64, Camera); 6] = [
-        (
-            "cook-torrance",
-            serde_json::json!({"alpha": 0.15}),
-            40.0,
-            Camera::default(),
-        ),
-        ("lambert", serde_json::json!({}), 0.0, Camera::default()),
-        (
-            "rough-dielectric",
-            serde_json::json!({"alpha": 0.3}),
-            60.0,
-            Camera {
-                pitch_deg: -10.0,
-                ..Camera::default()
-            },
-        ),
-        (
-            "phong",
-            serde_json::json!({}),
-            70.0,
-            Camera {
-                pitch_deg: 85.0,
-                yaw_deg: 10.0,
-                ..Camera::default()
-            },
-        ),
-        (
-            "ward",
-            serde_json::json!({}),
-            30.0,
-            Camera {
-                distance: 1.6,
-                ..Camera::default()
-            },
-        ),
-        (
-            "oren-nayar",
-            serde_json::json!({}),
-            20.0,
-            Camera {
-                distance: 0.3,
-                ..Camera::default()
-            },
-        ),
+    use serde_json::json;
+    // The camera by yaw, pitch and distance (the default is 90°, 20°, 4.9).
+    let cam = |yaw_deg, pitch_deg, distance| bv::session::state::Camera {
+        yaw_deg,
+        pitch_deg,
+        distance,
+        ..Default::default()
+    };
+    // (model, parameters, θi, camera, Lambert overlaid as a second lobe).
+    #[rustfmt::skip]
+    let cases = [
+        ("cook-torrance", json!({"alpha": 0.15}), 40.0, cam(90.0, 20.0, 4.9), false),
+        ("lambert", json!({}), 0.0, cam(90.0, 20.0, 4.9), false),
+        ("rough-dielectric", json!({"alpha": 0.3}), 60.0, cam(90.0, -10.0, 4.9), false),
+        ("phong", json!({}), 70.0, cam(10.0, 85.0, 4.9), false),
+        ("ward", json!({}), 30.0, cam(90.0, 20.0, 1.6), true),
+        ("oren-nayar", json!({}), 20.0, cam(90.0, 20.0, 0.3), false),
     ];
     let bg = bv::views::lobe3d::background(true);
     cases
         .into_iter()
         .filter(|(model, ..)| bv_core::find(model).is_ok())
-        .map(|(model, params, theta, camera)| {
+        .map(|(model, params, theta, camera, overlaid)| {
             let mut s = LobeOnly::new(model, params);
-            if model == "ward" {
+            if overlaid {
                 // Two lobes overlaid (the second translucent).
                 s.state.add(bv_core::ModelSpec::new("lambert").unwrap());
                 s.runtime.sync(&s.state);

@@ -130,43 +130,25 @@ mod tests {
 
     #[test]
     fn a_rectangle_maps_onto_the_viewport_within_the_clip() {
-        // Pixel for pixel, offset by the viewport.
-        assert_eq!(
-            scissor(
-                [10, 20, 30, 40],
-                [100, 100],
-                [5, 7, 100, 100],
-                [0, 0, 500, 500]
-            ),
-            Some([15, 27, 30, 40])
-        );
-        // Stretched twice: rounded outwards.
-        assert_eq!(
-            scissor([1, 1, 1, 1], [3, 3], [0, 0, 6, 6], [0, 0, 6, 6]),
-            Some([2, 2, 2, 2])
-        );
-        assert_eq!(
-            scissor([1, 1, 1, 1], [3, 3], [0, 0, 4, 4], [0, 0, 4, 4]),
-            Some([1, 1, 2, 2])
-        );
-        // Cut by the clip, or wholly outside it.
-        assert_eq!(
-            scissor(
-                [0, 0, 50, 50],
-                [100, 100],
-                [0, 0, 100, 100],
-                [25, 30, 100, 100]
-            ),
-            Some([25, 30, 25, 20])
-        );
-        assert_eq!(
-            scissor(
-                [0, 0, 10, 10],
-                [100, 100],
-                [0, 0, 100, 100],
-                [50, 50, 10, 10]
-            ),
-            None
-        );
+        // (rect, target, viewport, clip, scissor).
+        type Case = ([u32; 4], [u32; 2], [u32; 4], [u32; 4], Option<[u32; 4]>);
+        #[rustfmt::skip]
+        let cases: [Case; 5] = [
+            // Pixel for pixel, offset by the viewport.
+            ([10, 20, 30, 40], [100, 100], [5, 7, 100, 100], [0, 0, 500, 500], Some([15, 27, 30, 40])),
+            // Stretched: rounded outwards.
+            ([1, 1, 1, 1], [3, 3], [0, 0, 6, 6], [0, 0, 6, 6], Some([2, 2, 2, 2])),
+            ([1, 1, 1, 1], [3, 3], [0, 0, 4, 4], [0, 0, 4, 4], Some([1, 1, 2, 2])),
+            // Cut by the clip, or wholly outside it.
+            ([0, 0, 50, 50], [100, 100], [0, 0, 100, 100], [25, 30, 100, 100], Some([25, 30, 25, 20])),
+            ([0, 0, 10, 10], [100, 100], [0, 0, 100, 100], [50, 50, 10, 10], None),
+        ];
+        for (rect, target, viewport, clip, want) in cases {
+            assert_eq!(
+                scissor(rect, target, viewport, clip),
+                want,
+                "{rect:?} of {target:?} over {viewport:?} within {clip:?}"
+            );
+        }
     }
 }

@@ -336,49 +336,114 @@ impl LobeRenderer {
         viewport: [u32; 4],
         clip: [u32; 4],
     ) {
-        for copy in self.copy_draws(view, viewport, clip) {
-            fullscreen::draw(pass, &copy);
+        for copy in self.copy_draws(view, viewport, clip).iter().flatten() {
+            fullscreen::draw(pass, copy);
         }
     }
 
-    /// The draws that copy view `view`'s image over `viewport` within `clip`
-    /// (see [`Self::paint`]): as it stands, or, where the target is smoothed,
-    /// through FXAA about what the frame draws ([`content`]) and as it
-    /// stands elsewhere. None before the view has a target.
+    /// The draws, in order, that copy view `view`'s image over `viewport`
+    /// within `clip` (see [`Self::paint`]): as it stands, or, where the
+    /// target is smoothed, as it stands and then through FXAA about what the
+    /// frame draws ([`content`]). None before the view has a target. An
+    /// array, not a list: this runs for every frame egui paints.
     fn copy_draws(
         &self,
         view: u64,
         viewport: [u32; 4],
         clip: [u32; 4],
-    ) -> Vec<fullscreen::Draw<'_>> {
+    ) -> [Option<fullscreen::Draw<'_>>; 2] {
         let Some(target) = self.views.get(&view).and_then(|v| v.target.as_ref()) else {
-            return Vec::new();
+            return [None, None];
         };
         let draw = |pipeline, scissor| fullscreen::Draw {
             pipeline,
             bind_group: &target.blit_bg,
             scissor,
         };
-        let smooth = match &self.blit_smooth {
-            Some(smooth) if target.smooth => smooth,
-            _ => return vec![draw(&self.blit, None)],
+        let plain = draw(&self.blit, None);
+        let Some(smooth) = self.blit_smooth.as_ref().filter(|_| target.smooth) else {
+            return [Some(plain), None];
         };
         let content = match target.content {
-            _ if self.smooth_everywhere => Content::Everywhere,
-            Some((_, c)) => c,
-            None => Content::Everywhere,
+            Some((_, c)) if !self.smooth_everywhere => c,
+            _ => Content::Everywhere,
         };
         match content {
-            Content::Everywhere => vec![draw(smooth, None)],
-            Content::Empty => vec![draw(&self.blit, None)],
+            Content::Everywhere => [Some(draw(smooth, None)), None],
+            Content::Empty => [Some(plain), None],
             Content::Within(rect) => {
-                let plain = draw(&self.blit, None);
-                match content::scissor(rect, target.size, viewport, clip) {
-                    Some(inside) => vec![plain, draw(smooth, Some(inside))],
-                    None => vec![plain],
-                }
+                let inside = content::scissor(rect, target.size, viewport, clip);
+                [Some(plain), inside.map(|r| draw(smooth, Some(r)))]
             }
         }
+    }
+
+    /// The view keys of the renderer's own frames, so that a window's
+    /// targets are left alone: [`Self::render_to_image`]'s,
+    /// [`Self::render_copied`]'s and [`Self::prime`]'s. View keys are egui
+    /// id values, so a window's could equal one only by a very unlikely
+    /// chance; the copied and priming frames' targets are removed before
+    /// their functions return, the priming one before any view draws.
+    const HEADLESS: u64 = u64::MAX;
+    const COPIED: u64 = u64::MAX - 1;
+    const PRIMING: u64 = u64::MAX - 2;
+
+    /// A command encoder with `frame`'s pass for view `view` at `pixels`
+    /// recorded ([`Self::prepare`]): how the renderer's own frames begin.
+    fn record_frame(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        label: &str,
+        view: u64,
+        frame: &LobeFrame,
+        pixels: PixelSize,
+    ) -> wgpu::CommandEncoder {
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        self.prepare(device, queue, &mut encoder, view, frame, pixels);
+        encoder
+    }
+
+    /// Records the copy of view `view`'s image as [`Self::paint`] draws it
+    /// into a new one-sample texture of its size, in the format the copies
+    /// draw into, usable as `usage` too; `None` before the view has a target.
+    fn record_copy(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        label: &str,
+        view: u64,
+        usage: wgpu::TextureUsages,
+    ) -> Option<wgpu::Texture> {
+        let size = self.views.get(&view)?.target.as_ref()?.size;
+        let copy = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.target_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | usage,
+            view_formats: &[],
+        });
+        let all = [0, 0, size[0], size[1]];
+        let draws: Vec<_> = self
+            .copy_draws(view, all, all)
+            .into_iter()
+            .flatten()
+            .collect();
+        fullscreen::pass(
+            encoder,
+            label,
+            &copy.create_view(&Default::default()),
+            &draws,
+        );
+        Some(copy)
     }
 
     /// Renders `frame` headless at `width × height` pixels and reads the
@@ -394,17 +459,13 @@ impl LobeRenderer {
         height: u32,
         ppp: f32,
     ) -> Result<image::RgbaImage, String> {
-        // A view key of its own, so a window's targets are left alone.
-        const HEADLESS: u64 = u64::MAX;
         errors::scoped(device, "drawing the lobe", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("bv lobe headless"),
-            });
-            self.prepare(
+            let label = "bv lobe headless";
+            let encoder = self.record_frame(
                 device,
                 queue,
-                &mut encoder,
-                HEADLESS,
+                label,
+                Self::HEADLESS,
                 frame,
                 PixelSize {
                     size: [width, height],
@@ -414,37 +475,12 @@ impl LobeRenderer {
             queue.submit(std::iter::once(encoder.finish()));
             let target = self
                 .views
-                .get(&HEADLESS)
+                .get(&Self::HEADLESS)
                 .and_then(|v| v.target.as_ref())
                 .ok_or_else(|| anyhow::anyhow!("no target"))?;
             readback::read_rgba8(device, queue, &target.resolve)
         })
         .map_err(|e| format!("{e:#}"))
-    }
-
-    /// A one-sample texture of `size` in the format the copies draw into,
-    /// for a pass of the renderer's own to copy into.
-    fn copy_texture(
-        &self,
-        device: &wgpu::Device,
-        label: &str,
-        size: [u32; 2],
-        usage: wgpu::TextureUsages,
-    ) -> wgpu::Texture {
-        device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: size[0],
-                height: size[1],
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: self.target_format,
-            usage,
-            view_formats: &[],
-        })
     }
 
     /// Renders `frame` headless as [`Self::render_to_image`] does and reads
@@ -461,39 +497,29 @@ impl LobeRenderer {
         height: u32,
         ppp: f32,
     ) -> Result<image::RgbaImage, String> {
-        // A view key of its own, so a window's targets are left alone.
-        const COPIED: u64 = u64::MAX - 1;
         let result = errors::scoped(device, "drawing and copying the lobe", || {
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("bv lobe copied"),
-            });
-            let pixels = PixelSize {
-                size: [width, height],
-                ppp,
-            };
-            self.prepare(device, queue, &mut encoder, COPIED, frame, pixels);
-            let size = self
-                .views
-                .get(&COPIED)
-                .and_then(|v| v.target.as_ref())
-                .map(|t| t.size)
-                .ok_or_else(|| anyhow::anyhow!("no target"))?;
-            let copy = self.copy_texture(
+            let label = "bv lobe copied";
+            let mut encoder = self.record_frame(
                 device,
-                "bv lobe copied",
-                size,
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                queue,
+                label,
+                Self::COPIED,
+                frame,
+                PixelSize {
+                    size: [width, height],
+                    ppp,
+                },
             );
-            let view = copy.create_view(&Default::default());
-            let all = [0, 0, size[0], size[1]];
-            let draws = self.copy_draws(COPIED, all, all);
-            fullscreen::pass(&mut encoder, "bv lobe copied", &view, &draws);
+            let usage = wgpu::TextureUsages::COPY_SRC;
+            let copy = self
+                .record_copy(device, &mut encoder, label, Self::COPIED, usage)
+                .ok_or_else(|| anyhow::anyhow!("no target"))?;
             queue.submit(std::iter::once(encoder.finish()));
             let image = readback::read_rgba8(device, queue, &copy);
             copy.destroy();
             image
         });
-        self.views.remove(&COPIED);
+        self.views.remove(&Self::COPIED);
         result.map_err(|e| format!("{e:#}"))
     }
 }

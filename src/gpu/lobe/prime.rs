@@ -19,11 +19,6 @@ use super::{LobeCamera, LobeFrame, LobeRenderer, MeshDraw, MeshStyle, PixelSize}
 use bv_core::lobe::LobeMesh;
 use std::sync::Arc;
 
-/// The view key the priming frame is drawn under. Its resources are removed
-/// before `prime` returns, which is before any view draws, so a view whose
-/// key happened to be the same would find nothing of it.
-const PRIME_VIEW: u64 = u64::MAX;
-
 /// Side in pixels of the priming frame's targets: not a power of two, as a
 /// figure's sides seldom are (a CPU rasteriser may specialise its texture
 /// reads on that).
@@ -32,8 +27,8 @@ const PRIME_SIDE: u32 = 3;
 impl LobeRenderer {
     /// Records and submits a frame with one empty mesh in each way a mesh is
     /// drawn (opaque, wireframe, translucent), one line segment, and its copy
-    /// into a small texture of the renderer's target format through the copy a figure at
-    /// rest uses, without waiting for it. Its resources are released once
+    /// into a small texture of the renderer's target format through the
+    /// copies a figure at rest uses, without waiting for it. Its resources are released once
     /// submitted; the pipelines and the driver's compiled shaders stay.
     pub fn prime(&mut self, device: &wgpu::Device, queue: &wgpu::Queue) {
         let mesh = |alpha: f32, wireframe: bool, key: u64| MeshDraw {
@@ -69,28 +64,19 @@ impl LobeRenderer {
             )],
             interacting: false,
         };
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("bv lobe priming"),
-        });
+        let label = "bv lobe priming";
         let pixels = PixelSize {
             size: [PRIME_SIDE; 2],
             ppp: 1.0,
         };
-        self.prepare(device, queue, &mut encoder, PRIME_VIEW, &frame, pixels);
-        let copy = self.copy_texture(
-            device,
-            "bv lobe priming copy",
-            [PRIME_SIDE; 2],
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        );
-        let view = copy.create_view(&Default::default());
+        let mut encoder = self.record_frame(device, queue, label, Self::PRIMING, &frame, pixels);
         // The line's pixels get FXAA, the rest the plain copy: both copies'
         // pipelines run.
-        let all = [0, 0, PRIME_SIDE, PRIME_SIDE];
-        let draws = self.copy_draws(PRIME_VIEW, all, all);
-        super::fullscreen::pass(&mut encoder, "bv lobe priming copy", &view, &draws);
+        let usage = wgpu::TextureUsages::empty();
+        let copy = self.record_copy(device, &mut encoder, label, Self::PRIMING, usage);
         queue.submit(std::iter::once(encoder.finish()));
         // wgpu keeps what the submitted work uses alive until it is done.
-        self.views.remove(&PRIME_VIEW);
+        drop(copy);
+        self.views.remove(&Self::PRIMING);
     }
 }
