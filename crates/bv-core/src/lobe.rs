@@ -220,6 +220,9 @@ pub fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
     // where that plane maps grid columns onto grid columns (see
     // `mirror_axis`), half of each ring is evaluated and mirrored.
     let mirror = mirror_axis(brdf, wi, n_phi);
+    // Every pair shares `wi`: a kernel with a form for that computes the
+    // terms of `wi` alone once (see `batch::Kernel::at_wi`).
+    let at_wi = brdf.batch_kernel().and_then(|k| k.at_wi(wi32));
     let fill = |first_row: usize, ((vals, pos), rad): BandOut<'_>| {
         let start = first_row * n_phi;
         let n = vals.len();
@@ -237,17 +240,19 @@ pub fn build_with(brdf: &dyn Brdf, wi: DVec3, opts: &LobeOptions, mesh: &mut Lob
             wy.fill(wi32[1]);
             wz.fill(wi32[2]);
             let eval = |at: std::ops::Range<usize>, [r, g, b]: [&mut [f32]; 3]| {
-                batch::eval_with(
-                    brdf,
-                    isa,
-                    &batch::Dirs {
-                        wi: [&wx[at.clone()], &wy[at.clone()], &wz[at.clone()]],
-                        wo: [&wo[0][at.clone()], &wo[1][at.clone()], &wo[2][at.clone()]],
-                    },
-                    &mut Out {
-                        rgb: [&mut r[at.clone()], &mut g[at.clone()], &mut b[at]],
-                    },
-                );
+                let dirs = batch::Dirs {
+                    wi: [&wx[at.clone()], &wy[at.clone()], &wz[at.clone()]],
+                    wo: [&wo[0][at.clone()], &wo[1][at.clone()], &wo[2][at.clone()]],
+                };
+                let mut out = Out {
+                    rgb: [&mut r[at.clone()], &mut g[at.clone()], &mut b[at]],
+                };
+                match &at_wi {
+                    Some(k) => k.eval(isa, &dirs, &mut out),
+                    None => {
+                        batch::eval_with(brdf, isa, &dirs, &mut out);
+                    }
+                }
             };
             match mirror {
                 None => eval(0..n, [r, g, b]),

@@ -187,7 +187,10 @@ fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
     None
 }
 
-/// [`first_mismatch`] on one instruction set.
+/// [`first_mismatch`] on one instruction set: the kernel on `dirs`, and
+/// where it has a form for pairs that share `wi` ([`Kernel::at_wi`]), that
+/// form on every outgoing direction of `dirs` with each of a few of its
+/// incident ones (grazing and below the surface among them).
 fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String> {
     let n = dirs.len();
     let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
@@ -202,8 +205,42 @@ fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String
     );
     assert!(d.kernel);
     assert_eq!((d.isa, d.lanes), (isa.name(), isa.lanes()));
+    if let Some(e) = mismatch_in(brdf, dirs, &rgb) {
+        return Some(e);
+    }
+    let kernel = brdf.batch_kernel()?;
+    // The pairs' first, grazing and below-the-surface incident directions
+    // (see `pairs`), and a few from the rest.
+    for i in [0, 1, n - 1, n - 3, n / 3, n / 2, 2 * n / 3] {
+        let wi = [dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]];
+        let Some(k) = kernel.at_wi(wi) else {
+            break;
+        };
+        let mut shared = dirs.clone();
+        for (c, &w) in wi.iter().enumerate() {
+            shared.wi[c].fill(w);
+        }
+        let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
+        let [r, g, b] = &mut rgb;
+        k.eval(
+            isa,
+            &shared.dirs(0..n),
+            &mut Out {
+                rgb: [&mut r[..], &mut g[..], &mut b[..]],
+            },
+        );
+        if let Some(e) = mismatch_in(brdf, &shared, &rgb) {
+            return Some(format!("at_wi: {e}"));
+        }
+    }
+    None
+}
+
+/// The first lane of `rgb` (a batch's values at `dirs`) that is not within
+/// [`REL`] or [`ABS`] of `brdf.eval`.
+fn mismatch_in(brdf: &dyn Brdf, dirs: &PairBuf, rgb: &[Vec<f32>; 3]) -> Option<String> {
     #[allow(clippy::needless_range_loop)] // lane i of four arrays
-    for i in 0..n {
+    for i in 0..dirs.len() {
         let (wi, wo) = dirs.pair(i);
         let want = brdf.eval(wi, wo);
         for c in 0..3 {

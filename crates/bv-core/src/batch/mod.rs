@@ -186,6 +186,17 @@ pub trait Kernel: Send + Sync + std::fmt::Debug {
     /// Evaluates the batch with the instruction set `isa` (an instruction
     /// set this CPU lacks is replaced by [`Isa::best`]).
     fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>);
+
+    /// This kernel for pairs that all share the incident direction `wi` (a
+    /// lobe: one light, a mesh of viewers), with the terms of `wi` alone
+    /// computed once rather than in every lane; `None` (the default) where
+    /// the kernel has no such form. The kernel returned reads only the
+    /// outgoing directions of its `dirs`. The parity test holds it to
+    /// [`crate::Brdf::eval`] as it holds [`Kernel::eval`].
+    fn at_wi(&self, wi: [f32; 3]) -> Option<Box<dyn Kernel + '_>> {
+        let _ = wi;
+        None
+    }
 }
 
 /// A kernel's lanes: `f(wi, wo)` per channel for a vector of lanes, as

@@ -685,45 +685,77 @@ fn transmittance<V: Lanes>(c: V, eta2: f32) -> V {
     fresnel_t_lanes(c, g, V::splat(eta2))
 }
 
+/// What a direction `w` above the coat contributes to the base's light
+/// (`Coated::inside` and the macro interface's transmittance): a function of
+/// `w` alone, so that a lobe, whose pairs share one `wi`, computes `wi`'s
+/// once ([`CoatedAtWi`]) rather than in every lane.
+#[derive(Debug, Clone, Copy)]
+struct Crossing<V> {
+    /// `cos θ` of the refracted direction inside the coat.
+    t_z: V,
+    /// `1/t_z`: the path through the layer per unit depth.
+    inv_t_z: V,
+    /// `1 − F` of the macro interface at `w`.
+    trans: V,
+    /// For a conductor base, `1 + Λ` of the refracted direction (its
+    /// masking); 0 for a Lambert base.
+    opl: V,
+}
+
 /// One monomorphised combination of distribution and base
 /// (`CONDUCTOR = false`: Lambert).
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy)]
 struct CoatedLane<'a, const D: u8, const CONDUCTOR: bool>(&'a CoatedKernel);
 
-impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedLane<'_, D, CONDUCTOR> {
+impl<'a, const D: u8, const CONDUCTOR: bool> CoatedLane<'a, D, CONDUCTOR> {
+    /// `w`'s [`Crossing`]. The refracted direction's `sin²θ` is `x² + y²`
+    /// over η², which does not cancel near normal incidence.
     #[inline(always)]
-    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+    fn crossing<V: Lanes>(&self, w: [V; 3]) -> Crossing<V> {
         let k = self.0;
         let (zero, one) = (V::splat(0.0), V::splat(1.0));
-        let (zi, zo) = (wi[2], wo[2]);
-        let above = zi.gt(zero) & zo.gt(zero);
+        let sin2 = w[0] * w[0] + w[1] * w[1];
+        let t_z = (one - sin2 * V::splat(k.inv_eta2)).max(zero).sqrt();
+        let opl = match k.base {
+            BaseLanes::Conductor(scale, _) if CONDUCTOR => {
+                let s = V::splat(k.inv_eta);
+                scale.one_plus_lambda::<D, V>([w[0] * s, w[1] * s, t_z])
+            }
+            _ => zero,
+        };
+        Crossing {
+            t_z,
+            inv_t_z: one / t_z,
+            trans: transmittance(w[2], k.eta2),
+            opl,
+        }
+    }
+
+    /// `f(wi, wo)` per channel, given both directions' crossings.
+    #[inline(always)]
+    fn eval<V: Lanes>(&self, wi: [V; 3], wo: [V; 3], ci: Crossing<V>, co: Crossing<V>) -> [V; 3] {
+        let k = self.0;
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let above = wi[2].gt(zero) & wo[2].gt(zero);
         let coat = k.coat.lane::<D, V>(wi, wo);
-        // The refracted directions inside the coat (`Coated::inside`), with
-        // sin²θ as x² + y², which does not cancel near normal incidence.
-        let s2 = V::splat(k.inv_eta2);
-        let sin2_i = wi[0] * wi[0] + wi[1] * wi[1];
-        let sin2_o = wo[0] * wo[0] + wo[1] * wo[1];
-        let ti_z = (one - sin2_i * s2).max(zero).sqrt();
-        let to_z = (one - sin2_o * s2).max(zero).sqrt();
-        let trans = transmittance(zi, k.eta2) * transmittance(zo, k.eta2);
-        let path = one / ti_z + one / to_z;
+        let trans = ci.trans * co.trans;
+        let path = ci.inv_t_z + co.inv_t_z;
         let base: [V; 3] = if CONDUCTOR {
             let BaseLanes::Conductor(scale, fres) = k.base else {
                 return [zero; 3];
             };
             let s = V::splat(k.inv_eta);
-            let ti = [wi[0] * s, wi[1] * s, ti_z];
-            let to = [wo[0] * s, wo[1] * s, to_z];
+            let ti = [wi[0] * s, wi[1] * s, ci.t_z];
             // The tangential half vector as (wi + wo)/η, summed before it
             // is scaled: near the mirror pair the sum cancels (exactly, in
             // f32), and two rounded products would leave an error that a
             // base as sharp as α = 0.001 turns into 1e-4 of D.
-            let hu = [(wi[0] + wo[0]) * s, (wi[1] + wo[1]) * s, ti_z + to_z];
+            let hu = [(wi[0] + wo[0]) * s, (wi[1] + wo[1]) * s, ci.t_z + co.t_z];
             let h = math::scale3(hu, one / math::dot(hu, hu).sqrt());
             let c = math::dot(ti, h);
             let d = scale.d::<D, V>(h);
-            let g = one / (scale.one_plus_lambda::<D, V>(ti) * scale.one_plus_lambda::<D, V>(to));
-            let lobe = d * g / (ti_z * to_z * 4.0);
+            let g = one / (ci.opl * co.opl);
+            let lobe = d * g / (ci.t_z * co.t_z * 4.0);
             let f = fres.eval::<{ FresnelLanes::CONDUCTOR }, V>(c);
             let ok = c.gt(zero);
             math::channels!(|ch| ok.select(f[ch] * lobe, zero))
@@ -738,6 +770,47 @@ impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedLane<'_, D, CONDUC
             let v = coat + through;
             (above & v.is_finite()).select(v.max(zero), zero)
         })
+    }
+
+    /// This combination for pairs that share `wi` ([`Kernel::at_wi`]).
+    fn at_wi(self, wi: [f32; 3]) -> Box<dyn Kernel + 'a> {
+        Box::new(CoatedAtWi {
+            lane: self,
+            wi,
+            ci: self.crossing::<f32>(wi),
+        })
+    }
+}
+
+impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedLane<'_, D, CONDUCTOR> {
+    #[inline(always)]
+    fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        self.eval(wi, wo, self.crossing(wi), self.crossing(wo))
+    }
+}
+
+/// [`CoatedLane`] for pairs that all share the incident direction `wi`,
+/// with `wi`'s [`Crossing`] (two square roots, three divisions and, over a
+/// conductor, its masking) computed once in f32 by the same code.
+#[derive(Debug)]
+struct CoatedAtWi<'a, const D: u8, const CONDUCTOR: bool> {
+    lane: CoatedLane<'a, D, CONDUCTOR>,
+    wi: [f32; 3],
+    ci: Crossing<f32>,
+}
+
+impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedAtWi<'_, D, CONDUCTOR> {
+    #[inline(always)]
+    fn lane<V: Lanes>(&self, _wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+        let c = self.ci;
+        let ci = Crossing {
+            t_z: V::splat(c.t_z),
+            inv_t_z: V::splat(c.inv_t_z),
+            trans: V::splat(c.trans),
+            opl: V::splat(c.opl),
+        };
+        let co = self.lane.crossing(wo);
+        self.lane.eval(math::splat3(self.wi), wo, ci, co)
     }
 }
 
@@ -770,6 +843,20 @@ impl Kernel for CoatedKernel {
                 out,
             ),
         }
+    }
+
+    fn at_wi(&self, wi: [f32; 3]) -> Option<Box<dyn Kernel + '_>> {
+        let conductor = matches!(self.base, BaseLanes::Conductor(..));
+        Some(match (self.coat.dist(), conductor) {
+            (ScaleLanes::BECKMANN, false) => {
+                CoatedLane::<{ ScaleLanes::BECKMANN }, false>(self).at_wi(wi)
+            }
+            (ScaleLanes::BECKMANN, true) => {
+                CoatedLane::<{ ScaleLanes::BECKMANN }, true>(self).at_wi(wi)
+            }
+            (_, false) => CoatedLane::<{ ScaleLanes::GGX }, false>(self).at_wi(wi),
+            (_, true) => CoatedLane::<{ ScaleLanes::GGX }, true>(self).at_wi(wi),
+        })
     }
 }
 
