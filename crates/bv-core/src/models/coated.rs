@@ -814,49 +814,41 @@ impl<const D: u8, const CONDUCTOR: bool> LaneKernel for CoatedAtWi<'_, D, CONDUC
     }
 }
 
+/// Evaluates `$body` with `$lane` bound to the [`CoatedLane`] of `$k`'s
+/// distribution and base, the one monomorphised combination that serves it
+/// (shared by [`Kernel::eval`] and [`Kernel::at_wi`]).
+macro_rules! with_lane {
+    ($k:expr, |$lane:ident| $body:expr) => {{
+        let k: &CoatedKernel = $k;
+        let conductor = matches!(k.base, BaseLanes::Conductor(..));
+        match (k.coat.dist(), conductor) {
+            (ScaleLanes::BECKMANN, false) => {
+                let $lane = CoatedLane::<{ ScaleLanes::BECKMANN }, false>(k);
+                $body
+            }
+            (ScaleLanes::BECKMANN, true) => {
+                let $lane = CoatedLane::<{ ScaleLanes::BECKMANN }, true>(k);
+                $body
+            }
+            (_, false) => {
+                let $lane = CoatedLane::<{ ScaleLanes::GGX }, false>(k);
+                $body
+            }
+            (_, true) => {
+                let $lane = CoatedLane::<{ ScaleLanes::GGX }, true>(k);
+                $body
+            }
+        }
+    }};
+}
+
 impl Kernel for CoatedKernel {
     fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-        let conductor = matches!(self.base, BaseLanes::Conductor(..));
-        match (self.coat.dist(), conductor) {
-            (ScaleLanes::BECKMANN, false) => batch::run(
-                &CoatedLane::<{ ScaleLanes::BECKMANN }, false>(self),
-                isa,
-                dirs,
-                out,
-            ),
-            (ScaleLanes::BECKMANN, true) => batch::run(
-                &CoatedLane::<{ ScaleLanes::BECKMANN }, true>(self),
-                isa,
-                dirs,
-                out,
-            ),
-            (_, false) => batch::run(
-                &CoatedLane::<{ ScaleLanes::GGX }, false>(self),
-                isa,
-                dirs,
-                out,
-            ),
-            (_, true) => batch::run(
-                &CoatedLane::<{ ScaleLanes::GGX }, true>(self),
-                isa,
-                dirs,
-                out,
-            ),
-        }
+        with_lane!(self, |lane| batch::run(&lane, isa, dirs, out))
     }
 
     fn at_wi(&self, wi: [f32; 3]) -> Option<Box<dyn Kernel + '_>> {
-        let conductor = matches!(self.base, BaseLanes::Conductor(..));
-        Some(match (self.coat.dist(), conductor) {
-            (ScaleLanes::BECKMANN, false) => {
-                CoatedLane::<{ ScaleLanes::BECKMANN }, false>(self).at_wi(wi)
-            }
-            (ScaleLanes::BECKMANN, true) => {
-                CoatedLane::<{ ScaleLanes::BECKMANN }, true>(self).at_wi(wi)
-            }
-            (_, false) => CoatedLane::<{ ScaleLanes::GGX }, false>(self).at_wi(wi),
-            (_, true) => CoatedLane::<{ ScaleLanes::GGX }, true>(self).at_wi(wi),
-        })
+        Some(with_lane!(self, |lane| lane.at_wi(wi)))
     }
 }
 
