@@ -94,7 +94,7 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// compiled for each model, the calls inside it are direct, where the
     /// quadrature's calls through `&dyn Brdf` each went through the vtable
     /// and kept the out-of-order core from overlapping one evaluation with
-    /// the next (a GGX Cook-Torrance ρhd curve took a quarter less time).
+    /// the next (a GGX Cook-Torrance ρhd curve took a sixth less time).
     /// Override only with a form that returns the same values.
     fn eval_many(&self, wi: DVec3, wo: &[DVec3], out: &mut [Rgb]) {
         for (o, &w) in out.iter_mut().zip(wo) {
