@@ -508,20 +508,17 @@ impl Scratch {
     #[allow(clippy::type_complexity)]
     fn band(&mut self, wi: [f32; 3], n: usize) -> ([&mut [f32]; 3], [&mut [f32]; 3]) {
         let bits = wi.map(f32::to_bits);
-        if self.wi_holds != Some(bits) {
-            for (v, x) in self.wi.iter_mut().zip(wi) {
+        let moved = self.wi_holds != Some(bits);
+        self.wi_holds = Some(bits);
+        for (v, x) in self.wi.iter_mut().zip(wi) {
+            if moved {
                 v.fill(x);
             }
-            self.wi_holds = Some(bits);
-        }
-        let mut k = 0;
-        let lanes = self.wi.each_mut().map(|v| {
             if v.len() < n {
-                v.resize(n, wi[k]);
+                v.resize(n, x);
             }
-            k += 1;
-            &mut v[..n]
-        });
+        }
+        let lanes = self.wi.each_mut().map(|v| &mut v[..n]);
         let rgb = self.rgb.each_mut().map(|v| {
             v.resize(n, 0.0);
             &mut v[..n]
@@ -842,6 +839,15 @@ mod tests {
         assert!((r - (theta.cos() / PI).ln_1p()).abs() < 1e-6);
     }
 
+    /// Grid direction `k` of `g`, in f64.
+    fn grid_dir(g: &Grid, k: usize) -> DVec3 {
+        DVec3::new(
+            g.dirs[0][k] as f64,
+            g.dirs[1][k] as f64,
+            g.dirs[2][k] as f64,
+        )
+    }
+
     #[test]
     fn batch_values_match_eval_and_grids_are_reused() {
         // Values through the batch path (a kernel for cook-torrance, the
@@ -871,12 +877,7 @@ mod tests {
             assert_eq!(m.indices, g.indices);
             let wi32 = wi.as_vec3().as_dvec3();
             for (k, v) in m.values.iter().enumerate() {
-                let wo = DVec3::new(
-                    g.dirs[0][k] as f64,
-                    g.dirs[1][k] as f64,
-                    g.dirs[2][k] as f64,
-                );
-                let want = b.eval(wi32, wo);
+                let want = b.eval(wi32, grid_dir(&g, k));
                 for c in 0..3 {
                     let tol = (1e-4 * want[c].abs()).max(1e-6);
                     assert!(
@@ -916,12 +917,7 @@ mod tests {
             let g = grid(n_theta, n_phi, false);
             let wi32 = wi.as_vec3().as_dvec3();
             for (k, v) in mesh.values.iter().enumerate() {
-                let wo = DVec3::new(
-                    g.dirs[0][k] as f64,
-                    g.dirs[1][k] as f64,
-                    g.dirs[2][k] as f64,
-                );
-                let want = b.eval(wi32, wo)[0];
+                let want = b.eval(wi32, grid_dir(&g, k))[0];
                 let tol = (1e-4 * want.abs()).max(1e-6);
                 assert!(
                     (v[0] as f64 - want).abs() <= tol,

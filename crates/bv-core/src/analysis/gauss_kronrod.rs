@@ -198,27 +198,38 @@ pub fn segments(breaks: &[f64], grade_start: bool, grade_end: bool) -> Vec<Segme
         .collect()
 }
 
+/// The `N` nodes `(x, dx/du)` of a symmetric rule on segment `s` about
+/// `u = c` with half-width `h`, in the order the rules sum them: `c ∓ h·a(i)`
+/// for each abscissa `a(i)`, `i < N / 2`, then the centre.
+fn nodes<const N: usize>(
+    s: &Segment,
+    c: f64,
+    h: f64,
+    a: impl Fn(usize) -> f64,
+) -> ([f64; N], [f64; N]) {
+    let mut xs = [0.0; N];
+    let mut jacs = [0.0; N];
+    for i in 0..N / 2 {
+        (xs[2 * i], jacs[2 * i]) = s.at(c - h * a(i));
+        (xs[2 * i + 1], jacs[2 * i + 1]) = s.at(c + h * a(i));
+    }
+    (xs[N - 1], jacs[N - 1]) = s.at(c);
+    (xs, jacs)
+}
+
 /// One GK15 panel `[u0, u1]` of segment `s` for an integrand returning
 /// `(value, error of the value)`: `(K15, |K15 − G7| + Σ wK · error)`.
 fn panel<T: Value>(f: &mut impl Integrand<T>, s: &Segment, u0: f64, u1: f64) -> (T, T) {
     let c = 0.5 * (u0 + u1);
     let h = 0.5 * (u1 - u0);
-    // The nodes in the order they are summed: ∓ each Kronrod node, then
-    // the centre.
-    let mut xs = [0.0; 15];
-    let mut jacs = [0.0; 15];
-    for i in 0..7 {
-        (xs[2 * i], jacs[2 * i]) = s.at(c - h * XGK[i]);
-        (xs[2 * i + 1], jacs[2 * i + 1]) = s.at(c + h * XGK[i]);
-    }
-    (xs[14], jacs[14]) = s.at(c);
-    let mut vals = [(T::default(), T::default()); 15];
+    let (xs, jacs) = nodes::<PANEL_EVALS>(s, c, h, |i| XGK[i]);
+    let mut vals = [(T::default(), T::default()); PANEL_EVALS];
     f.at(&xs, &mut vals);
     let mut k = T::default();
     let mut g = T::default();
     let mut inner = T::default();
     for (n, ((v, e), jac)) in vals.into_iter().zip(jacs).enumerate() {
-        let i = if n == 14 { 7 } else { n / 2 };
+        let i = if n + 1 == PANEL_EVALS { 7 } else { n / 2 };
         let (v, e) = (v * jac, e * jac.abs());
         k = k + v * WGK[i];
         inner = inner + e * WGK[i];
@@ -377,20 +388,13 @@ pub fn integrate<T: Value>(
 fn gauss7<T: Value>(f: &mut impl Integrand<T>, s: &Segment, u0: f64, u1: f64) -> (T, T) {
     let c = 0.5 * (u0 + u1);
     let h = 0.5 * (u1 - u0);
-    let mut xs = [0.0; 7];
-    let mut jacs = [0.0; 7];
-    for i in 0..3 {
-        let x = XGK[2 * i + 1];
-        (xs[2 * i], jacs[2 * i]) = s.at(c - h * x);
-        (xs[2 * i + 1], jacs[2 * i + 1]) = s.at(c + h * x);
-    }
-    (xs[6], jacs[6]) = s.at(c);
-    let mut vals = [(T::default(), T::default()); 7];
+    let (xs, jacs) = nodes::<GAUSS7_EVALS>(s, c, h, |i| XGK[2 * i + 1]);
+    let mut vals = [(T::default(), T::default()); GAUSS7_EVALS];
     f.at(&xs, &mut vals);
     let mut g = T::default();
     let mut inner = T::default();
     for (n, ((v, e), jac)) in vals.into_iter().zip(jacs).enumerate() {
-        let w = WG[if n == 6 { 3 } else { n / 2 }];
+        let w = WG[if n + 1 == GAUSS7_EVALS { 3 } else { n / 2 }];
         g = g + v * (jac * w);
         inner = inner + e * (jac.abs() * w);
     }
