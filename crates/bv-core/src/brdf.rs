@@ -23,6 +23,17 @@ pub struct Claims {
 /// says which branch applies; only where it changes sign matters.
 pub type Kink<'a> = Box<dyn Fn(DVec3) -> f64 + 'a>;
 
+/// A cone of directions about a unit `axis`: the `w` with
+/// `w·axis > cos_half` (a half-angle over 90° when `cos_half < 0`; see
+/// [`Brdf::transmission_support`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cone {
+    /// The cone's axis (unit).
+    pub axis: DVec3,
+    /// The cosine of its half-angle.
+    pub cos_half: f64,
+}
+
 /// Whether a delta lobe reflects or transmits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DeltaKind {
@@ -197,6 +208,23 @@ pub trait Brdf: Send + Sync + std::fmt::Debug {
     /// a function whose sign changes where `f` is smooth costs a break.
     /// Default: none.
     fn kinks(&self, _wi: DVec3) -> Vec<Kink<'_>> {
+        Vec::new()
+    }
+
+    /// For a transmitting model: cones that hold every direction on the far
+    /// side of the surface from `wi` where `f(wi, ·)` may be non-zero
+    /// (`f(wi, wo) = 0` for every `wo` with `wo.z · wi.z < 0` that lies
+    /// outside any of them, `wo·axis ≤ cos_half`): the rough dielectric's
+    /// cone past which no facet refracts and the plane beyond which the
+    /// facet that would would face down. The albedo quadrature integrates
+    /// the transmitted part only inside them, with breaks where its rings
+    /// cross them: rings and arcs outside cost no evaluation (at 45° on the
+    /// default rough dielectric, half of the transmitted part's evaluations
+    /// were exact zeros out there). A claim, not a hint: a cone narrower
+    /// than the model's support loses energy without a sign, so the
+    /// catalogue's cones are tested against `eval`. Default: none (the
+    /// whole far side).
+    fn transmission_support(&self, _wi: DVec3) -> Vec<Cone> {
         Vec::new()
     }
 

@@ -39,8 +39,8 @@ pub mod text;
 pub mod user;
 
 pub use brdf::{
-    Brdf, BrdfSample, Claims, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, Kink, MicrofacetTerms,
-    Ndf, sample_weighted,
+    Brdf, BrdfSample, Claims, Cone, DeltaKind, DeltaLobe, EvalHealth, FresnelTerm, Kink,
+    MicrofacetTerms, Ndf, sample_weighted,
 };
 pub use error::{BvError, Result};
 pub use model::ModelInfo;

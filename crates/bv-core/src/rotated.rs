@@ -157,6 +157,14 @@ impl Brdf for Rotated {
             .collect()
     }
 
+    fn transmission_support(&self, wi: DVec3) -> Vec<crate::Cone> {
+        let mut cones = self.inner.transmission_support(self.to_inner(wi));
+        for c in &mut cones {
+            c.axis = self.to_rotated(c.axis);
+        }
+        cones
+    }
+
     fn is_analytic(&self) -> bool {
         self.inner.is_analytic()
     }

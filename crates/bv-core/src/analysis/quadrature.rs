@@ -48,6 +48,13 @@
 //!   mirror image: each ring about the pole is then smooth, where over the
 //!   half vector Hapke's cusp is a 2-D feature at `h = wi` that both axes
 //!   must bisect towards and Banks' cone a ridge across every circle.
+//! - A transmitting model may name cones outside which its transmitted part
+//!   is zero ([`Brdf::transmission_support`]: the rough dielectric's cone
+//!   past which no facet refracts, and the plane past which that facet
+//!   would face down). Their crossings with each ring (and the rings that
+//!   touch them) are breaks in closed form, and the arcs and rings outside
+//!   are skipped without an evaluation: a third of the rough dielectric's
+//!   evaluations, and more for light from below.
 //! - The inner integrands hand a panel's nodes to the model in one call
 //!   ([`Brdf::eval_many_with_half`], [`Brdf::eval_many`]), whose loop is
 //!   compiled for the model: the same values bit for bit as one call per
@@ -57,7 +64,7 @@
 use super::directions::below;
 use super::estimate::{AlbedoParts, Estimate, Method};
 use super::gauss_kronrod::{self, Segment};
-use crate::{Brdf, DeltaKind, Rgb, frame};
+use crate::{Brdf, Cone, DeltaKind, Rgb, frame};
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
@@ -194,6 +201,113 @@ fn polar_segments(breaks: &[f64], theta_full: f64, theta_end: f64) -> Vec<Segmen
         .collect()
 }
 
+/// How far outside a model's [`Cone`] a part of a ring must lie (in
+/// `wo·axis − cos_half`) to be skipped: a kink root that [`kink_roots`]
+/// placed at an arc's break is within 1e-12 of the cone, on either side,
+/// and `f` falls to 0 at the cone (see `RoughDielectric::kinks`), so what a
+/// margin this small leaves out is far below any tolerance.
+const CONE_MARGIN: f64 = 1e-9;
+
+/// One of a model's [`Brdf::transmission_support`] cones on the rings of
+/// [`transmitted`]: with `wo(θ, ψ) = cos θ p − sin θ (cos ψ e₁ + sin ψ e₂)`,
+/// `wo·axis − cos_half = A cos θ − sin θ (B cos ψ + C sin ψ) − cos_half`
+/// (`A = p·axis`, `B = e₁·axis`, `C = e₂·axis`): where a ring crosses the
+/// cone, and which rings touch it, in closed form. A part of a ring is
+/// skipped only when all of it lies outside, whether or not a kink search
+/// found the cone there.
+#[derive(Debug, Clone, Copy)]
+struct ConeOnRings {
+    a: f64,
+    b: f64,
+    c: f64,
+    cos_half: f64,
+    /// `√(B² + C²)`, the ring's reach across the axis.
+    r: f64,
+    /// Where `B cos ψ + C sin ψ = r cos(ψ − ψ₀)` is largest.
+    psi0: f64,
+}
+
+impl ConeOnRings {
+    fn new(cone: Cone, p: DVec3, e1: DVec3, e2: DVec3) -> Option<Self> {
+        let ok = cone.axis.is_finite()
+            && (cone.axis.length() - 1.0).abs() < 1e-9
+            && cone.cos_half.is_finite();
+        let (a, b, c) = (p.dot(cone.axis), e1.dot(cone.axis), e2.dot(cone.axis));
+        ok.then_some(Self {
+            a,
+            b,
+            c,
+            cos_half: cone.cos_half,
+            r: b.hypot(c),
+            psi0: c.atan2(b),
+        })
+    }
+
+    /// `wo·axis − cos_half` at `ψ` on the ring of `(sin θ, cos θ)`.
+    fn at(&self, st: f64, ct: f64, psi: f64) -> f64 {
+        let (sp, cp) = psi.sin_cos();
+        self.a * ct - st * (self.b * cp + self.c * sp) - self.cos_half
+    }
+
+    /// Whether the arc `[lo, hi]` (`hi − lo ≤ 2π`) of the ring of
+    /// `(sin θ ≥ 0, cos θ)` lies outside the cone, up to [`CONE_MARGIN`].
+    fn outside(&self, st: f64, ct: f64, lo: f64, hi: f64) -> bool {
+        // The point nearest the axis (ψ₀ + π), at its first turn after lo.
+        let near = self.psi0 + PI;
+        let near = near + ((lo - near) / TAU).ceil() * TAU;
+        let most = if near <= hi {
+            self.a * ct + st * self.r - self.cos_half
+        } else {
+            self.at(st, ct, lo).max(self.at(st, ct, hi))
+        };
+        most <= CONE_MARGIN
+    }
+
+    /// Where the ring of `(sin θ, cos θ)` crosses the cone inside
+    /// `(lo, hi)`: `r cos(ψ − ψ₀) = (A cos θ − cos_half)/sin θ`.
+    fn crossings(&self, st: f64, ct: f64, lo: f64, hi: f64, out: &mut Vec<f64>) {
+        let den = st * self.r;
+        let q = (self.a * ct - self.cos_half) / den;
+        // (No crossing for a ring of radius 0 or one wholly on one side,
+        // nor for NaN.)
+        if den <= 0.0 || q.is_nan() || q.abs() >= 1.0 {
+            return;
+        }
+        let d = q.acos();
+        for x in [self.psi0 + d, self.psi0 - d] {
+            let x = x + ((lo - x) / TAU).ceil() * TAU;
+            if x > lo && x < hi {
+                insert_break(out, x);
+            }
+        }
+    }
+
+    /// The polar angles in `(0, end)` of the rings that touch the cone
+    /// (`A cos θ ± r sin θ = cos_half`), where the part of a ring inside it
+    /// appears or vanishes: kinks of the outer integrand.
+    fn tangent_rings(&self, end: f64, out: &mut Vec<f64>) {
+        let rho = self.a.hypot(self.r);
+        if rho <= 0.0 || rho.is_nan() || self.cos_half.abs() >= rho {
+            return;
+        }
+        let (d, g) = (self.r.atan2(self.a), (self.cos_half / rho).acos());
+        for t in [d + g, d - g, g - d, -d - g] {
+            if t > 0.0 && t < end {
+                insert_break(out, t);
+            }
+        }
+    }
+}
+
+/// Adds the break `x` unless one lies within 1e-9 of it already: a kink
+/// root that the search placed to 1e-12 is kept, and no sliver of a panel
+/// is left between the two.
+fn insert_break(breaks: &mut Vec<f64>, x: f64) {
+    if breaks.iter().all(|&b| (b - x).abs() > 1e-9) {
+        breaks.push(x);
+    }
+}
+
 /// One inner (azimuthal) integral over the arc cut at `breaks`: graded at
 /// the arc's ends unless it is the `full` circle, and with `half` only the
 /// side from the plane of incidence, doubled (to half the tolerance).
@@ -205,7 +319,31 @@ fn arc_integral(
     tol: f64,
     panels: usize,
 ) -> gauss_kronrod::Integral<Rgb> {
-    let segs = gauss_kronrod::segments(breaks, !full && !half, !full);
+    arc_integral_where(f, breaks, full, half, tol, panels, |_| true)
+}
+
+/// [`arc_integral`] over the segments between `breaks` that `keep` keeps
+/// (the others are known to be zero; each keeps the grading it has among
+/// all of them).
+fn arc_integral_where(
+    f: &mut impl gauss_kronrod::Integrand<Rgb>,
+    breaks: &[f64],
+    full: bool,
+    half: bool,
+    tol: f64,
+    panels: usize,
+    keep: impl Fn(&Segment) -> bool,
+) -> gauss_kronrod::Integral<Rgb> {
+    let mut segs = gauss_kronrod::segments(breaks, !full && !half, !full);
+    segs.retain(keep);
+    if segs.is_empty() {
+        return gauss_kronrod::Integral {
+            value: Rgb::ZERO,
+            error: Rgb::ZERO,
+            evaluations: 0,
+            converged: true,
+        };
+    }
     let (tol, scale) = if half { (0.5 * tol, 2.0) } else { (tol, 1.0) };
     let mut r = gauss_kronrod::integrate(f, &segs, tol, 0.0, panels, false);
     r.value *= scale;
@@ -544,6 +682,14 @@ impl Brdf for Flipped<'_> {
             .map(|k| -> crate::Kink<'_> { Box::new(move |wo| k(below(wo))) })
             .collect()
     }
+    fn transmission_support(&self, wi: DVec3) -> Vec<Cone> {
+        // A mirror keeps dot products: wo·axis = below(wo)·below(axis).
+        let mut cones = self.0.transmission_support(below(wi));
+        for c in &mut cones {
+            c.axis = below(c.axis);
+        }
+        cones
+    }
 }
 
 /// A reflection model seen through the surface plane on the outgoing side
@@ -798,6 +944,13 @@ fn transmitted(
         DVec3::new(c, s, 0.0)
     };
     let e2 = p.cross(e1);
+    // The model's cone outside which the transmitted part is zero: rings
+    // and arcs out there are skipped.
+    let cones: Vec<ConeOnRings> = brdf
+        .transmission_support(wi)
+        .into_iter()
+        .filter_map(|c| ConeOnRings::new(c, p, e1, e2))
+        .collect();
     let (sb, cb) = (e1.z.clamp(0.0, 1.0), (-p.z).clamp(0.0, 1.0));
     let beta = sb.atan2(cb);
     let theta_full = FRAC_PI_2 - beta;
@@ -844,6 +997,9 @@ fn transmitted(
         };
         outer_kink_roots(&kinks, along, theta_end, &mut breaks);
     }
+    for c in &cones {
+        c.tangent_rings(theta_end, &mut breaks);
+    }
     breaks.retain(|&x| (0.0..=theta_end).contains(&x));
     breaks.sort_by(f64::total_cmp);
     breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14);
@@ -878,6 +1034,10 @@ fn transmitted(
         }
         let full = psi_max >= PI;
         let (lo, hi) = (if half { 0.0 } else { -psi_max }, psi_max);
+        let outside = |a: f64, b: f64| cones.iter().any(|c| c.outside(st, ct, a, b));
+        if outside(lo, hi) {
+            return (Rgb::ZERO, Rgb::ZERO);
+        }
         // `at(theta, ·)` with the ring's sine and cosine computed once (the
         // same values: `at` takes them from `sin_cos` too).
         let (st_r, ct_r) = sin_cos(theta);
@@ -920,6 +1080,9 @@ fn transmitted(
             KINK_SCAN,
             &mut br,
         );
+        for c in &cones {
+            c.crossings(st, ct, lo, hi, &mut br);
+        }
         // A panel's nodes below the surface to the model in one call.
         let mut inner = gauss_kronrod::Batched(|psis: &[f64], out: &mut [(Rgb, Rgb)]| {
             for (psis, out) in psis.chunks(NODES).zip(out.chunks_mut(NODES)) {
@@ -943,7 +1106,15 @@ fn transmitted(
                 }
             }
         });
-        let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
+        let r = arc_integral_where(
+            &mut inner,
+            &br,
+            full,
+            half,
+            inner_tol,
+            opts.inner_panels,
+            |s| !outside(s.a, s.b),
+        );
         inner_evals += r.evaluations;
         (r.value, r.error)
     };
@@ -1032,6 +1203,7 @@ pub fn rho_hh(brdf: &dyn Brdf, opts: &QuadratureOptions) -> Estimate {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::Arc;
 
     #[test]
     fn a_kink_in_a_scan_step_that_ends_below_the_horizon_is_found() {
@@ -1079,6 +1251,165 @@ mod tests {
         assert!((out[1] - (phi_i + root)).abs() < 1e-12, "{out:?}");
         // The scan looks at both ends of each step: 2 · KINK_SCAN.
         assert!(calls.get() <= 2 * KINK_SCAN + 2, "{} looks", calls.get());
+    }
+
+    /// A uniform direction on the sphere.
+    fn sphere_dir(rng: &mut crate::sampling::BvRng) -> DVec3 {
+        let u = crate::sampling::uniform2(rng);
+        let z = 1.0 - 2.0 * u.x;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (s, c) = (TAU * u.y).sin_cos();
+        DVec3::new(r * c, r * s, z)
+    }
+
+    /// The catalogue at its defaults, and the rough dielectric across its
+    /// distributions, roughnesses, indices (below and above 1) and
+    /// geometries, turned (`Rotated`) and seen from below (`Flipped`).
+    fn transmitting_models() -> Vec<(String, Arc<dyn Brdf>)> {
+        let mut out: Vec<(String, Arc<dyn Brdf>)> = Vec::new();
+        for m in crate::catalogue().iter() {
+            let path = m
+                .params
+                .iter()
+                .any(|d| matches!(d.kind, crate::params::ParamKind::Path { .. }));
+            if !path {
+                out.push((
+                    m.id.into(),
+                    crate::ModelSpec::new(m.id).unwrap().build().unwrap().into(),
+                ));
+            }
+        }
+        for p in [
+            serde_json::json!({"eta": 1.5}),
+            serde_json::json!({"eta": 0.66, "alpha_x": 0.05, "alpha_y": 0.05}),
+            serde_json::json!({"eta": 1.02, "alpha_x": 0.8, "alpha_y": 0.8}),
+            serde_json::json!({"eta": 4.0, "distribution": "beckmann", "alpha_x": 0.1, "alpha_y": 0.5}),
+            serde_json::json!({"eta": 0.2, "geometry": "smith-correlated", "alpha_x": 0.3, "alpha_y": 0.3}),
+        ] {
+            let b: Arc<dyn Brdf> = crate::ModelSpec::from_json("rough-dielectric", &p)
+                .unwrap()
+                .build()
+                .unwrap()
+                .into();
+            out.push((format!("rough-dielectric {p}"), b.clone()));
+            out.push((
+                format!("rotated {p}"),
+                Arc::new(crate::rotated::Rotated::new(b, 0.7)),
+            ));
+        }
+        out
+    }
+
+    #[test]
+    fn f_is_zero_outside_every_cone_a_model_names_for_its_transmission() {
+        // `transmission_support` is a claim the quadrature relies on without
+        // looking: it skips what lies outside. Every model's cones against
+        // `eval` at random pairs across the surface (and through Flipped,
+        // the quadrature's view of light from below), and the cones must
+        // cut something for the rough dielectric (else this proves nothing).
+        let mut rng = crate::sampling::rng(11);
+        for (name, b) in transmitting_models() {
+            let flipped = Flipped(b.as_ref());
+            for (view, m) in [("", b.as_ref()), (" flipped", &flipped as &dyn Brdf)] {
+                let (mut cut, mut nonzero) = (0, 0);
+                for _ in 0..300 {
+                    let wi = sphere_dir(&mut rng);
+                    let cones = m.transmission_support(wi);
+                    for _ in 0..40 {
+                        let mut wo = sphere_dir(&mut rng);
+                        if wo.z * wi.z > 0.0 {
+                            wo.z = -wo.z;
+                        }
+                        let f = m.eval(wi, wo);
+                        nonzero += usize::from(f != Rgb::ZERO);
+                        if cones.iter().any(|c| wo.dot(c.axis) <= c.cos_half) {
+                            cut += 1;
+                            assert_eq!(f, Rgb::ZERO, "{name}{view}: wi {wi} wo {wo} {cones:?}");
+                        }
+                    }
+                }
+                if name.starts_with("rough") || name.starts_with("rotated") {
+                    assert!(
+                        cut > 1000 && nonzero > 50,
+                        "{name}{view}: {cut} cut, {nonzero} non-zero"
+                    );
+                }
+            }
+        }
+    }
+
+    /// `b` without its [`Brdf::transmission_support`], as the quadrature
+    /// sees it otherwise.
+    #[derive(Debug)]
+    struct NoSupport<'a>(&'a dyn Brdf);
+
+    impl Brdf for NoSupport<'_> {
+        fn id(&self) -> &'static str {
+            self.0.id()
+        }
+        fn eval(&self, wi: DVec3, wo: DVec3) -> Rgb {
+            self.0.eval(wi, wo)
+        }
+        fn eval_with_half(&self, wi: DVec3, wo: DVec3, h: DVec3) -> Rgb {
+            self.0.eval_with_half(wi, wo, h)
+        }
+        fn claims(&self) -> crate::Claims {
+            self.0.claims()
+        }
+        fn transmits(&self) -> bool {
+            self.0.transmits()
+        }
+        fn interface_eta(&self) -> Option<f64> {
+            self.0.interface_eta()
+        }
+        fn deltas(&self, wi: DVec3) -> Vec<crate::DeltaLobe> {
+            self.0.deltas(wi)
+        }
+        fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
+            self.0.peaks(wi)
+        }
+        fn pole(&self, wi: DVec3) -> Option<DVec3> {
+            self.0.pole(wi)
+        }
+        fn kinks(&self, wi: DVec3) -> Vec<crate::Kink<'_>> {
+            self.0.kinks(wi)
+        }
+    }
+
+    #[test]
+    fn a_transmission_support_spares_evaluations_and_keeps_the_value() {
+        // The same albedo within the two stated errors with and without
+        // the cones, from both sides and at grazing light, in fewer
+        // evaluations (at least a fifth fewer over the set).
+        let opts = QuadratureOptions::default();
+        let (mut with, mut without) = (0, 0);
+        for (name, b) in transmitting_models() {
+            if !(name.starts_with("rough") || name.starts_with("rotated")) {
+                continue;
+            }
+            for (t, phi) in [(0.0, 0.0), (0.6, 0.3), (1.2, 2.0), (1.55, -1.0)] {
+                for side in [1.0, -1.0] {
+                    let (st, ct) = f64::sin_cos(t);
+                    let wi = DVec3::new(st * f64::cos(phi), st * f64::sin(phi), side * ct);
+                    let a = rho_hd_dir(b.as_ref(), wi, &opts);
+                    let c = rho_hd_dir(&NoSupport(b.as_ref()), wi, &opts);
+                    let d = (a.value - c.value).abs().max_element();
+                    let e = (a.std_error + c.std_error).max_element();
+                    assert!(
+                        d <= e,
+                        "{name} wi {wi}: {} vs {} ({d:e} > {e:e})",
+                        a.value,
+                        c.value
+                    );
+                    with += a.samples;
+                    without += c.samples;
+                }
+            }
+        }
+        assert!(
+            5 * with < 4 * without,
+            "{with} evaluations with the cones, {without} without"
+        );
     }
 
     #[test]

@@ -515,6 +515,41 @@ impl Brdf for RoughDielectric {
         k
     }
 
+    fn transmission_support(&self, wi: DVec3) -> Vec<crate::Cone> {
+        // χ⁺ (eq. 21) for the facet h = s (ηi wi + ηo wo)/|·| that refracts
+        // wi into wo, with σ = sign(wi.z) and k = ηi/ηo: wi·h, wo·h and h.z
+        // must have the signs σ, −σ and +. With k < 1, wo·(ηi wi + ηo wo)
+        // = ηi wi·wo + ηo > 0 fixes s = −σ; then wi·wo < −k (the cone of
+        // `kinks` about −wi) and ηi wi.z + ηo wo.z must have the sign −σ:
+        // wo·(−σ z) > k |wi.z|. With k > 1, ηi + ηo wi·wo > 0 fixes s = σ;
+        // then wi·wo < −1/k and wo·(σ z) > −k |wi.z| (an obtuse cone about
+        // wi's side of the normal). Outside either, f is 0 (facet returns
+        // None).
+        let (Some(axis), true) = ((-wi).try_normalize(), wi.z != 0.0) else {
+            return Vec::new();
+        };
+        let side = wi.z.signum();
+        let k = self.eta_of(wi) / self.eta_of(-wi);
+        let plane = if k < 1.0 {
+            crate::Cone {
+                axis: DVec3::new(0.0, 0.0, -side),
+                cos_half: k * wi.z.abs(),
+            }
+        } else {
+            crate::Cone {
+                axis: DVec3::new(0.0, 0.0, side),
+                cos_half: -k * wi.z.abs(),
+            }
+        };
+        vec![
+            crate::Cone {
+                axis,
+                cos_half: self.eta.min(1.0 / self.eta),
+            },
+            plane,
+        ]
+    }
+
     fn peaks(&self, wi: DVec3) -> Vec<DVec3> {
         // The refracted direction through the macro surface (the transmitted
         // lobe's centre), when Snell's law has a solution.
