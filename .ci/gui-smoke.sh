@@ -86,6 +86,29 @@ if ! timeout 180 xvfb-run -a -s "-screen 0 $screen" "$bv" --fresh "${models[@]}"
 fi
 check_png "$out/app.png" "bv --screenshot"
 
+# 1b. `--size` wins over the size of the last session's window, which eframe
+# restores from its storage whatever the viewer asks for.
+mkdir -p "$rt/.local/share/bv"
+cat >"$rt/.local/share/bv/app.ron" <<'RON'
+{
+    "window": "(normal_geometry:(outer_position_pixels:Some((x:0.0,y:0.0)),scale_factor:1.0,inner_size_points:(x:1000.0,y:700.0)),fullscreen:false,maximized:false)",
+}
+RON
+rm -f "$out/sized.png"
+if ! timeout 180 xvfb-run -a -s "-screen 0 1920x1080x24" "$bv" --fresh --model lambert --size 1600x900 \
+    --screenshot "$out/sized.png" >"$out/sized.log" 2>&1; then
+    echo "gui-smoke: FAIL: bv --size --screenshot exited with an error:" >&2
+    cat "$out/sized.log" >&2
+    fail=1
+fi
+sized="$(/usr/bin/convert "$out/sized.png" -format '%wx%h' info: 2>/dev/null || echo none)"
+echo "gui-smoke: --size 1600x900 over a saved 1000x700 window: $sized"
+if [[ "$sized" != 1600x900 ]]; then
+    echo "gui-smoke: FAIL: --size 1600x900 gave a $sized screenshot" >&2
+    fail=1
+fi
+rm -rf "$rt/.local/share/bv"
+
 # 2. What the X server shows, a few seconds after start.
 rm -f "$out/xroot.png"
 timeout 180 xvfb-run -a -s "-screen 0 $screen" sh -c "

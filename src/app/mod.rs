@@ -236,6 +236,7 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 persist,
                 bench: args2.bench_frames.map(|n| Bench::new(n, adapter)),
                 shot: args2.screenshot.clone().map(Shot::new),
+                resize: args2.size.is_some().then(|| egui::Vec2::from(size)),
                 outcome: outcome2,
             };
             app.viewer.panels_on_clear = true;
@@ -272,6 +273,11 @@ struct BvApp {
     persist: bool,
     bench: Option<Bench>,
     shot: Option<Shot>,
+    /// The size `--size` asked for, sent to the window on the first frame:
+    /// eframe restores a saved window's size over the one the viewport
+    /// builder asks for, whatever `persist_window` says (eframe 0.37,
+    /// `load_window_settings`), so `--size` alone lost to the last session.
+    resize: Option<egui::Vec2>,
     outcome: Arc<Mutex<Option<anyhow::Result<()>>>>,
 }
 
@@ -288,6 +294,9 @@ impl eframe::App for BvApp {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         let t0 = Instant::now();
+        if let Some(size) = self.resize.take() {
+            ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
+        }
         if let Some(b) = &mut self.bench {
             if b.settling(self.viewer.views_busy()) {
                 // Let progressive views finish (as they have when a user
