@@ -1262,23 +1262,27 @@ mod tests {
         DVec3::new(r * c, r * s, z)
     }
 
+    /// Every catalogue model that needs no file, at its defaults.
+    fn catalogue_at_defaults() -> Vec<(String, Arc<dyn Brdf>)> {
+        crate::catalogue()
+            .iter()
+            .filter(|m| {
+                !m.params
+                    .iter()
+                    .any(|d| matches!(d.kind, crate::params::ParamKind::Path { .. }))
+            })
+            .map(|m| {
+                let b = crate::ModelSpec::new(m.id).unwrap().build().unwrap();
+                (m.id.to_string(), Arc::from(b))
+            })
+            .collect()
+    }
+
     /// The catalogue at its defaults, and the rough dielectric across its
     /// distributions, roughnesses, indices (below and above 1) and
     /// geometries, turned (`Rotated`) and seen from below (`Flipped`).
     fn transmitting_models() -> Vec<(String, Arc<dyn Brdf>)> {
-        let mut out: Vec<(String, Arc<dyn Brdf>)> = Vec::new();
-        for m in crate::catalogue().iter() {
-            let path = m
-                .params
-                .iter()
-                .any(|d| matches!(d.kind, crate::params::ParamKind::Path { .. }));
-            if !path {
-                out.push((
-                    m.id.into(),
-                    crate::ModelSpec::new(m.id).unwrap().build().unwrap().into(),
-                ));
-            }
-        }
+        let mut out = catalogue_at_defaults();
         for p in [
             serde_json::json!({"eta": 1.5}),
             serde_json::json!({"eta": 0.66, "alpha_x": 0.05, "alpha_y": 0.05}),
@@ -1421,21 +1425,8 @@ mod tests {
         // batched). Every catalogue model at its defaults, pairs on the
         // whole sphere (the transmitted part's below the surface).
         let mut rng = crate::sampling::rng(7);
-        let mut sphere = || {
-            let u = crate::sampling::uniform2(&mut rng);
-            let z = 1.0 - 2.0 * u.x;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let (s, c) = (TAU * u.y).sin_cos();
-            DVec3::new(r * c, r * s, z)
-        };
-        for m in crate::catalogue().iter() {
-            if m.params
-                .iter()
-                .any(|d| matches!(d.kind, crate::params::ParamKind::Path { .. }))
-            {
-                continue;
-            }
-            let b = crate::ModelSpec::new(m.id).unwrap().build().unwrap();
+        let mut sphere = || sphere_dir(&mut rng);
+        for (id, b) in catalogue_at_defaults() {
             for _ in 0..8 {
                 let wi = sphere();
                 let wos: Vec<DVec3> = (0..15).map(|_| sphere()).collect();
@@ -1448,15 +1439,11 @@ mod tests {
                     let same = |a: Rgb, b: Rgb| {
                         a.to_array().map(f64::to_bits) == b.to_array().map(f64::to_bits)
                     };
-                    assert!(
-                        same(many[k], b.eval(wi, wos[k])),
-                        "{} eval_many at {k}",
-                        m.id
-                    );
+                    assert!(same(many[k], b.eval(wi, wos[k])), "{} eval_many at {k}", id);
                     assert!(
                         same(half[k], b.eval_with_half(wi, wos[k], hs[k])),
                         "{} eval_many_with_half at {k}",
-                        m.id
+                        id
                     );
                 }
             }
