@@ -170,32 +170,49 @@ impl Segment {
 /// first break when `grade_start` and at the last when `grade_end`. Breaks
 /// closer than `1e-12` (relative to the span) are merged.
 pub fn segments(breaks: &[f64], grade_start: bool, grade_end: bool) -> Vec<Segment> {
-    let mut b: Vec<f64> = breaks.iter().copied().filter(|x| x.is_finite()).collect();
+    let mut out = Vec::new();
+    segments_into(breaks, grade_start, grade_end, &mut Vec::new(), &mut out);
+    out
+}
+
+/// [`segments`] into `out` (cleared first), with `scratch` for the sorted
+/// breaks: for a caller that cuts many axes in a row (the albedo
+/// quadrature's rings, hundreds per ρhd) and keeps both vectors, so that no
+/// axis allocates.
+pub fn segments_into(
+    breaks: &[f64],
+    grade_start: bool,
+    grade_end: bool,
+    scratch: &mut Vec<f64>,
+    out: &mut Vec<Segment>,
+) {
+    out.clear();
+    let b = scratch;
+    b.clear();
+    b.extend(breaks.iter().copied().filter(|x| x.is_finite()));
     b.sort_by(f64::total_cmp);
     let span = match (b.first(), b.last()) {
         (Some(&lo), Some(&hi)) => hi - lo,
-        _ => return Vec::new(),
+        _ => return,
     };
     let eps = 1e-12 * span.max(f64::MIN_POSITIVE);
     b.dedup_by(|x, y| (*x - *y).abs() <= eps);
     let n = b.len().saturating_sub(1);
-    (0..n)
-        .map(|k| {
-            let first = grade_start && k == 0;
-            let last = grade_end && k + 1 == n;
-            let grading = match (first, last) {
-                (true, true) => Grading::Both,
-                (true, false) => Grading::Start,
-                (false, true) => Grading::End,
-                (false, false) => Grading::Linear,
-            };
-            Segment {
-                a: b[k],
-                b: b[k + 1],
-                grading,
-            }
-        })
-        .collect()
+    out.extend((0..n).map(|k| {
+        let first = grade_start && k == 0;
+        let last = grade_end && k + 1 == n;
+        let grading = match (first, last) {
+            (true, true) => Grading::Both,
+            (true, false) => Grading::Start,
+            (false, true) => Grading::End,
+            (false, false) => Grading::Linear,
+        };
+        Segment {
+            a: b[k],
+            b: b[k + 1],
+            grading,
+        }
+    }));
 }
 
 /// The `N` nodes `(x, dx/du)` of a symmetric rule on segment `s` about

@@ -318,8 +318,18 @@ fn arc_integral(
     half: bool,
     tol: f64,
     panels: usize,
+    scratch: &mut ArcScratch,
 ) -> gauss_kronrod::Integral<Rgb> {
-    arc_integral_where(f, breaks, full, half, tol, panels, |_| true)
+    arc_integral_where(f, breaks, full, half, tol, panels, |_| true, scratch)
+}
+
+/// The vectors one ring's inner integral fills (its breaks, sorted, and
+/// its segments), kept from ring to ring: a ρhd curve integrates hundreds
+/// of rings per angle, each of which allocated them.
+#[derive(Default)]
+struct ArcScratch {
+    sorted: Vec<f64>,
+    segs: Vec<Segment>,
 }
 
 /// [`arc_integral`] over the segments between `breaks` that `keep` keeps
@@ -333,8 +343,10 @@ fn arc_integral_where(
     tol: f64,
     panels: usize,
     keep: impl Fn(&Segment) -> bool,
+    scratch: &mut ArcScratch,
 ) -> gauss_kronrod::Integral<Rgb> {
-    let mut segs = gauss_kronrod::segments(breaks, !full && !half, !full);
+    let segs = &mut scratch.segs;
+    gauss_kronrod::segments_into(breaks, !full && !half, !full, &mut scratch.sorted, segs);
     segs.retain(keep);
     if segs.is_empty() {
         return gauss_kronrod::Integral {
@@ -345,7 +357,7 @@ fn arc_integral_where(
         };
     }
     let (tol, scale) = if half { (0.5 * tol, 2.0) } else { (tol, 1.0) };
-    let mut r = gauss_kronrod::integrate(f, &segs, tol, 0.0, panels, false);
+    let mut r = gauss_kronrod::integrate(f, segs, tol, 0.0, panels, false);
     r.value *= scale;
     r.error *= scale;
     r
@@ -821,6 +833,7 @@ fn reflected(
         && mirror_symmetric(brdf, wi, phi_i, false);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
+    let (mut br, mut scratch) = (Vec::new(), ArcScratch::default());
     let mut outer = |theta_h: f64| -> (Rgb, Rgb) {
         let psi = arc_half_width(cos_ti, sin_ti, theta_h);
         if psi <= 0.0 {
@@ -866,7 +879,8 @@ fn reflected(
         });
         let full = psi >= PI;
         let (lo, hi) = (if half { phi_i } else { phi_i - psi }, phi_i + psi);
-        let mut br = vec![lo, phi_i, hi];
+        br.clear();
+        br.extend([lo, phi_i, hi]);
         for &p in &fixed_phis {
             let p = wrap_near(p, phi_i);
             if p > lo && p < hi {
@@ -881,7 +895,15 @@ fn reflected(
             (wo.z > 0.0).then_some(wo)
         };
         kink_roots(&kinks, dir, cos_secant(phi_i), lo, hi, KINK_SCAN, &mut br);
-        let r = arc_integral(&mut inner, &br, full, half, inner_tol, opts.inner_panels);
+        let r = arc_integral(
+            &mut inner,
+            &br,
+            full,
+            half,
+            inner_tol,
+            opts.inner_panels,
+            &mut scratch,
+        );
         inner_evals += r.evaluations;
         (r.value, r.error)
     };
@@ -1013,8 +1035,12 @@ fn transmitted(
         && mirror_symmetric(brdf, wi, phi_i, true);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
+    let (mut br, mut scratch) = (Vec::new(), ArcScratch::default());
     let mut outer = |theta: f64| -> (Rgb, Rgb) {
-        let (st, ct) = theta.sin_cos();
+        // The ring's sine and cosine, once: for its arc, its cones, its
+        // directions (`at(theta, ·)` takes them from `sin_cos` too) and the
+        // Jacobian.
+        let (st, ct) = sin_cos(theta);
         // Half-width of the arc about ψ = 0 below the surface, where
         // cos θo = −cos θ cos β − sin θ sin β cos ψ < 0.
         let psi_max = if theta <= theta_full || sb * st <= 0.0 {
@@ -1038,15 +1064,13 @@ fn transmitted(
         if outside(lo, hi) {
             return (Rgb::ZERO, Rgb::ZERO);
         }
-        // `at(theta, ·)` with the ring's sine and cosine computed once (the
-        // same values: `at` takes them from `sin_cos` too).
-        let (st_r, ct_r) = sin_cos(theta);
-        let u = ct_r * p;
+        let u = ct * p;
         let on_ring = |psi: f64| {
             let (sp, cp) = sin_cos(psi);
-            u - st_r * (cp * e1 + sp * e2)
+            u - st * (cp * e1 + sp * e2)
         };
-        let mut br = vec![lo, 0.0, hi];
+        br.clear();
+        br.extend([lo, 0.0, hi]);
         for &(_, a) in &others {
             let a = wrap_near(a, 0.0);
             if a > lo && a < hi {
@@ -1114,6 +1138,7 @@ fn transmitted(
             inner_tol,
             opts.inner_panels,
             |s| !outside(s.a, s.b),
+            &mut scratch,
         );
         inner_evals += r.evaluations;
         (r.value, r.error)

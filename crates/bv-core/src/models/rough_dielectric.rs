@@ -191,7 +191,43 @@ pub fn beta(x: f64, y: f64) -> f64 {
     (libm::lgamma(x) + libm::lgamma(y) - libm::lgamma(x + y)).exp()
 }
 
+/// The microfacet that joins a pair ([`RoughDielectric::facet`]).
+struct Facet {
+    /// Its normal, towards +z.
+    h: DVec3,
+    /// Whether the pair lies on opposite sides.
+    transmits: bool,
+    /// `wi·h`.
+    ci: f64,
+    /// `wo·h`.
+    co: f64,
+}
+
+/// What `f(wi, ·)` needs of the incident direction alone: `wi` and its
+/// Smith Λ (many pairs share one `wi` in the albedo quadrature's panels).
+struct Incident {
+    wi: DVec3,
+    lambda: f64,
+}
+
 impl RoughDielectric {
+    /// What `f(wi, ·)` needs of `wi` alone.
+    fn incident(&self, wi: DVec3) -> Incident {
+        Incident {
+            wi,
+            lambda: self.lambda(wi),
+        }
+    }
+
+    /// [`Brdf::eval_with_half`] at `(inc.wi, wo)` with half vector `h`.
+    fn eval_with_half_from(&self, inc: &Incident, wo: DVec3, h: DVec3) -> Rgb {
+        if inc.wi.z > 0.0 && wo.z > 0.0 {
+            self.tint * self.reflection_from(inc, wo, h)
+        } else {
+            self.tint * self.eval_from(inc, wo)
+        }
+    }
+
     /// An interface with distribution `dist` of roughness (`ax`, `ay`),
     /// relative index `eta` (below over above), Smith term `geometry` and
     /// specular `tint`. Refuses `eta = 1` (no interface), non-positive or
@@ -258,7 +294,13 @@ impl RoughDielectric {
 
     /// The masking-shadowing term for the pair (`transmits`: opposite sides).
     fn g(&self, wi: DVec3, wo: DVec3, transmits: bool) -> f64 {
-        let (li, lo) = (self.lambda(wi), self.lambda(wo));
+        self.g_from(&self.incident(wi), wo, transmits)
+    }
+
+    /// [`RoughDielectric::g`] with `wi`'s Λ taken from `inc`.
+    fn g_from(&self, inc: &Incident, wo: DVec3, transmits: bool) -> f64 {
+        let li = inc.lambda;
+        let lo = self.lambda(wo);
         match (self.geometry, transmits) {
             (Geometry::Smith, _) => 1.0 / ((1.0 + li) * (1.0 + lo)),
             (Geometry::SmithCorrelated, false) => 1.0 / (1.0 + li + lo),
@@ -267,9 +309,10 @@ impl RoughDielectric {
     }
 
     /// The microfacet normal that scatters `wi` into `wo` (pointing to +z),
-    /// and whether the pair is a transmission; `None` when no facet does
-    /// (a direction at the horizon, a facet seen from its back side).
-    fn facet(&self, wi: DVec3, wo: DVec3) -> Option<(DVec3, bool)> {
+    /// whether the pair is a transmission, and the cosines `wi·h`, `wo·h`;
+    /// `None` when no facet does (a direction at the horizon, a facet seen
+    /// from its back side).
+    fn facet(&self, wi: DVec3, wo: DVec3) -> Option<Facet> {
         let (zi, zo) = (wi.z, wo.z);
         if zi == 0.0 || zo == 0.0 || !(zi.is_finite() && zo.is_finite()) {
             return None;
@@ -285,31 +328,51 @@ impl RoughDielectric {
         if !(l2 > 1e-300 && l2.is_finite()) {
             return None;
         }
-        let mut h = hu / l2.sqrt();
+        // One division, not three.
+        let mut h = hu * (1.0 / l2.sqrt());
         if h.z < 0.0 {
             h = -h;
         }
         // χ⁺: each direction sees the facet from its own side.
-        if h.z <= 0.0 || wi.dot(h) * zi <= 0.0 || wo.dot(h) * zo <= 0.0 {
+        let (ci, co) = (wi.dot(h), wo.dot(h));
+        if h.z <= 0.0 || ci * zi <= 0.0 || co * zo <= 0.0 {
             return None;
         }
-        Some((h, transmits))
+        Some(Facet {
+            h,
+            transmits,
+            ci,
+            co,
+        })
     }
 
     /// `f` without the tint (a scalar: the interface is grey).
     pub fn eval_scalar(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let Some((h, transmits)) = self.facet(wi, wo) else {
+        self.eval_from(&self.incident(wi), wo)
+    }
+
+    /// [`RoughDielectric::eval_scalar`] at `(inc.wi, wo)`, with what
+    /// depends on `wi` alone computed once per `inc` (the same values: the
+    /// same function of the same `wi`).
+    fn eval_from(&self, inc: &Incident, wo: DVec3) -> f64 {
+        let wi = inc.wi;
+        let Some(Facet {
+            h,
+            transmits,
+            ci,
+            co,
+        }) = self.facet(wi, wo)
+        else {
             return 0.0;
         };
         if !transmits {
-            return self.reflection_at(wi, wo, h);
+            return self.reflection_from(inc, wo, h);
         }
         let d = self.ndf.d(h);
         if d == 0.0 {
             return 0.0;
         }
-        let g = self.g(wi, wo, transmits);
-        let (ci, co) = (wi.dot(h), wo.dot(h));
+        let g = self.g_from(inc, wo, transmits);
         // Exact dielectric F for light arriving at the facet from wi's side
         // (a negative cosine: from inside, index 1/eta); 1 under TIR.
         let f = fresnel::dielectric(ci, self.eta);
@@ -327,6 +390,13 @@ impl RoughDielectric {
     /// this model and `coated`'s coat. 0 where a direction sees the facet
     /// from behind (χ⁺).
     pub(crate) fn reflection_at(&self, wi: DVec3, wo: DVec3, h: DVec3) -> f64 {
+        self.reflection_from(&self.incident(wi), wo, h)
+    }
+
+    /// [`RoughDielectric::reflection_at`] at `(inc.wi, wo)`, as
+    /// [`RoughDielectric::eval_from`] is to `eval_scalar`.
+    fn reflection_from(&self, inc: &Incident, wo: DVec3, h: DVec3) -> f64 {
+        let wi = inc.wi;
         let (ci, co) = (wi.dot(h), wo.dot(h));
         if !(h.z > 0.0 && ci * wi.z > 0.0 && co * wo.z > 0.0) {
             return 0.0;
@@ -335,7 +405,7 @@ impl RoughDielectric {
         if d == 0.0 {
             return 0.0;
         }
-        let g = self.g(wi, wo, false);
+        let g = self.g_from(inc, wo, false);
         // Exact dielectric F for light arriving at the facet from wi's side
         // (a negative cosine: from inside, index 1/eta); 1 under TIR.
         let f = fresnel::dielectric(ci, self.eta);
@@ -397,10 +467,22 @@ impl Brdf for RoughDielectric {
     }
 
     fn eval_with_half(&self, wi: DVec3, wo: DVec3, h: DVec3) -> Rgb {
-        if wi.z > 0.0 && wo.z > 0.0 {
-            self.tint * self.reflection_at(wi, wo, h)
-        } else {
-            self.eval(wi, wo)
+        self.eval_with_half_from(&self.incident(wi), wo, h)
+    }
+
+    // The albedo quadrature's panels: Λ(wi) (a square root and two
+    // divisions) once per panel rather than once per node.
+    fn eval_many(&self, wi: DVec3, wo: &[DVec3], out: &mut [Rgb]) {
+        let inc = self.incident(wi);
+        for (o, &w) in out.iter_mut().zip(wo) {
+            *o = self.tint * self.eval_from(&inc, w);
+        }
+    }
+
+    fn eval_many_with_half(&self, wi: DVec3, wo: &[DVec3], h: &[DVec3], out: &mut [Rgb]) {
+        let inc = self.incident(wi);
+        for ((o, &w), &hh) in out.iter_mut().zip(wo).zip(h) {
+            *o = self.eval_with_half_from(&inc, w, hh);
         }
     }
 
@@ -461,16 +543,21 @@ impl Brdf for RoughDielectric {
     }
 
     fn pdf(&self, wi: DVec3, wo: DVec3) -> f64 {
-        let Some((h, transmits)) = self.facet(wi, wo) else {
+        let Some(Facet {
+            h,
+            transmits,
+            ci,
+            co,
+        }) = self.facet(wi, wo)
+        else {
             return 0.0;
         };
         let pm = self.pdf_m(wi, h);
         let pr = self.p_reflect(wi);
-        let co = wo.dot(h);
         let p = if transmits {
             // Eq. 17: dωh/dωo = ηo² |wo·h| / (ηi wi·h + ηo wo·h)².
             let (ei, eo) = (self.eta_of(wi), self.eta_of(wo));
-            let den = ei * wi.dot(h) + eo * co;
+            let den = ei * ci + eo * co;
             (1.0 - pr) * pm * eo * eo * co.abs() / (den * den)
         } else {
             // Eq. 14: dωh/dωo = 1 / (4 |wo·h|).
