@@ -308,59 +308,72 @@ fn insert_break(breaks: &mut Vec<f64>, x: f64) {
     }
 }
 
-/// One inner (azimuthal) integral over the arc cut at `breaks`: graded at
-/// the arc's ends unless it is the `full` circle, and with `half` only the
-/// side from the plane of incidence, doubled (to half the tolerance).
-fn arc_integral(
-    f: &mut impl gauss_kronrod::Integrand<Rgb>,
-    breaks: &[f64],
-    full: bool,
-    half: bool,
+/// The inner (azimuthal) integrals of one part, ring after ring: their
+/// tolerance and panel budget, and the vectors each ring fills (its sorted
+/// breaks, its segments), kept from ring to ring (a ρhd curve integrates
+/// hundreds of rings per angle, each of which allocated them).
+struct Arcs {
     tol: f64,
     panels: usize,
-    scratch: &mut ArcScratch,
-) -> gauss_kronrod::Integral<Rgb> {
-    arc_integral_where(f, breaks, full, half, tol, panels, |_| true, scratch)
-}
-
-/// The vectors one ring's inner integral fills (its breaks, sorted, and
-/// its segments), kept from ring to ring: a ρhd curve integrates hundreds
-/// of rings per angle, each of which allocated them.
-#[derive(Default)]
-struct ArcScratch {
     sorted: Vec<f64>,
     segs: Vec<Segment>,
 }
 
-/// [`arc_integral`] over the segments between `breaks` that `keep` keeps
-/// (the others are known to be zero; each keeps the grading it has among
-/// all of them).
-fn arc_integral_where(
-    f: &mut impl gauss_kronrod::Integrand<Rgb>,
-    breaks: &[f64],
-    full: bool,
-    half: bool,
-    tol: f64,
-    panels: usize,
-    keep: impl Fn(&Segment) -> bool,
-    scratch: &mut ArcScratch,
-) -> gauss_kronrod::Integral<Rgb> {
-    let segs = &mut scratch.segs;
-    gauss_kronrod::segments_into(breaks, !full && !half, !full, &mut scratch.sorted, segs);
-    segs.retain(keep);
-    if segs.is_empty() {
-        return gauss_kronrod::Integral {
-            value: Rgb::ZERO,
-            error: Rgb::ZERO,
-            evaluations: 0,
-            converged: true,
-        };
+impl Arcs {
+    fn new(tol: f64, panels: usize) -> Self {
+        Self {
+            tol,
+            panels,
+            sorted: Vec::new(),
+            segs: Vec::new(),
+        }
     }
-    let (tol, scale) = if half { (0.5 * tol, 2.0) } else { (tol, 1.0) };
-    let mut r = gauss_kronrod::integrate(f, segs, tol, 0.0, panels, false);
-    r.value *= scale;
-    r.error *= scale;
-    r
+
+    /// One ring's integral over the arc cut at `breaks`: graded at the
+    /// arc's ends unless it is the `full` circle, and with `half` only the
+    /// side from the plane of incidence, doubled (to half the tolerance).
+    fn integral(
+        &mut self,
+        f: &mut impl gauss_kronrod::Integrand<Rgb>,
+        breaks: &[f64],
+        full: bool,
+        half: bool,
+    ) -> gauss_kronrod::Integral<Rgb> {
+        self.integral_where(f, breaks, full, half, |_| true)
+    }
+
+    /// [`Arcs::integral`] over the segments between `breaks` that `keep`
+    /// keeps (the others are known to be zero; each keeps the grading it
+    /// has among all of them).
+    fn integral_where(
+        &mut self,
+        f: &mut impl gauss_kronrod::Integrand<Rgb>,
+        breaks: &[f64],
+        full: bool,
+        half: bool,
+        keep: impl Fn(&Segment) -> bool,
+    ) -> gauss_kronrod::Integral<Rgb> {
+        let segs = &mut self.segs;
+        gauss_kronrod::segments_into(breaks, !full && !half, !full, &mut self.sorted, segs);
+        segs.retain(keep);
+        if segs.is_empty() {
+            return gauss_kronrod::Integral {
+                value: Rgb::ZERO,
+                error: Rgb::ZERO,
+                evaluations: 0,
+                converged: true,
+            };
+        }
+        let (tol, scale) = if half {
+            (0.5 * self.tol, 2.0)
+        } else {
+            (self.tol, 1.0)
+        };
+        let mut r = gauss_kronrod::integrate(f, segs, tol, 0.0, self.panels, false);
+        r.value *= scale;
+        r.error *= scale;
+        r
+    }
 }
 
 /// Whether azimuth `p` lies in the plane of incidence at azimuth `phi_i`
@@ -833,7 +846,7 @@ fn reflected(
         && mirror_symmetric(brdf, wi, phi_i, false);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
-    let (mut br, mut scratch) = (Vec::new(), ArcScratch::default());
+    let (mut br, mut arcs) = (Vec::new(), Arcs::new(inner_tol, opts.inner_panels));
     let mut outer = |theta_h: f64| -> (Rgb, Rgb) {
         let psi = arc_half_width(cos_ti, sin_ti, theta_h);
         if psi <= 0.0 {
@@ -895,15 +908,7 @@ fn reflected(
             (wo.z > 0.0).then_some(wo)
         };
         kink_roots(&kinks, dir, cos_secant(phi_i), lo, hi, KINK_SCAN, &mut br);
-        let r = arc_integral(
-            &mut inner,
-            &br,
-            full,
-            half,
-            inner_tol,
-            opts.inner_panels,
-            &mut scratch,
-        );
+        let r = arcs.integral(&mut inner, &br, full, half);
         inner_evals += r.evaluations;
         (r.value, r.error)
     };
@@ -1035,7 +1040,7 @@ fn transmitted(
         && mirror_symmetric(brdf, wi, phi_i, true);
     let inner_tol = 0.2 * opts.abs_tol / theta_end.max(1e-3);
     let mut inner_evals = 0usize;
-    let (mut br, mut scratch) = (Vec::new(), ArcScratch::default());
+    let (mut br, mut arcs) = (Vec::new(), Arcs::new(inner_tol, opts.inner_panels));
     let mut outer = |theta: f64| -> (Rgb, Rgb) {
         // The ring's sine and cosine, once: for its arc, its cones, its
         // directions (`at(theta, ·)` takes them from `sin_cos` too) and the
@@ -1130,16 +1135,7 @@ fn transmitted(
                 }
             }
         });
-        let r = arc_integral_where(
-            &mut inner,
-            &br,
-            full,
-            half,
-            inner_tol,
-            opts.inner_panels,
-            |s| !outside(s.a, s.b),
-            &mut scratch,
-        );
+        let r = arcs.integral_where(&mut inner, &br, full, half, |s| !outside(s.a, s.b));
         inner_evals += r.evaluations;
         (r.value, r.error)
     };
