@@ -1443,11 +1443,13 @@ mod tests {
         // `eval_many_with_half` per panel; a model that overrides them must
         // return what `eval` and `eval_with_half` return, bit for bit (the
         // curves' values and errors were compared so when the calls were
-        // batched). Every catalogue model at its defaults, pairs on the
-        // whole sphere (the transmitted part's below the surface).
+        // batched). Every catalogue model at its defaults, and the rough
+        // dielectric (which overrides both) in each of its distributions and
+        // geometries, turned and seen from below; pairs on the whole sphere
+        // (the transmitted part's below the surface).
         let mut rng = crate::sampling::rng(7);
         let mut sphere = || sphere_dir(&mut rng);
-        for (id, b) in catalogue_at_defaults() {
+        for (id, b) in transmitting_models() {
             for _ in 0..8 {
                 let wi = sphere();
                 let wos: Vec<DVec3> = (0..15).map(|_| sphere()).collect();

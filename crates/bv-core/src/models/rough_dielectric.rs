@@ -185,10 +185,15 @@ fn build(p: &Params) -> Result<Box<dyn Brdf>> {
 /// `B(x, y) = Γ(x) Γ(y) / Γ(x + y)` for `x, y ≥ 1`, through `ln Γ`
 /// (0 when either argument is infinite: Λ at the horizon).
 pub fn beta(x: f64, y: f64) -> f64 {
+    beta_with(x, libm::lgamma(x), y)
+}
+
+/// [`beta`] with `ln Γ(x)` given (the same for every pair that shares ωi).
+fn beta_with(x: f64, lgamma_x: f64, y: f64) -> f64 {
     if !(x.is_finite() && y.is_finite()) {
         return 0.0;
     }
-    (libm::lgamma(x) + libm::lgamma(y) - libm::lgamma(x + y)).exp()
+    (lgamma_x + libm::lgamma(y) - libm::lgamma(x + y)).exp()
 }
 
 /// The microfacet that joins a pair ([`RoughDielectric::facet`]).
@@ -203,20 +208,26 @@ struct Facet {
     co: f64,
 }
 
-/// What `f(wi, ·)` needs of the incident direction alone: `wi` and its
-/// Smith Λ (many pairs share one `wi` in the albedo quadrature's panels).
+/// What `f(wi, ·)` needs of the incident direction alone: `wi`, its
+/// Smith Λ and, for the height-correlated term, `ln Γ(1 + Λ)` (many pairs
+/// share one `wi` in the albedo quadrature's panels).
 struct Incident {
     wi: DVec3,
     lambda: f64,
+    /// `ln Γ(1 + Λ)` with [`Geometry::SmithCorrelated`]; NaN (unused)
+    /// otherwise.
+    lgamma: f64,
 }
 
 impl RoughDielectric {
     /// What `f(wi, ·)` needs of `wi` alone.
     fn incident(&self, wi: DVec3) -> Incident {
-        Incident {
-            wi,
-            lambda: self.lambda(wi),
-        }
+        let lambda = self.lambda(wi);
+        let lgamma = match self.geometry {
+            Geometry::SmithCorrelated => libm::lgamma(1.0 + lambda),
+            Geometry::Smith => f64::NAN,
+        };
+        Incident { wi, lambda, lgamma }
     }
 
     /// [`Brdf::eval_with_half`] at `(inc.wi, wo)` with half vector `h`.
@@ -304,7 +315,7 @@ impl RoughDielectric {
         match (self.geometry, transmits) {
             (Geometry::Smith, _) => 1.0 / ((1.0 + li) * (1.0 + lo)),
             (Geometry::SmithCorrelated, false) => 1.0 / (1.0 + li + lo),
-            (Geometry::SmithCorrelated, true) => beta(1.0 + li, 1.0 + lo),
+            (Geometry::SmithCorrelated, true) => beta_with(1.0 + li, inc.lgamma, 1.0 + lo),
         }
     }
 
@@ -1061,13 +1072,18 @@ mod tests {
     // the anisotropic exponent), G1 from Walter's eqs. 25/27 (Beckmann, erf)
     // and 34 (GGX), F from Walter's eq. 22 (Cook & Torrance's form, not the
     // r∥/r⊥ form of `fresnel::dielectric`), h from eqs. 13 and 16, f from
-    // eqs. 20 and 21.
+    // eqs. 20 and 21. With `correlated`, Heitz 2014's height-correlated
+    // terms instead of G1·G1 (eq. 99 in reflection; in transmission the
+    // integral over the height CDF u of u^Λi (1 − u)^Λo, which is
+    // B(1 + Λi, 1 + Λo), here from Γ itself rather than the model's ln Γ),
+    // with Λ = 1/G1 − 1 from the G1 above.
 
     struct Walter {
         ggx: bool,
         ax: f64,
         ay: f64,
         eta: f64,
+        correlated: bool,
     }
 
     impl Walter {
@@ -1146,7 +1162,21 @@ mod tests {
             if i.dot(m) / i.z <= 0.0 || o.dot(m) / o.z <= 0.0 {
                 return 0.0;
             }
-            let (d, g, f) = (self.d(m), self.g1(i) * self.g1(o), self.fresnel(i, m));
+            let (gi, go) = (self.g1(i), self.g1(o));
+            let g = if !self.correlated {
+                gi * go
+            } else {
+                let (x, y) = (1.0 / gi, 1.0 / go);
+                if reflect {
+                    1.0 / (x + y - 1.0)
+                } else if x + y < 170.0 {
+                    libm::tgamma(x) * libm::tgamma(y) / libm::tgamma(x + y)
+                } else {
+                    // Γ overflows; such grazing pairs are left out.
+                    return f64::NAN;
+                }
+            };
+            let (d, f) = (self.d(m), self.fresnel(i, m));
             if reflect {
                 f * d * g / (4.0 * i.z.abs() * o.z.abs())
             } else {
@@ -1181,31 +1211,46 @@ mod tests {
 
     #[test]
     fn matches_walters_formulas_on_the_whole_sphere() {
-        let mut nonzero = [0usize; 2];
-        for ggx in [true, false] {
+        let mut nonzero = [[0usize; 2]; 2];
+        for (ggx, correlated) in [(true, false), (false, false), (true, true), (false, true)] {
             for eta in [1.5, 0.6, 1.01, 2.4, 0.2] {
                 for (ax, ay) in [(0.05, 0.05), (0.3, 0.3), (1.2, 1.2), (0.1, 0.6)] {
-                    let r = Walter { ggx, ax, ay, eta };
+                    let r = Walter {
+                        ggx,
+                        ax,
+                        ay,
+                        eta,
+                        correlated,
+                    };
+                    let geometry = if correlated {
+                        "smith-correlated"
+                    } else {
+                        "smith"
+                    };
                     let b = model(json!({"distribution": if ggx {"ggx"} else {"beckmann"},
-                        "alpha_x": ax, "alpha_y": ay, "eta": eta, "geometry": "smith"}));
+                        "alpha_x": ax, "alpha_y": ay, "eta": eta, "geometry": geometry}));
                     for (wi, wo) in sphere_pairs(eta, ax, 400, 7) {
                         let want = r.f(wi, wo);
+                        if want.is_nan() {
+                            continue;
+                        }
                         let got = b.eval(wi, wo);
                         assert!(
                             (got.x - want).abs() <= 1e-9 * want.abs() + 1e-300,
-                            "ggx {ggx} η {eta} α {ax},{ay}: f({wi}, {wo}) = {} vs {want}",
+                            "ggx {ggx} {geometry} η {eta} α {ax},{ay}: f({wi}, {wo}) = {} vs {want}",
                             got.x
                         );
                         assert_eq!(got.x, got.y);
                         if want > 0.0 {
-                            nonzero[usize::from((wi.z > 0.0) != (wo.z > 0.0))] += 1;
+                            let transmits = (wi.z > 0.0) != (wo.z > 0.0);
+                            nonzero[usize::from(correlated)][usize::from(transmits)] += 1;
                         }
                     }
                 }
             }
         }
-        // Both lobes were really exercised.
-        assert!(nonzero[0] > 2000 && nonzero[1] > 2000, "{nonzero:?}");
+        // Both lobes were really exercised, with each Smith term.
+        assert!(nonzero.iter().flatten().all(|&n| n > 2000), "{nonzero:?}");
     }
 
     #[test]
