@@ -225,6 +225,8 @@ impl WebApp {
                 bench: None,
                 shot: None,
                 outcome: Arc::new(Mutex::new(None)),
+                // The page's canvas takes the size the page gives it.
+                resize: None,
             },
             hash,
             message,
