@@ -214,20 +214,20 @@ struct Facet {
 struct Incident {
     wi: DVec3,
     lambda: f64,
-    /// `ln Γ(1 + Λ)` with [`Geometry::SmithCorrelated`]; NaN (unused)
-    /// otherwise.
-    lgamma: f64,
+    /// `ln Γ(1 + Λ)`, once a transmitted pair with the height-correlated
+    /// term has needed it (no other pair does, and it costs more than the
+    /// rest of `wi`'s work).
+    lgamma: std::cell::OnceCell<f64>,
 }
 
 impl RoughDielectric {
     /// What `f(wi, ·)` needs of `wi` alone.
     fn incident(&self, wi: DVec3) -> Incident {
-        let lambda = self.lambda(wi);
-        let lgamma = match self.geometry {
-            Geometry::SmithCorrelated => libm::lgamma(1.0 + lambda),
-            Geometry::Smith => f64::NAN,
-        };
-        Incident { wi, lambda, lgamma }
+        Incident {
+            wi,
+            lambda: self.lambda(wi),
+            lgamma: std::cell::OnceCell::new(),
+        }
     }
 
     /// [`Brdf::eval_with_half`] at `(inc.wi, wo)` with half vector `h`.
@@ -315,7 +315,10 @@ impl RoughDielectric {
         match (self.geometry, transmits) {
             (Geometry::Smith, _) => 1.0 / ((1.0 + li) * (1.0 + lo)),
             (Geometry::SmithCorrelated, false) => 1.0 / (1.0 + li + lo),
-            (Geometry::SmithCorrelated, true) => beta_with(1.0 + li, inc.lgamma, 1.0 + lo),
+            (Geometry::SmithCorrelated, true) => {
+                let lgamma_i = *inc.lgamma.get_or_init(|| libm::lgamma(1.0 + li));
+                beta_with(1.0 + li, lgamma_i, 1.0 + lo)
+            }
         }
     }
 
