@@ -240,11 +240,10 @@ pub fn run(args: &ViewerArgs) -> anyhow::Result<()> {
                 outcome: outcome2,
             };
             app.viewer.panels_on_clear = true;
-            if app.bench.is_some() {
-                app.viewer.force_interacting = true;
-                if let Ok(v) = std::env::var("BV_BENCH_MAXIMISE") {
-                    app.viewer.push(Command::Maximise(Some(v)));
-                }
+            if app.bench.is_some()
+                && let Ok(v) = std::env::var("BV_BENCH_MAXIMISE")
+            {
+                app.viewer.push(Command::Maximise(Some(v)));
             }
             Ok(Box::new(app))
         }),
@@ -298,7 +297,13 @@ impl eframe::App for BvApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
         }
         if let Some(b) = &mut self.bench {
-            if b.settling(self.viewer.views_busy()) {
+            let settling = b.settling(&self.viewer.busy_views());
+            // At rest while the views settle, as a window is before a user
+            // takes a slider; dragging from the sweep's first frame. (Forced
+            // from the start, the environment view took one sample a frame
+            // and never finished on a CPU rasteriser: the wait ran out.)
+            self.viewer.force_interacting = !settling;
+            if settling {
                 // Let progressive views finish (as they have when a user
                 // starts dragging) before the sweep is timed.
                 self.viewer.ui(ui);
@@ -371,6 +376,9 @@ struct Bench {
     idle_frames: usize,
     /// How long the views took to settle, once they have.
     settled_after: Option<Duration>,
+    /// The views still at work when [`Self::MAX_SETTLE`] ran out (the
+    /// sweep's frames then include their work: the report names them).
+    unsettled: Vec<&'static str>,
 }
 
 impl Bench {
@@ -389,6 +397,7 @@ impl Bench {
             settle_start: None,
             idle_frames: 0,
             settled_after: None,
+            unsettled: Vec::new(),
         }
     }
 
@@ -403,16 +412,23 @@ impl Bench {
     /// accumulating its samples, a renderer compiling) finish first, for at
     /// most [`Self::MAX_SETTLE`]. Without this the first frames time the
     /// environment view converging, which is no part of a slider drag.
-    fn settling(&mut self, busy: bool) -> bool {
+    fn settling(&mut self, busy: &[&'static str]) -> bool {
         if self.settled_after.is_some() {
             return false;
         }
         let start = *self.settle_start.get_or_insert_with(Instant::now);
-        self.idle_frames = if busy { 0 } else { self.idle_frames + 1 };
+        self.idle_frames = if busy.is_empty() {
+            self.idle_frames + 1
+        } else {
+            0
+        };
         if self.idle_frames < Self::IDLE_FRAMES && start.elapsed() < Self::MAX_SETTLE {
             return true;
         }
         self.settled_after = Some(start.elapsed());
+        if self.idle_frames < Self::IDLE_FRAMES {
+            self.unsettled = busy.to_vec();
+        }
         false
     }
 
@@ -482,8 +498,13 @@ impl Bench {
     }
 
     fn report(&self) -> String {
+        let still = if self.unsettled.is_empty() {
+            String::new()
+        } else {
+            format!("; still at work: {}", self.unsettled.join(", "))
+        };
         format!(
-            "bench: {} frames sweeping {} on {} (after {:.1} s of views settling): frame time p50 {:.2} ms, \
+            "bench: {} frames sweeping {} on {} (after {:.1} s of views settling{still}): frame time p50 {:.2} ms, \
              p95 {:.2} ms ({:.1} fps median); app ui (incl. mesh rebuild) p50 {:.2} ms, p95 {:.2} ms",
             self.intervals.len(),
             self.what,
@@ -613,6 +634,40 @@ mod tests {
             ..Default::default()
         };
         assert!(initial_state(&bad, None).is_err());
+    }
+
+    #[test]
+    fn the_bench_report_names_views_still_at_work_when_the_wait_runs_out() {
+        // Idle views settle after IDLE_FRAMES frames; the report names none.
+        let mut b = Bench::new(10, "test".into());
+        let mut frames = 0;
+        while b.settling(&[]) {
+            frames += 1;
+            assert!(frames < 100, "idle views never settled");
+        }
+        assert_eq!(frames, Bench::IDLE_FRAMES - 1);
+        assert!(!b.report().contains("still at work"), "{}", b.report());
+
+        // A view busy until the wait runs out is named, once the wait is over.
+        let mut b = Bench::new(10, "test".into());
+        assert!(b.settling(&["environment"]));
+        let Some(long_ago) = Instant::now().checked_sub(Bench::MAX_SETTLE) else {
+            return; // a clock this close to its epoch cannot go back 60 s
+        };
+        b.settle_start = Some(long_ago);
+        assert!(!b.settling(&["environment", "lit-sphere"]));
+        assert!(
+            b.report()
+                .contains("still at work: environment, lit-sphere"),
+            "{}",
+            b.report()
+        );
+        // A view that went idle just before the wait ran out is not named.
+        let mut b = Bench::new(10, "test".into());
+        assert!(b.settling(&[]));
+        b.settle_start = Some(long_ago);
+        assert!(!b.settling(&[]));
+        assert!(!b.report().contains("still at work"), "{}", b.report());
     }
 
     #[test]

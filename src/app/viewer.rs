@@ -424,13 +424,23 @@ impl Viewer {
     /// (building its renderer, or the environment view sampling towards its
     /// target): screenshots wait for them.
     pub fn views_busy(&self) -> bool {
+        !self.busy_views().is_empty()
+    }
+
+    /// The ids of the shown views whose last frame left work to do (in the
+    /// layout's order): what [`Self::views_busy`] waits for, named.
+    pub fn busy_views(&self) -> Vec<&'static str> {
         // A view is hidden by another one being maximised, or by being
         // outside the overview grid.
         let shown = |e: &ViewEntry| match self.ws.state.maximised.as_deref() {
             Some(m) => m == e.id,
             None => e.in_grid,
         };
-        self.views.iter().any(|(e, v)| shown(e) && v.busy())
+        self.views
+            .iter()
+            .filter(|(e, v)| shown(e) && v.busy())
+            .map(|(e, _)| e.id)
+            .collect()
     }
 
     /// Whether the help overlay is open.

@@ -23,11 +23,11 @@ pub struct ViewerArgs {
     #[arg(long)]
     pub fresh: bool,
 
-    /// Benchmark: once the views have settled (the environment view
-    /// converged, renderers built; at most 60 s), drive a scripted slider
-    /// sweep of the selected BRDF for N frames, print the frame-time p50/p95
-    /// and exit. (Set BV_BENCH_MAXIMISE=lobe|polar|cartesian to time one view
-    /// alone.)
+    /// Benchmark: once the views have settled at rest (the environment view
+    /// converged, renderers built; at most 60 s, after which the report names
+    /// the views still at work), drive a scripted slider drag of the selected
+    /// BRDF for N frames, print the frame-time p50/p95 and exit. (Set
+    /// BV_BENCH_MAXIMISE=lobe|polar|cartesian to time one view alone.)
     #[arg(long, value_name = "N")]
     pub bench_frames: Option<usize>,
 
