@@ -297,7 +297,9 @@ impl eframe::App for BvApp {
             ctx.send_viewport_cmd(egui::ViewportCommand::InnerSize(size));
         }
         if let Some(b) = &mut self.bench {
-            let settling = b.settling(&self.viewer.busy_views());
+            // The busy views are asked for only while the wait lasts, not on
+            // every timed frame of the sweep.
+            let settling = b.settled_after.is_none() && b.settling(&self.viewer.busy_views());
             // At rest while the views settle, as a window is before a user
             // takes a slider; dragging from the sweep's first frame. (Forced
             // from the start, the environment view took one sample a frame

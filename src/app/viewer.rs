@@ -424,23 +424,28 @@ impl Viewer {
     /// (building its renderer, or the environment view sampling towards its
     /// target): screenshots wait for them.
     pub fn views_busy(&self) -> bool {
-        !self.busy_views().is_empty()
+        self.shown_busy().next().is_some()
     }
 
     /// The ids of the shown views whose last frame left work to do (in the
     /// layout's order): what [`Self::views_busy`] waits for, named.
     pub fn busy_views(&self) -> Vec<&'static str> {
+        self.shown_busy().collect()
+    }
+
+    /// The shown views at work, lazily (so that [`Self::views_busy`], asked
+    /// every frame of a screenshot's wait, allocates nothing).
+    fn shown_busy(&self) -> impl Iterator<Item = &'static str> + '_ {
         // A view is hidden by another one being maximised, or by being
         // outside the overview grid.
-        let shown = |e: &ViewEntry| match self.ws.state.maximised.as_deref() {
-            Some(m) => m == e.id,
-            None => e.in_grid,
-        };
+        let maximised = self.ws.state.maximised.as_deref();
         self.views
             .iter()
-            .filter(|(e, v)| shown(e) && v.busy())
+            .filter(move |(e, v)| match maximised {
+                Some(m) => m == e.id,
+                None => e.in_grid,
+            } && v.busy())
             .map(|(e, _)| e.id)
-            .collect()
     }
 
     /// Whether the help overlay is open.
