@@ -4,8 +4,8 @@
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-#[path = "support/rgl_files.rs"]
-mod rgl_files;
+// The suite's one copy of tests/support/rgl_files.rs.
+use super::rgl_files;
 
 use bv::gpu::sphere::sphere_at;
 use bv::gpu::{EnvRenderer, EnvSettings, EnvironmentMap, gpu_for_test, shaders::ShaderLibrary};

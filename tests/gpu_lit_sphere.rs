@@ -36,7 +36,7 @@ fn compare(
 ) {
     let gpu = r.render_image(models, settings, w, h).unwrap();
     if let Ok(dir) = std::env::var("BV_TEST_IMAGES") {
-        // For a look by eye: BV_TEST_IMAGES=/tmp cargo test --test gpu_lit_sphere
+        // For a look by eye: BV_TEST_IMAGES=/tmp cargo test --test suite gpu_lit_sphere::
         let name: Vec<&str> = models.iter().map(|m| m.id()).collect();
         gpu.save(format!("{dir}/lit_sphere_{}_{w}x{h}.png", name.join("+")))
             .unwrap();

@@ -8,7 +8,7 @@
 //! every choice parameter, and compared with bv-core's f64 `eval` on the same
 //! inputs. The test fails when any channel of any pair is off by more than
 //! `1e-4 + 1e-3 |f|` (absolute + relative), and prints the worst case per model
-//! (`cargo test --test gpu_parity -- --nocapture`).
+//! (`cargo test --test suite gpu_parity:: -- --nocapture`).
 //!
 //! Inputs: each direction is the f32 vector nearest to unit length near the rounded
 //! f64 unit vector (| |w|² − 1 | ~1e-9 instead of ~1e-7), and bv-core gets exactly those f32 values. An f32 cannot hold a unit
@@ -26,8 +26,8 @@
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-#[path = "support/rgl_files.rs"]
-mod rgl_files;
+// The suite's one copy of tests/support/rgl_files.rs.
+use super::rgl_files;
 
 use bv::gpu::{GpuEvaluator, gpu_for_test, shaders::ShaderLibrary};
 use bv_core::measured::merl;

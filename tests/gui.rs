@@ -5,7 +5,7 @@
 //!
 //! The `snapshot_*` and `headless_*` tests render on the GPU (lavapipe on
 //! machines without one) and compare small images with `tests/snapshots/`.
-//! Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p bv --test gui`.
+//! Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p bv --test suite gui::`.
 
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -836,7 +836,7 @@ fn smoothing_only_the_content_changes_no_pixel() {
 }
 
 /// Timing of the offscreen lobe pass alone (not a pass/fail test: run with
-/// `cargo test --release --test gui -- --ignored --nocapture lobe_pass_timing`).
+/// `cargo test --release --test suite -- --ignored --nocapture gui::lobe_pass_timing`).
 #[test]
 #[ignore]
 fn lobe_pass_timing() {
@@ -926,7 +926,7 @@ fn shift_drag_on_the_lobe_moves_the_light() {
 
 /// Renders the whole window in a few states into `$BV_RENDER_DIR` (default
 /// `out/gui-states`) for a human to look at; not a pass/fail test. Run with
-/// `cargo test --test gui -- --ignored render_window_states`.
+/// `cargo test --test suite -- --ignored gui::render_window_states`.
 #[test]
 #[ignore]
 fn render_window_states() {

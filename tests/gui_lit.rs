@@ -2,7 +2,7 @@
 //! on machines without one): the lit sphere follows the sliders and the light
 //! drag, the environment view accumulates samples across frames and restarts
 //! on a change, errors show in the view, and small snapshots of both.
-//! Regenerate the snapshots with `UPDATE_SNAPSHOTS=1 cargo test --test gui_lit`.
+//! Regenerate the snapshots with `UPDATE_SNAPSHOTS=1 cargo test --test suite gui_lit::`.
 
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -518,7 +518,7 @@ fn snapshot_environment() {
 }
 
 /// Throughput of the renderers at GUI sizes on this machine's adapter (not a
-/// pass/fail test: `cargo test --test gui_lit -- --ignored --nocapture timing`;
+/// pass/fail test: `cargo test --test suite -- --ignored --nocapture gui_lit::timing`;
 /// the GPU work is the driver's, so a debug build measures the same).
 #[test]
 #[ignore]

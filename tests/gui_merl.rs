@@ -7,7 +7,7 @@
 //!
 //! `snapshot_image_slice` renders on the GPU (lavapipe without one) and
 //! compares with `tests/snapshots/image_slice_cook_torrance.png`
-//! (regenerate with `UPDATE_SNAPSHOTS=1 cargo test --test gui_merl`).
+//! (regenerate with `UPDATE_SNAPSHOTS=1 cargo test --test suite gui_merl::`).
 
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -434,7 +434,7 @@ fn snapshot_image_slice() {
 }
 
 /// Timings for the record (not a pass/fail test; machines are noisy):
-/// `cargo test --release --test gui_merl timings -- --ignored --nocapture`.
+/// `cargo test --release --test suite gui_merl::timings -- --ignored --nocapture`.
 /// A public-size table read through the GUI's background loader, a 256 × 256
 /// image slice of the analytic model and of its table, and the SH projection
 /// at L = 16 of both.

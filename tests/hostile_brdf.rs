@@ -25,7 +25,7 @@ fn corpus(name: &str) -> PathBuf {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bv-hostile-{}-{name}", std::process::id()));
+    let d = std::env::temp_dir().join(format!("bv-hostile-brdf-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d

@@ -14,7 +14,7 @@ use std::process::{Command, Output};
 const BV: &str = env!("CARGO_BIN_EXE_bv");
 
 fn dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bv-hostile-{}-{tag}", std::process::id()));
+    let d = std::env::temp_dir().join(format!("bv-hostile-files-{}-{tag}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -148,8 +148,14 @@ fn a_killed_save_leaves_a_temporary_the_next_save_removes() {
     let o = bv(&["scene", "new", "--model", "lambert", "--out", s(&target)]);
     assert!(o.status.success(), "{}", stderr(&o));
     let old = std::fs::read(&target).unwrap();
+    // The child test's name as libtest knows it: its module path without
+    // the crate's name (`hostile_files::killed_writer_child` in the suite).
+    let child_test = match module_path!().split_once("::") {
+        Some((_, module)) => format!("{module}::killed_writer_child"),
+        None => "killed_writer_child".to_string(),
+    };
     let mut child = Command::new(std::env::current_exe().unwrap())
-        .args(["--exact", "killed_writer_child", "--nocapture"])
+        .args(["--exact", &child_test, "--nocapture"])
         .env("BV_HOSTILE_WRITER", &target)
         .spawn()
         .unwrap();

@@ -459,3 +459,64 @@ fn derive_files_form_no_cycle() {
         c.join("\n")
     );
 }
+
+/// The files of `tests/` that no test binary compiles: not a `mod` of
+/// `tests/suite.rs` and not the `path` of a `[[test]]` in Cargo.toml (the
+/// package sets `autotests = false`, so cargo would skip such a file
+/// silently). `files` are the names of `tests/*.rs`.
+fn tests_left_out(files: &[String], suite: &str, manifest: &str) -> Vec<String> {
+    let suite = without_comments(suite);
+    let mods: BTreeSet<&str> = suite
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mod ")?.strip_suffix(';'))
+        .map(str::trim)
+        .collect();
+    let targets: BTreeSet<&str> = manifest
+        .lines()
+        .filter_map(|l| {
+            let (key, value) = l.split_once('=')?;
+            (key.trim() == "path").then(|| value.trim().trim_matches('"'))
+        })
+        .filter_map(|p| p.strip_prefix("tests/")?.strip_suffix(".rs"))
+        .collect();
+    files
+        .iter()
+        .filter(|f| !mods.contains(f.as_str()) && !targets.contains(f.as_str()))
+        .cloned()
+        .collect()
+}
+
+#[test]
+fn the_left_out_test_finder_finds_them() {
+    let files: Vec<String> = ["suite", "a", "b", "c"].map(String::from).to_vec();
+    let suite = "//! mod c;\nmod a;\n";
+    let manifest = "[[test]]\nname = \"suite\"\npath = \"tests/suite.rs\"\n\
+                    [[bin]]\npath = \"src/b.rs\"\n";
+    assert_eq!(tests_left_out(&files, suite, manifest), ["b", "c"]);
+    let manifest = format!("{manifest}[[test]]\nname = \"b\"\npath = \"tests/b.rs\"\n");
+    assert_eq!(
+        tests_left_out(&files, "mod a;\nmod c;\n", &manifest),
+        Vec::<String>::new()
+    );
+}
+
+#[test]
+fn every_test_file_is_compiled() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files: Vec<String> = std::fs::read_dir(root.join("tests"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "rs"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    files.sort();
+    assert!(files.len() > 10, "{files:?}");
+    let suite = std::fs::read_to_string(root.join("tests/suite.rs")).unwrap();
+    let manifest = std::fs::read_to_string(root.join("Cargo.toml")).unwrap();
+    let left_out = tests_left_out(&files, &suite, &manifest);
+    assert!(
+        left_out.is_empty(),
+        "tests/{{{}}}.rs: not a `mod` of tests/suite.rs nor a [[test]] in Cargo.toml, so no test binary compiles them",
+        left_out.join(",")
+    );
+}

@@ -5,7 +5,7 @@
 //! `bv render --deck` is tested as the binary in `render_deck.rs`.
 //!
 //! Regenerate the snapshot with
-//! `UPDATE_SNAPSHOTS=1 cargo test -p bv --test presentation`.
+//! `UPDATE_SNAPSHOTS=1 cargo test -p bv --test suite presentation::`.
 
 // Test and benchmark code: a panic is how a failure is reported.
 #![allow(clippy::unwrap_used, clippy::expect_used)]

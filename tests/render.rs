@@ -7,7 +7,7 @@
 //! and an image passes when at most [`MAX_DIFFERING`] of its pixels differ
 //! (about 2 %, room for another Mesa version's rasterisation and font
 //! hinting; a wrong curve, colour or layout changes far more). Regenerate
-//! with `UPDATE_SNAPSHOTS=1 cargo test --test render`; a missing or failing
+//! with `UPDATE_SNAPSHOTS=1 cargo test --test suite render::`; a missing or failing
 //! snapshot writes `<name>.new.png` beside it.
 
 // Test and benchmark code: a panic is how a failure is reported.

@@ -1,5 +1,6 @@
-//! RGL test files shared by the GPU tests (`gpu_parity`, `gpu_env`) and
-//! bv-core's `tests/rgl.rs` (which includes this file by path).
+//! RGL test files shared by the GPU tests (`gpu_parity`, `gpu_env`, through
+//! the suite's one module) and bv-core's `tests/rgl.rs` (both include this
+//! file by path).
 
 // Each test crate that includes this module uses part of it.
 #![allow(dead_code)]
