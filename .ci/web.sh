@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The browser build's check: installs what a fresh Debian machine lacks
 # (chromium, Node.js and npm; the wasm32 target and wasm-bindgen-cli come
-# with web/build.sh), builds the bundle in the dev profile (quicker to build;
-# the page is the same), installs the pinned test driver and runs the
+# with web/build.sh, the latter at opt-level 1 here), builds the bundle in
+# the web-ci profile (the dev profile, lighter still: see Cargo.toml; the
+# page is the same), installs the pinned test driver and runs the
 # headless-browser test. Screenshots are left in web/shots for a human.
 #
 #   bash .ci/web.sh
@@ -21,7 +22,7 @@ command -v node >/dev/null 2>&1 || web_packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || web_packages+=(npm)
 bv_apt_install "${web_packages[@]}"
 bv_ensure_rust
-BV_WEB_PROFILE=${BV_WEB_PROFILE:-dev} bash web/build.sh
+BV_WEB_PROFILE=${BV_WEB_PROFILE:-web-ci} BV_BINDGEN_OPT_LEVEL=${BV_BINDGEN_OPT_LEVEL:-1} bash web/build.sh
 npm ci --prefix web --no-audit --no-fund
 # Chromium and Mesa want a private runtime directory (see .ci/run).
 if [ -z "${XDG_RUNTIME_DIR:-}" ]; then

@@ -5,13 +5,16 @@
 # http://localhost:PORT/ (default 8080) until interrupted.
 #
 #   bash web/build.sh                 # release build (smaller, faster page)
-#   BV_WEB_PROFILE=dev bash web/build.sh   # quicker to build (CI)
+#   BV_WEB_PROFILE=dev bash web/build.sh   # quicker to build
+#   BV_WEB_PROFILE=web-ci bash web/build.sh   # quicker still (CI, Cargo.toml)
 #   bash web/build.sh --serve 8080
 #
 # The bundler is wasm-bindgen-cli at exactly the version of the
 # `wasm-bindgen` crate in Cargo.lock (the two must match); it is installed
-# with `cargo install` when missing. (trunk would do the same and more, but
-# building it from source costs several times as long on a small CI machine.)
+# with `cargo install` when missing, optimised at BV_BINDGEN_OPT_LEVEL
+# (default 3, release's; CI takes 1, quicker to build). (trunk would do the
+# same and more, but building it from source costs several times as long on
+# a small CI machine.)
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -39,7 +42,8 @@ want=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/[^0-9.]/, "", $0); print;
 have=$(wasm-bindgen --version 2>/dev/null | awk '{ print $2 }' || true)
 if [ "$have" != "$want" ]; then
     log "cargo install wasm-bindgen-cli $want (found: ${have:-none})"
-    cargo install wasm-bindgen-cli --version "$want"
+    CARGO_PROFILE_RELEASE_OPT_LEVEL=${BV_BINDGEN_OPT_LEVEL:-3} \
+        cargo install wasm-bindgen-cli --version "$want"
 fi
 
 case "$profile" in

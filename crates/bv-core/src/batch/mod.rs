@@ -241,15 +241,75 @@ pub fn run<K: LaneKernel>(k: &K, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
     match isa {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `is_available` saw AVX-512F, AVX2 and FMA on this CPU.
-        Isa::Avx512 => unsafe { x86::run_avx512(k, dirs, out) },
+        Isa::Avx512 => unsafe { k.run_avx512(dirs, out) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: `is_available` saw AVX2 and FMA on this CPU.
-        Isa::Avx2 => unsafe { x86::run_avx2(k, dirs, out) },
+        Isa::Avx2 => unsafe { k.run_avx2(dirs, out) },
         #[cfg(target_arch = "aarch64")]
-        Isa::Neon => neon::run_neon(k, dirs, out),
+        Isa::Neon => k.run_neon(dirs, out),
         #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
-        Isa::Simd128 => wasm::run_simd128(k, dirs, out),
+        Isa::Simd128 => k.run_simd128(dirs, out),
         _ => lanes_loop::<f32, K>(k, dirs, out),
+    }
+}
+
+/// Each instruction set's copy of a [`LaneKernel`]'s loop, as methods of
+/// the kernel's own type rather than generic functions of the
+/// architecture's module.
+///
+/// Why methods: rustc puts the monomorphised copies of a generic *function*
+/// in the codegen unit of the module that defines it, but those of a
+/// *method* in the unit of its `Self` type's module. As functions of
+/// `batch::x86`, every model's AVX2 and AVX-512 loop (244 copies, each with
+/// its kernel inlined) was one codegen unit, a 62 MB object that LLVM
+/// optimised on one core for minutes of every build of the core. As
+/// methods they land with their models (`models::cook_torrance`, …) and
+/// the build spreads them over every core. The code is the same.
+trait IsaLoops: LaneKernel + Sized {
+    /// [`path_loop`] in AVX2 + FMA code.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn run_avx2(&self, dirs: &Dirs<'_>, out: &mut Out<'_>);
+
+    /// [`path_loop`] in AVX-512F code.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512F, AVX2 and FMA.
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn run_avx512(&self, dirs: &Dirs<'_>, out: &mut Out<'_>);
+
+    /// [`lanes_loop`] in NEON code (always there on AArch64).
+    #[cfg(target_arch = "aarch64")]
+    fn run_neon(&self, dirs: &Dirs<'_>, out: &mut Out<'_>);
+
+    /// [`lanes_loop`] in `simd128` code (a build with the feature on).
+    #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+    fn run_simd128(&self, dirs: &Dirs<'_>, out: &mut Out<'_>);
+}
+
+impl<K: LaneKernel> IsaLoops for K {
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn run_avx2(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        path_loop::<x86::Avx2, K>(Isa::Avx2, self, dirs, out);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx2,fma")]
+    unsafe fn run_avx512(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        path_loop::<x86::Avx512, K>(Isa::Avx512, self, dirs, out);
+    }
+
+    #[cfg(target_arch = "aarch64")]
+    fn run_neon(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        lanes_loop::<neon::Neon, K>(self, dirs, out);
+    }
+
+    #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+    fn run_simd128(&self, dirs: &Dirs<'_>, out: &mut Out<'_>) {
+        lanes_loop::<wasm::Simd128, K>(self, dirs, out);
     }
 }
 
@@ -330,8 +390,8 @@ fn whole_vectors<V: Lanes, K: LaneKernel>(
     from: usize,
     n: usize,
 ) -> usize {
-    let [ix, iy, iz] = dirs.wi.map(|a| &a[..n]);
-    let [ox, oy, oz] = dirs.wo.map(|a| &a[..n]);
+    let [ix, iy, iz] = first_n(dirs.wi, n);
+    let [ox, oy, oz] = first_n(dirs.wo, n);
     let [r, g, b] = &mut out.rgb;
     let (r, g, b) = (&mut r[..n], &mut g[..n], &mut b[..n]);
     let whole = from + (n - from) / V::LANES * V::LANES;
@@ -364,14 +424,10 @@ fn padded_rest<V: Lanes, K: LaneKernel>(
     if rest == 0 {
         return;
     }
-    let [ix, iy, iz] = dirs.wi.map(|a| &a[..n]);
-    let [ox, oy, oz] = dirs.wo.map(|a| &a[..n]);
+    let [ix, iy, iz] = first_n(dirs.wi, n);
+    let [ox, oy, oz] = first_n(dirs.wo, n);
     let [r, g, b] = &mut out.rgb;
-    let pad = |src: &[f32], fill: f32| {
-        let mut a = [fill; 16];
-        a[..rest].copy_from_slice(&src[whole..]);
-        a
-    };
+    let pad = |src: &[f32], fill: f32| padded(&src[whole..], fill);
     let wi = [
         V::load(&pad(ix, 0.0)),
         V::load(&pad(iy, 0.0)),
@@ -390,6 +446,28 @@ fn padded_rest<V: Lanes, K: LaneKernel>(
     r[whole..n].copy_from_slice(&a[0][..rest]);
     g[whole..n].copy_from_slice(&a[1][..rest]);
     b[whole..n].copy_from_slice(&a[2][..rest]);
+}
+
+/// The first `n` elements of each of three arrays.
+///
+/// A function of its own, not `array::map` with a closure in the generic
+/// loops above: a closure written in a generic function is a new type in
+/// each of its copies, and each such `map` was its own out-of-line copy of
+/// std's `try_map` (about 1 700 of them, a codegen unit that took LLVM as
+/// long as all the kernels together, to make code nothing called after
+/// inlining).
+#[inline]
+fn first_n(a: [&[f32]; 3], n: usize) -> [&[f32]; 3] {
+    [&a[0][..n], &a[1][..n], &a[2][..n]]
+}
+
+/// `src` (at most 16 values) followed by `fill` up to 16 lanes (a
+/// function of its own for the reason [`first_n`] gives).
+#[inline]
+fn padded(src: &[f32], fill: f32) -> [f32; 16] {
+    let mut a = [fill; 16];
+    a[..src.len()].copy_from_slice(src);
+    a
 }
 
 /// Which path a batch took.

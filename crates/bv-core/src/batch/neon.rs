@@ -2,8 +2,8 @@
 //! architecture's baseline, so its types need no run-time check: every
 //! AArch64 CPU that runs Rust's `aarch64-*` targets has it.
 
+use super::LaneTask;
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, LaneTask, Out};
 use std::arch::aarch64::*;
 
 /// Four f32 lanes in a 128-bit NEON register.
@@ -192,11 +192,6 @@ impl Lanes for Neon {
         // SAFETY: NEON is baseline on AArch64.
         Self(unsafe { vcvt_high_f32_f64(vcvt_f32_f64(w.0[0]), w.0[1]) })
     }
-}
-
-/// The lane loop of `k` in NEON code.
-pub(super) fn run_neon<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::lanes_loop::<Neon, K>(k, dirs, out);
 }
 
 /// `task` in NEON code.

@@ -5,8 +5,8 @@
 //! `.cargo/config.toml` sets it; every current browser with WebGPU has
 //! SIMD).
 
+use super::LaneTask;
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, LaneKernel, LaneTask, Out};
 use std::arch::wasm32::*;
 
 /// Four f32 lanes in a `v128`.
@@ -195,11 +195,6 @@ impl Lanes for Simd128 {
         let hi = f32x4_demote_f64x2_zero(w.0[1]);
         Self(i32x4_shuffle::<0, 1, 4, 5>(lo, hi))
     }
-}
-
-/// The lane loop of `k` in `simd128` code.
-pub(super) fn run_simd128<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::lanes_loop::<Simd128, K>(k, dirs, out);
 }
 
 /// `task` in `simd128` code.

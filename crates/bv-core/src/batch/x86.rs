@@ -1,15 +1,17 @@
 //! [`Lanes`] on x86-64: AVX2 + FMA (8 lanes) and AVX-512F (16 lanes), and
-//! the lane loops compiled for each.
+//! the tasks compiled for each (the kernels' loops are the batch module's
+//! `IsaLoops` methods, which say why).
 //!
 //! Soundness: every type here wraps a register whose instructions need the
-//! CPU feature named in its doc. A value of the type is made only inside
-//! [`run_avx2`] or [`run_avx512`], which the dispatcher
-//! ([`super::run`]) calls only after [`super::Isa::is_available`] saw the
-//! feature; the types are private to the batch module, so no other code can
-//! make one.
+//! CPU feature named in its doc. A value of the type is made only inside a
+//! function compiled with that feature (`IsaLoops::run_avx2` and
+//! `run_avx512`, [`task_avx2`], [`task_avx512`]), which the dispatchers
+//! ([`super::run`], [`super::run_task`]) call only after
+//! [`super::Isa::is_available`] saw the feature; the types are private to
+//! the batch module, so no other code can make one.
 
+use super::LaneTask;
 use super::lanes::{Lanes, mask_ops, vector_ops, wide_pair};
-use super::{Dirs, Isa, LaneKernel, LaneTask, Out};
 use std::arch::x86_64::*;
 
 // ---------------------------------------------------------------------------
@@ -237,15 +239,6 @@ impl Lanes for Avx2 {
             Self(_mm256_set_m128(hi, lo))
         }
     }
-}
-
-/// The lane loop of `k` in AVX2 + FMA code.
-///
-/// # Safety
-/// The CPU must have AVX2 and FMA.
-#[target_feature(enable = "avx2,fma")]
-pub(super) unsafe fn run_avx2<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::path_loop::<Avx2, K>(Isa::Avx2, k, dirs, out);
 }
 
 /// `task` in AVX2 + FMA code.
@@ -582,15 +575,6 @@ impl Lanes for Avx512 {
             )))
         }
     }
-}
-
-/// The lane loop of `k` in AVX-512F code.
-///
-/// # Safety
-/// The CPU must have AVX-512F, AVX2 and FMA.
-#[target_feature(enable = "avx512f,avx2,fma")]
-pub(super) unsafe fn run_avx512<K: LaneKernel>(k: &K, dirs: &Dirs<'_>, out: &mut Out<'_>) {
-    super::path_loop::<Avx512, K>(Isa::Avx512, k, dirs, out);
 }
 
 /// `task` in AVX-512F code.

@@ -6,7 +6,7 @@
 //! single-scattering lobe loses (`multiscatter = kulla-conty`,
 //! `crate::multiscatter`): `+ ks F_ms (1 − E(μi)) (1 − E(μo)) / (π (1 − E_avg))`.
 
-use crate::batch::{self, Dirs, Isa, Kernel, LaneKernel, LaneMask, Lanes, Out, math};
+use crate::batch::{self, Dirs, Isa, Kernel, LaneMask, Lanes, Out, math};
 use crate::fresnel::{self, Fresnel, FresnelLanes};
 use crate::microfacet::{
     self, DISTRIBUTION_OPTIONS, Distribution, GEOMETRY_OPTIONS, Geometry, Microfacet, ScaleLanes,
@@ -539,7 +539,9 @@ impl Brdf for CookTorrance {
 /// [`CookTorrance::eval`] in f32 lanes: the same `kd/π + ks F D G / (4 cosθi
 /// cosθo)` with the lane forms of D, Λ and F. Each combination of D (Beckmann,
 /// GGX), G, F and mixture on/off is its own monomorphised loop ([`CtLane`]),
-/// so the lane code has no branch on the model's choices.
+/// so the lane code has no branch on the model's choices. The 90 loops are
+/// five kernel types, one per Fresnel term, each in a module of its own
+/// (`fresnel_kernels!`).
 #[derive(Debug, Clone)]
 struct CtKernel {
     diffuse: [f32; 3],
@@ -647,9 +649,8 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> CtLane<'_, D, G, F,
     }
 }
 
-impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
-    for CtLane<'_, D, G, F, MIX>
-{
+impl<const D: u8, const G: u8, const F: u8, const MIX: bool> CtLane<'_, D, G, F, MIX> {
+    /// [`crate::batch::LaneKernel::lane`] of this combination.
     #[inline(always)]
     fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
         let k = self.0;
@@ -720,25 +721,60 @@ impl<const D: u8, const G: u8, const F: u8, const MIX: bool> LaneKernel
     }
 }
 
+/// The kernel types of [`CtLane`]: one per Fresnel term, each in a module
+/// of its own, generic over D, G and the mixture. rustc puts a kernel's
+/// instruction-set loops (`batch`'s `IsaLoops`) in the codegen unit of its
+/// type's module, so the 90 combinations are five units that LLVM optimises
+/// side by side; as one type they were one unit, the longest of the core's
+/// build, on one core. The code is the same.
+macro_rules! fresnel_kernels {
+    ($($m:ident: $f:ident,)*) => {$(
+        mod $m {
+            use super::{CtKernel, CtLane};
+            use crate::batch::{LaneKernel, Lanes};
+            use crate::fresnel::FresnelLanes;
+
+            /// [`CtLane`] with this module's Fresnel term.
+            #[derive(Debug)]
+            pub(super) struct Lane<'a, const D: u8, const G: u8, const MIX: bool>(
+                pub(super) &'a CtKernel,
+            );
+
+            impl<const D: u8, const G: u8, const MIX: bool> LaneKernel for Lane<'_, D, G, MIX> {
+                #[inline(always)]
+                fn lane<V: Lanes>(&self, wi: [V; 3], wo: [V; 3]) -> [V; 3] {
+                    CtLane::<D, G, { FresnelLanes::$f }, MIX>(self.0).lane(wi, wo)
+                }
+            }
+        }
+    )*};
+}
+
+fresnel_kernels! {
+    f_none: NONE,
+    f_dielectric: DIELECTRIC,
+    f_dielectric_grey: DIELECTRIC_GREY,
+    f_conductor: CONDUCTOR,
+    f_schlick: SCHLICK,
+}
+
 impl Kernel for CtKernel {
     fn eval(&self, isa: Isa, dirs: &Dirs<'_>, out: &mut Out<'_>) {
         macro_rules! go {
-            ($d:expr, $g:expr, $f:expr) => {
+            ($d:expr, $g:expr, $f:ident) => {
                 if self.mix {
-                    batch::run(&CtLane::<$d, $g, $f, true>(self), isa, dirs, out)
+                    batch::run(&$f::Lane::<$d, $g, true>(self), isa, dirs, out)
                 } else {
-                    batch::run(&CtLane::<$d, $g, $f, false>(self), isa, dirs, out)
+                    batch::run(&$f::Lane::<$d, $g, false>(self), isa, dirs, out)
                 }
             };
             ($d:expr, $g:expr) => {
                 match self.fresnel.kind {
-                    FresnelLanes::DIELECTRIC => go!($d, $g, { FresnelLanes::DIELECTRIC }),
-                    FresnelLanes::DIELECTRIC_GREY => {
-                        go!($d, $g, { FresnelLanes::DIELECTRIC_GREY })
-                    }
-                    FresnelLanes::CONDUCTOR => go!($d, $g, { FresnelLanes::CONDUCTOR }),
-                    FresnelLanes::SCHLICK => go!($d, $g, { FresnelLanes::SCHLICK }),
-                    _ => go!($d, $g, { FresnelLanes::NONE }),
+                    FresnelLanes::DIELECTRIC => go!($d, $g, f_dielectric),
+                    FresnelLanes::DIELECTRIC_GREY => go!($d, $g, f_dielectric_grey),
+                    FresnelLanes::CONDUCTOR => go!($d, $g, f_conductor),
+                    FresnelLanes::SCHLICK => go!($d, $g, f_schlick),
+                    _ => go!($d, $g, f_none),
                 }
             };
             ($d:expr) => {
