@@ -5,6 +5,7 @@
 use anyhow::Result;
 use bv_core::analysis::{albedo, directions, reciprocity};
 use bv_core::measured::merl::{self, Interpolation, MerlTable};
+use bv_core::model::FileFormat;
 use bv_core::models::merl::Merl;
 use serde_json::{Value, json};
 use std::path::PathBuf;
@@ -61,10 +62,12 @@ fn pairs_count(s: &str) -> Result<usize, String> {
 /// Runs `bv info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
     let name = args.file.to_string_lossy();
+    // Formats compare by tag, not by address: the formats are zero-sized
+    // statics, and zero-sized statics may share one address (they did once
+    // the core's codegen units changed: an RGL file went to the MERL reader).
+    let merl = bv_core::models::merl::MERL_FILES.tag();
     if let Some((info, _)) = bv_core::registry::file_model(&name)
-        && info
-            .file_param()
-            .is_some_and(|(_, f)| !std::ptr::addr_eq(f, &bv_core::models::merl::MERL_FILES))
+        && info.file_param().is_some_and(|(_, f)| f.tag() != merl)
     {
         return run_other(args);
     }
