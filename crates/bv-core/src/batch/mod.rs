@@ -427,16 +427,15 @@ fn padded_rest<V: Lanes, K: LaneKernel>(
     let [ix, iy, iz] = first_n(dirs.wi, n);
     let [ox, oy, oz] = first_n(dirs.wo, n);
     let [r, g, b] = &mut out.rgb;
-    let pad = |src: &[f32], fill: f32| padded(&src[whole..], fill);
     let wi = [
-        V::load(&pad(ix, 0.0)),
-        V::load(&pad(iy, 0.0)),
-        V::load(&pad(iz, 1.0)),
+        V::load(&padded(&ix[whole..], 0.0)),
+        V::load(&padded(&iy[whole..], 0.0)),
+        V::load(&padded(&iz[whole..], 1.0)),
     ];
     let wo = [
-        V::load(&pad(ox, 0.0)),
-        V::load(&pad(oy, 0.0)),
-        V::load(&pad(oz, 1.0)),
+        V::load(&padded(&ox[whole..], 0.0)),
+        V::load(&padded(&oy[whole..], 0.0)),
+        V::load(&padded(&oz[whole..], 1.0)),
     ];
     let f = k.lane(wi, wo);
     let mut a = [[0f32; 16]; 3];
