@@ -41,9 +41,14 @@ fn deck_path() -> PathBuf {
 
 /// The shipped deck at projector size (1920×1080), every slide numbered,
 /// titled and not blank. This is the deck check of CI (.ci/gui-smoke.sh
-/// rendered the same deck again at this size; one debug-build rendering of
-/// 83 scenes is minutes on 2 cores). The slides are left in
-/// `target/tmp/lecture-deck/` for a human to look at.
+/// rendered the same deck again at this size). The environment scenes are
+/// path traced at `--spp 8` rather than their 64: at 64, on lavapipe in the
+/// debug build, eight of them took 330 s of this test's 485 (and the test
+/// was the suite's last minutes, alone on one core); `--spp` reaching them is
+/// `a_deck_takes_the_sample_count_asked_for`'s check. The slides are left in
+/// `target/tmp/lecture-deck/` for a human to look at (the environment scenes
+/// grainy: `bv render --deck` without `--spp` draws them as the lecture
+/// shows them).
 #[test]
 fn the_lecture_deck_renders_one_png_per_scene() {
     let loaded = deck::load(&deck_path(), Builds::Required).unwrap();
@@ -60,6 +65,7 @@ fn the_lecture_deck_renders_one_png_per_scene() {
         .arg(deck_path())
         .args(["--out", &dir, "--width", &w.to_string(), "--height"])
         .arg(h.to_string())
+        .args(["--spp", "8"])
         .output()
         .unwrap();
     assert!(

@@ -66,8 +66,12 @@ const PROBE_MS = 8000;
 
 fs.mkdirSync(shots, { recursive: true });
 let failures = 0;
+// Seconds since the start on every check: where a slow CI run spent its
+// minutes can be read off its log.
+const started = Date.now();
 function check(ok, what) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
+  const t = ((Date.now() - started) / 1000).toFixed(0).padStart(4);
+  console.log(`${ok ? "ok  " : "FAIL"} [${t} s] ${what}`);
   if (!ok) failures++;
 }
 

@@ -179,19 +179,69 @@ fn sphere_pairs(brdf: &dyn Brdf, seed: u64) -> PairBuf {
 fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
     let available = Isa::available();
     assert!(available.contains(&Isa::Scalar));
+    let want = Reference::new(brdf, dirs);
     for isa in available {
-        if let Some(e) = first_mismatch_on(brdf, dirs, isa) {
+        if let Some(e) = first_mismatch_on(brdf, &want, isa) {
             return Some(format!("[{isa}] {e}"));
         }
     }
     None
 }
 
-/// [`first_mismatch`] on one instruction set: the kernel on `dirs`, and
-/// where it has a form for pairs that share `wi` ([`Kernel::at_wi`]), that
-/// form on every outgoing direction of `dirs` with each of a few of its
-/// incident ones (grazing and below the surface among them).
-fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String> {
+/// What every instruction set is held to, evaluated once: `eval` at every
+/// pair of `dirs`, and where the kernel has a form for pairs that share `wi`
+/// ([`Kernel::at_wi`]), `eval` at every outgoing direction of `dirs` with
+/// each of a few of its incident ones (grazing and below the surface among
+/// them). The f64 evaluations are most of this test's work, and under qemu
+/// (.ci/simd.sh) most of its minutes: each path compares with the same
+/// values rather than computing them again.
+struct Reference {
+    dirs: PairBuf,
+    want: Vec<Rgb>,
+    /// The shared incident direction, its pairs and their values.
+    at_wi: Vec<([f32; 3], PairBuf, Vec<Rgb>)>,
+}
+
+impl Reference {
+    fn new(brdf: &dyn Brdf, dirs: &PairBuf) -> Self {
+        let eval_all = |d: &PairBuf| -> Vec<Rgb> {
+            (0..d.len())
+                .map(|i| {
+                    let (wi, wo) = d.pair(i);
+                    brdf.eval(wi, wo)
+                })
+                .collect()
+        };
+        let n = dirs.len();
+        let mut at_wi = Vec::new();
+        if let Some(kernel) = brdf.batch_kernel() {
+            // The pairs' first, grazing and below-the-surface incident
+            // directions (see `pairs`), and a few from the rest.
+            for i in [0, 1, n - 1, n - 3, n / 3, n / 2, 2 * n / 3] {
+                let wi = [dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]];
+                if kernel.at_wi(wi).is_none() {
+                    break;
+                }
+                let mut shared = dirs.clone();
+                for (c, &w) in wi.iter().enumerate() {
+                    shared.wi[c].fill(w);
+                }
+                let want = eval_all(&shared);
+                at_wi.push((wi, shared, want));
+            }
+        }
+        Reference {
+            dirs: dirs.clone(),
+            want: eval_all(dirs),
+            at_wi,
+        }
+    }
+}
+
+/// [`first_mismatch`] on one instruction set: the kernel, and its forms for
+/// a shared `wi`, against `reference`.
+fn first_mismatch_on(brdf: &dyn Brdf, reference: &Reference, isa: Isa) -> Option<String> {
+    let dirs = &reference.dirs;
     let n = dirs.len();
     let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
     let [r, g, b] = &mut rgb;
@@ -205,21 +255,14 @@ fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String
     );
     assert!(d.kernel);
     assert_eq!((d.isa, d.lanes), (isa.name(), isa.lanes()));
-    if let Some(e) = mismatch_in(brdf, dirs, &rgb) {
+    if let Some(e) = mismatch_in(dirs, &reference.want, &rgb) {
         return Some(e);
     }
     let kernel = brdf.batch_kernel()?;
-    // The pairs' first, grazing and below-the-surface incident directions
-    // (see `pairs`), and a few from the rest.
-    for i in [0, 1, n - 1, n - 3, n / 3, n / 2, 2 * n / 3] {
-        let wi = [dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]];
-        let Some(k) = kernel.at_wi(wi) else {
-            break;
-        };
-        let mut shared = dirs.clone();
-        for (c, &w) in wi.iter().enumerate() {
-            shared.wi[c].fill(w);
-        }
+    for (wi, shared, want) in &reference.at_wi {
+        let k = kernel
+            .at_wi(*wi)
+            .expect("at_wi gave a kernel for this wi a moment ago");
         let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
         let [r, g, b] = &mut rgb;
         k.eval(
@@ -229,7 +272,7 @@ fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String
                 rgb: [&mut r[..], &mut g[..], &mut b[..]],
             },
         );
-        if let Some(e) = mismatch_in(brdf, &shared, &rgb) {
+        if let Some(e) = mismatch_in(shared, want, &rgb) {
             return Some(format!("at_wi: {e}"));
         }
     }
@@ -237,18 +280,18 @@ fn first_mismatch_on(brdf: &dyn Brdf, dirs: &PairBuf, isa: Isa) -> Option<String
 }
 
 /// The first lane of `rgb` (a batch's values at `dirs`) that is not within
-/// [`REL`] or [`ABS`] of `brdf.eval`.
-fn mismatch_in(brdf: &dyn Brdf, dirs: &PairBuf, rgb: &[Vec<f32>; 3]) -> Option<String> {
+/// [`REL`] or [`ABS`] of `want` (`eval` there).
+fn mismatch_in(dirs: &PairBuf, want: &[Rgb], rgb: &[Vec<f32>; 3]) -> Option<String> {
     #[allow(clippy::needless_range_loop)] // lane i of four arrays
     for i in 0..dirs.len() {
-        let (wi, wo) = dirs.pair(i);
-        let want = brdf.eval(wi, wo);
+        let want = want[i];
         for c in 0..3 {
             let got = rgb[c][i] as f64;
             let tol = (REL * want[c].abs()).max(ABS);
             // NaN fails too.
             let close = (got - want[c]).abs() <= tol;
             if !close {
+                let (wi, wo) = dirs.pair(i);
                 return Some(format!(
                     "lane {i} channel {c}: wi {wi} wo {wo}: batch {got:e} vs eval {:e}",
                     want[c]
@@ -718,8 +761,12 @@ fn a_wrong_kernel_is_caught() {
     let dirs = pairs(9);
     assert!(first_mismatch(lambert.as_ref(), &dirs).is_none());
     let wrong = Wrong(lambert, WrongKernel);
+    let reference = Reference::new(&wrong, &dirs);
     for isa in Isa::available() {
-        assert!(first_mismatch_on(&wrong, &dirs, isa).is_some(), "{isa}");
+        assert!(
+            first_mismatch_on(&wrong, &reference, isa).is_some(),
+            "{isa}"
+        );
     }
 }
 
