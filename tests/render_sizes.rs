@@ -63,7 +63,7 @@ fn view_ids() -> Vec<String> {
 /// Distinct colours of an image (a blank render has one), counted up to
 /// `enough`: a scan that stops once the picture is plainly not a flat fill.
 /// (Sorting every pixel of each 4096×3072 image, in this unoptimised test
-/// build, was most of a minute of the suite.)
+/// build, was over a minute of the suite.)
 fn colours_up_to(img: &image::RgbaImage, enough: usize) -> usize {
     let mut seen: Vec<[u8; 4]> = Vec::with_capacity(enough);
     for p in img.pixels() {

@@ -179,9 +179,9 @@ fn sphere_pairs(brdf: &dyn Brdf, seed: u64) -> PairBuf {
 fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
     let available = Isa::available();
     assert!(available.contains(&Isa::Scalar));
-    let want = Reference::new(brdf, dirs);
+    let reference = Reference::new(brdf, dirs);
     for isa in available {
-        if let Some(e) = first_mismatch_on(brdf, &want, isa) {
+        if let Some(e) = first_mismatch_on(brdf, &reference, isa) {
             return Some(format!("[{isa}] {e}"));
         }
     }
@@ -190,20 +190,20 @@ fn first_mismatch(brdf: &dyn Brdf, dirs: &PairBuf) -> Option<String> {
 
 /// What every instruction set is held to, evaluated once: `eval` at every
 /// pair of `dirs`, and where the kernel has a form for pairs that share `wi`
-/// ([`Kernel::at_wi`]), `eval` at every outgoing direction of `dirs` with
-/// each of a few of its incident ones (grazing and below the surface among
-/// them). The f64 evaluations are most of this test's work, and under qemu
-/// (.ci/simd.sh) most of its minutes: each path compares with the same
-/// values rather than computing them again.
-struct Reference {
-    dirs: PairBuf,
+/// ([`Kernel::at_wi`]), that form with `eval` at every outgoing direction of
+/// `dirs` with each of a few of its incident ones (grazing and below the
+/// surface among them). The f64 evaluations are most of this test's work,
+/// and under qemu (.ci/simd.sh) most of its minutes: each path compares with
+/// the same values rather than computing them again.
+struct Reference<'a> {
+    dirs: &'a PairBuf,
     want: Vec<Rgb>,
-    /// The shared incident direction, its pairs and their values.
-    at_wi: Vec<([f32; 3], PairBuf, Vec<Rgb>)>,
+    /// A kernel for one shared incident direction, its pairs and their values.
+    at_wi: Vec<(Box<dyn Kernel + 'a>, PairBuf, Vec<Rgb>)>,
 }
 
-impl Reference {
-    fn new(brdf: &dyn Brdf, dirs: &PairBuf) -> Self {
+impl<'a> Reference<'a> {
+    fn new(brdf: &'a dyn Brdf, dirs: &'a PairBuf) -> Self {
         let eval_all = |d: &PairBuf| -> Vec<Rgb> {
             (0..d.len())
                 .map(|i| {
@@ -219,19 +219,19 @@ impl Reference {
             // directions (see `pairs`), and a few from the rest.
             for i in [0, 1, n - 1, n - 3, n / 3, n / 2, 2 * n / 3] {
                 let wi = [dirs.wi[0][i], dirs.wi[1][i], dirs.wi[2][i]];
-                if kernel.at_wi(wi).is_none() {
+                let Some(k) = kernel.at_wi(wi) else {
                     break;
-                }
+                };
                 let mut shared = dirs.clone();
                 for (c, &w) in wi.iter().enumerate() {
                     shared.wi[c].fill(w);
                 }
                 let want = eval_all(&shared);
-                at_wi.push((wi, shared, want));
+                at_wi.push((k, shared, want));
             }
         }
         Reference {
-            dirs: dirs.clone(),
+            dirs,
             want: eval_all(dirs),
             at_wi,
         }
@@ -240,8 +240,8 @@ impl Reference {
 
 /// [`first_mismatch`] on one instruction set: the kernel, and its forms for
 /// a shared `wi`, against `reference`.
-fn first_mismatch_on(brdf: &dyn Brdf, reference: &Reference, isa: Isa) -> Option<String> {
-    let dirs = &reference.dirs;
+fn first_mismatch_on(brdf: &dyn Brdf, reference: &Reference<'_>, isa: Isa) -> Option<String> {
+    let dirs = reference.dirs;
     let n = dirs.len();
     let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
     let [r, g, b] = &mut rgb;
@@ -258,11 +258,7 @@ fn first_mismatch_on(brdf: &dyn Brdf, reference: &Reference, isa: Isa) -> Option
     if let Some(e) = mismatch_in(dirs, &reference.want, &rgb) {
         return Some(e);
     }
-    let kernel = brdf.batch_kernel()?;
-    for (wi, shared, want) in &reference.at_wi {
-        let k = kernel
-            .at_wi(*wi)
-            .expect("at_wi gave a kernel for this wi a moment ago");
+    for (k, shared, want) in &reference.at_wi {
         let mut rgb = [vec![f32::NAN; n], vec![f32::NAN; n], vec![f32::NAN; n]];
         let [r, g, b] = &mut rgb;
         k.eval(
